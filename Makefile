@@ -1,0 +1,99 @@
+# ballast — build, test, validate, benchmark.
+#
+#   make validate     build, run the default tier of the catalogue, gate, report
+#   make test         C unit tests (Check), symbol-prefix check, harness tests (pytest)
+#   make test-sanitize  C unit tests under AddressSanitizer + UndefinedBehaviorSanitizer
+#   make bench        dense-packing benchmark (median and spread of 5 repeats)
+#   make clean
+
+# ---- settings -------------------------------------------------------------
+CC       ?= cc
+PYTHON   ?= /usr/bin/python3
+TIER     ?= standard
+JOBS     ?= $(shell nproc 2>/dev/null || echo 2)
+OPT      ?= -O2
+WERROR   ?=
+CFLAGS_BASE := -std=c11 -Wall -Wextra -Wpedantic -ffp-contract=off \
+               -D_POSIX_C_SOURCE=200809L $(WERROR)
+CFLAGS   ?= $(OPT) -g
+ALL_CFLAGS = $(CFLAGS_BASE) $(CFLAGS) -DBAL_BUILD_FLAGS='"$(CC) $(CFLAGS_BASE) $(CFLAGS)"'
+LDLIBS   := -lm
+CHECK_LIBS = $(shell pkg-config --libs check 2>/dev/null)
+SAN      := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+
+BUILD    := build
+LIB_SRC  := $(filter-out core/main.c,$(wildcard core/*.c))
+LIB_OBJ  := $(LIB_SRC:core/%.c=$(BUILD)/%.o)
+TEST_SRC := $(wildcard core/tests/check_*.c)
+BENCH_SRC := core/bench/bench.c
+
+.PHONY: all deps test test-c test-prefix test-py test-sanitize validate bench clean keys
+
+all: deps bin/ballast
+
+# Install missing Debian packages (quiet and quick when all are present).
+deps:
+	@sh .ci/install-deps
+
+# ---- library and command --------------------------------------------------
+$(BUILD)/%.o: core/%.c | $(BUILD)
+	$(CC) $(ALL_CFLAGS) -MMD -MP -c $< -o $@
+
+$(BUILD)/libballast.a: $(LIB_OBJ)
+	ar rcs $@ $^
+
+bin/ballast: $(BUILD)/main.o $(BUILD)/libballast.a | bin
+	$(CC) $(ALL_CFLAGS) -o $@ $^ $(LDLIBS)
+
+$(BUILD) bin $(BUILD)/san:
+	mkdir -p $@
+
+# ---- tests ----------------------------------------------------------------
+$(BUILD)/check_ballast: $(TEST_SRC) $(BUILD)/libballast.a core/tests/check_main.h
+	$(CC) $(ALL_CFLAGS) -Icore -o $@ $(TEST_SRC) $(BUILD)/libballast.a $(CHECK_LIBS) $(LDLIBS)
+
+test: deps bin/ballast test-prefix test-c test-py
+
+test-c: $(BUILD)/check_ballast
+	cd core/tests && CK_FORK=yes ../../$(BUILD)/check_ballast
+
+# Every symbol the library exports starts with bal_ (STYLE practice 7).
+test-prefix: $(LIB_OBJ)
+	@bad=$$(nm -g --defined-only $(LIB_OBJ) | awk 'NF==3 && $$3 !~ /^bal_/ {print $$3}'); \
+	if [ -n "$$bad" ]; then echo "symbols without the bal_ prefix: $$bad"; exit 1; fi; \
+	echo "prefix check: every exported symbol starts with bal_"
+
+test-py: bin/ballast
+	$(PYTHON) -m pytest -q harness/tests
+
+# Sanitized build of the library and the C tests, in its own directory.
+SAN_OBJ := $(LIB_SRC:core/%.c=$(BUILD)/san/%.o)
+$(BUILD)/san/%.o: core/%.c | $(BUILD)/san
+	$(CC) $(CFLAGS_BASE) -O1 -g $(SAN) -MMD -MP -c $< -o $@
+
+$(BUILD)/san/check_ballast: $(TEST_SRC) $(SAN_OBJ) core/tests/check_main.h
+	$(CC) $(CFLAGS_BASE) -O1 -g $(SAN) -Icore -o $@ $(TEST_SRC) $(SAN_OBJ) $(CHECK_LIBS) $(LDLIBS)
+
+test-sanitize: deps $(BUILD)/san/check_ballast
+	cd core/tests && CK_FORK=no ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	  ../../$(BUILD)/san/check_ballast
+
+# ---- validation -----------------------------------------------------------
+validate: all
+	$(PYTHON) -m harness validate --tier $(TIER) -j $(JOBS)
+
+# ---- benchmark ------------------------------------------------------------
+$(BUILD)/bench: $(BENCH_SRC) $(BUILD)/libballast.a
+	$(CC) $(ALL_CFLAGS) -Icore -o $@ $(BENCH_SRC) $(BUILD)/libballast.a $(LDLIBS)
+
+bench: deps $(BUILD)/bench
+	$(BUILD)/bench cases/bench/dense.scene
+
+keys: bin/ballast
+	bin/ballast keys
+
+clean:
+	rm -rf $(BUILD) bin reports/runs reports/figures reports/*.json reports/*.xml \
+	       reports/*.html reports/*.md reports/sweeps
+
+-include $(LIB_OBJ:.o=.d) $(SAN_OBJ:.o=.d) $(BUILD)/main.d

@@ -1,0 +1,303 @@
+/*
+ * ballast.h — the public interface of the ballast 2D DEM core.
+ *
+ * ballast implements the BALL scheme of Cundall & Strack (1979) for discs and
+ * straight rigid walls.  Data flows through this header in order:
+ *
+ *   status and errors → scene (define, default, load, validate)
+ *   → simulation life cycle (create, free) → stepping (step, run)
+ *   → measurements → output
+ *
+ * Units are whatever the scene uses (the paper's examples use unitless
+ * numbers); lengths, masses and times must only be consistent.  Angles in
+ * scene files are degrees; inside the core they are radians.
+ *
+ * Sign conventions follow Cundall & Strack Figs 2–3: for a contact between
+ * bodies x and y, e points from x to y, t = (e2, −e1) is e turned clockwise,
+ * and F_n, F_s act on x in the directions −e and −t (compression positive).
+ * Angular velocities and moments are positive counter-clockwise.
+ *
+ * No function here keeps global state; everything lives in the objects
+ * passed in.  Every function that can fail returns an enum bal_status and
+ * fills a struct bal_error with a message naming the place.
+ */
+#ifndef BALLAST_H
+#define BALLAST_H
+
+#include <signal.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#define BAL_VERSION "0.1.0"
+
+/* ------------------------------------------------------------------ */
+/* Status and errors                                                   */
+/* ------------------------------------------------------------------ */
+
+enum bal_status {
+    BAL_OK = 0,        /* success */
+    BAL_EINVAL,        /* invalid input: scene syntax, value out of range */
+    BAL_ENOMEM,        /* allocation failed */
+    BAL_EIO,           /* a file could not be read or written */
+    BAL_EUNSTABLE,     /* the run blew up: NaN or an overlap beyond budget */
+    BAL_EINTR          /* interrupted by a signal */
+};
+
+#define BAL_MSG_MAX 640
+
+struct bal_error {
+    enum bal_status code;          /* the last status raised */
+    char msg[BAL_MSG_MAX];         /* "file:line: key: what was expected" */
+};
+
+/* Fill err (if not NULL) with a formatted message and return code.  Every
+ * error in the core passes through here: one breakpoint catches them all. */
+enum bal_status bal_error(struct bal_error *err, enum bal_status code,
+                          const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* A short name for a status ("ok", "invalid input", ...). */
+const char *bal_strerror(enum bal_status code);
+
+/* ------------------------------------------------------------------ */
+/* Scene: plain data filled from a scene file                          */
+/* ------------------------------------------------------------------ */
+
+#define BAL_NAME_MAX 48
+#define BAL_MAX_MOVES 16
+#define BAL_KEYS_MAX 24   /* most keys one section kind has */
+
+/* Every section struct ends with these: which keys were given (bit k for the
+ * k-th key of its kind in the key table) and on which line. */
+#define BAL_SECTION_TAIL uint32_t given; int key_line[BAL_KEYS_MAX]
+
+enum bal_normal_law {
+    BAL_NORMAL_INCREMENTAL = 0, /* C&S eqs (14), (16), (18): F_n += k_n ṅ Δt */
+    BAL_NORMAL_POWER = 1        /* MLH eq. (2): F_n = k_n δ0 (δ/δ0)^ν */
+};
+
+enum bal_grid_mode {
+    BAL_GRID_AUTO = 0, /* all pairs below the measured cross-over, else grid */
+    BAL_GRID_ON = 1,   /* always a cell grid with a Verlet skin */
+    BAL_GRID_OFF = 2   /* always all pairs (built once, never rebuilt) */
+};
+
+struct bal_settings {
+    double dt;            /* time step; 0 = dt_fraction × estimate (default 0) */
+    double dt_fraction;   /* fraction of the critical-step estimate (0.1) */
+    double alpha;         /* global damping α, C&S eq. (34), 1/time (0) */
+    double beta;          /* contact damping β, C&S eq. (28), time (0) */
+    double gravity[2];    /* body-force acceleration g_i (0 0) */
+    int normal_law;       /* enum bal_normal_law (incremental) */
+    double nu;            /* exponent ν of the power law (1) */
+    double delta0;        /* normalisation δ0 of the power law, length (1) */
+    int grid;             /* enum bal_grid_mode (auto) */
+    double skin;          /* Verlet skin, length; 0 = auto (0) */
+    long output_every;    /* cycles between series rows (1) */
+    BAL_SECTION_TAIL;
+};
+
+struct bal_material_def {
+    char name[BAL_NAME_MAX];
+    int line;             /* line of the section header, for messages */
+    double kn;            /* normal stiffness k_n, force/length (required) */
+    double ks;            /* shear stiffness k_s, force/length (= kn) */
+    double friction;      /* tan φ_μ (0) */
+    double cohesion;      /* c of eq. (19), force (0) */
+    double density;       /* mass per area (per unit thickness) (required for discs) */
+    BAL_SECTION_TAIL;
+};
+
+struct bal_disc_def {
+    char name[BAL_NAME_MAX];
+    int line;
+    double x[2];          /* centre */
+    double r;             /* radius (required) */
+    double v[2];          /* initial velocity (at t_{1/2}) (0 0) */
+    double theta;         /* rotation, degrees (0) */
+    double omega;         /* angular velocity, rad/time (0) */
+    char material[BAL_NAME_MAX];
+    long fixed;           /* 1: held in place (velocity stays zero) (0) */
+    BAL_SECTION_TAIL;
+};
+
+struct bal_wall_def {
+    char name[BAL_NAME_MAX];
+    int line;
+    double p[2];          /* point P of C&S Fig. 4 */
+    double angle;         /* α of e = (cos α, sin α), degrees */
+    double h1, h2;        /* end multipliers: A = P + h1 e, B = P + h2 e */
+    char material[BAL_NAME_MAX];
+    BAL_SECTION_TAIL;
+};
+
+/* A generator: n discs with radii uniform in [rmin, rmax] on a square lattice
+ * of spacing 2 rmax, `columns` per row, filled row by row from (x0, y0); with
+ * box = walls, four walls enclose the lattice region. */
+struct bal_fill_def {
+    char name[BAL_NAME_MAX];
+    int line;
+    long n;               /* number of discs (required) */
+    long columns;         /* lattice columns (required) */
+    double origin[2];     /* lower-left corner of the region (0 0) */
+    double rmin, rmax;    /* radius range (required) */
+    double headroom;      /* extra height above the lattice inside the box (0) */
+    double vmax;          /* initial speeds uniform in [0, vmax), random direction (0) */
+    unsigned long seed;   /* PRNG seed (1) */
+    long box;             /* 1: enclose with four walls (0) */
+    char material[BAL_NAME_MAX];
+    char wall_material[BAL_NAME_MAX];
+    BAL_SECTION_TAIL;
+};
+
+struct bal_move_def {
+    char wall[BAL_NAME_MAX];  /* wall name */
+    int line;
+    double v[2];              /* velocity of P */
+    double omega;             /* angular velocity about P, rad/time */
+};
+
+struct bal_stage_def {
+    char name[BAL_NAME_MAX];
+    int line;
+    long cycles;              /* number of cycles (required, > 0) */
+    int n_moves;
+    struct bal_move_def moves[BAL_MAX_MOVES];
+    BAL_SECTION_TAIL;
+};
+
+enum bal_probe_kind {
+    BAL_PROBE_CONTACT_FN, BAL_PROBE_CONTACT_FS, BAL_PROBE_CONTACT_SLIDING,
+    BAL_PROBE_WALL_F1, BAL_PROBE_WALL_F2, BAL_PROBE_WALL_MOMENT, BAL_PROBE_WALL_ECC,
+    BAL_PROBE_DISC_X, BAL_PROBE_DISC_Y, BAL_PROBE_DISC_VX, BAL_PROBE_DISC_VY,
+    BAL_PROBE_DISC_THETA, BAL_PROBE_DISC_OMEGA,
+    BAL_PROBE_ENERGY_KINETIC, BAL_PROBE_ENERGY_ELASTIC,
+    BAL_PROBE_UNBALANCED, BAL_PROBE_N_CONTACTS,
+    BAL_PROBE_COUNT
+};
+
+struct bal_probe_def {
+    char name[BAL_NAME_MAX];  /* column name in series.tsv */
+    int line;
+    int kind;                 /* enum bal_probe_kind */
+    char a[BAL_NAME_MAX];     /* first body (disc or wall name) */
+    char b[BAL_NAME_MAX];     /* second body, for contact probes */
+    BAL_SECTION_TAIL;
+};
+
+struct bal_scene {
+    char path[512];                 /* file the scene came from */
+    struct bal_settings settings;
+    int n_materials, n_discs, n_walls, n_fills, n_stages, n_probes;
+    int cap_materials, cap_discs, cap_walls, cap_fills, cap_stages, cap_probes;
+    struct bal_material_def *materials;
+    struct bal_disc_def *discs;
+    struct bal_wall_def *walls;
+    struct bal_fill_def *fills;
+    struct bal_stage_def *stages;
+    struct bal_probe_def *probes;
+};
+
+/* Fill s with defaults and no bodies. */
+void bal_scene_default(struct bal_scene *s);
+/* Read a scene file into s (which bal_scene_default has prepared). */
+enum bal_status bal_scene_load(struct bal_scene *s, const char *path,
+                               struct bal_error *err);
+/* Read a scene from a string; `name` stands for the file in messages. */
+enum bal_status bal_scene_parse(struct bal_scene *s, const char *text,
+                                const char *name, struct bal_error *err);
+/* Apply one override "section[.name].key=value", as from --set. */
+enum bal_status bal_scene_set(struct bal_scene *s, const char *assignment,
+                              struct bal_error *err);
+/* Check everything once: ranges, references, stages; names file:line:key. */
+enum bal_status bal_scene_validate(const struct bal_scene *s,
+                                   struct bal_error *err);
+/* Release what the scene owns. */
+void bal_scene_free(struct bal_scene *s);
+/* Print every key of every section with default, range and doc (README). */
+void bal_scene_print_keys(FILE *out);
+
+/* ------------------------------------------------------------------ */
+/* Simulation life cycle                                               */
+/* ------------------------------------------------------------------ */
+
+struct bal_sim;
+
+/* Build the state from a validated scene; all memory is reserved here. */
+enum bal_status bal_sim_create(struct bal_sim **sim, const struct bal_scene *s,
+                               struct bal_error *err);
+void bal_sim_free(struct bal_sim *sim);
+
+/* ------------------------------------------------------------------ */
+/* Stepping                                                            */
+/* ------------------------------------------------------------------ */
+
+/* Per-run counters and timings. */
+struct bal_run_info {
+    long steps;               /* cycles completed */
+    double time;              /* simulated time */
+    double dt;                /* time step used */
+    double dt_estimate;       /* critical-step estimate */
+    double dt_fraction;       /* dt / dt_estimate */
+    double wall_seconds;      /* wall-clock time spent stepping */
+    long rebuilds;            /* neighbour-list rebuilds */
+    int grid_used;            /* 1 when the cell grid is in use */
+    int n_discs, n_walls;
+    long n_candidates;        /* candidate disc–disc pairs (last rebuild) */
+};
+
+/* Advance one cycle (C&S calculation cycle): move discs and walls to t_N,
+ * find contacts, apply the force–displacement law at t_N, update the
+ * velocities to t_{N+1/2}.  The scene must outlive the simulation. */
+enum bal_status bal_sim_step(struct bal_sim *sim, struct bal_error *err);
+
+/* Select the wall motions of stage `stage` (index into the scene's stages). */
+void bal_sim_set_stage(struct bal_sim *sim, int stage);
+
+/* Run every stage of the loading protocol, writing a row to `series` (may be
+ * NULL) every output_every cycles.  `stop` (may be NULL) is polled between
+ * cycles; when it becomes non-zero the run ends with BAL_EINTR. */
+enum bal_status bal_sim_run(struct bal_sim *sim, FILE *series,
+                            volatile const sig_atomic_t *stop, struct bal_error *err);
+
+void bal_sim_info(const struct bal_sim *sim, struct bal_run_info *info);
+
+/* ------------------------------------------------------------------ */
+/* Measurements                                                        */
+/* ------------------------------------------------------------------ */
+
+/* The value of one probe of the scene at the current cycle. */
+double bal_measure_probe(const struct bal_sim *sim, int probe);
+double bal_measure_kinetic(const struct bal_sim *sim);
+double bal_measure_elastic(const struct bal_sim *sim);
+/* ΔF/F of C&S Tables 1–3: largest force sum on any free disc over the
+ * largest contact force (0 when there is no contact). */
+double bal_measure_unbalanced(const struct bal_sim *sim);
+
+/* ------------------------------------------------------------------ */
+/* Output                                                              */
+/* ------------------------------------------------------------------ */
+
+/* Write the series header (cycle, time, probe names) / one row. */
+void bal_output_series_header(const struct bal_sim *sim, FILE *f);
+void bal_output_series_row(const struct bal_sim *sim, FILE *f);
+/* Name of disc `id` (scene order): its [disc] name, or FILL.k. */
+void bal_output_disc_name(const struct bal_sim *sim, int id, char *buf, size_t size);
+/* Write contacts.tsv and discs.tsv of the final state into dir. */
+enum bal_status bal_output_state(const struct bal_sim *sim, const char *dir,
+                                 struct bal_error *err);
+
+/* Write run.json into dir (via a temporary name): version, build, scene,
+ * the --set overrides, how the run ended, steps, time step and estimate,
+ * timings and energies.  `sim` may be NULL when the run never started. */
+enum bal_status bal_output_run_json(const struct bal_sim *sim, const char *dir,
+                                    const char *scene_path, int n_sets,
+                                    char *const *sets, enum bal_status status,
+                                    const char *message, struct bal_error *err);
+
+/* Rename dir/name.tmp to dir/name: outputs appear only when complete. */
+enum bal_status bal_output_commit(const char *dir, const char *name,
+                                  struct bal_error *err);
+
+#endif /* BALLAST_H */

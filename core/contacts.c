@@ -1,0 +1,325 @@
+/*
+ * contacts.c — candidate lists with contact history, and the
+ * force–displacement law at every contact (Cundall & Strack eqs 8–19,
+ * 24–28; Matuttis, Luding & Herrmann eq. 2).
+ *
+ * For a contact between bodies x and y (x = the lower index; for a disc–wall
+ * contact x is the disc and y the wall):
+ *
+ *   e  = (y − x)/D, t = (e2, −e1)                          C&S eqs (9)–(10)
+ *   ṅ  = (ẋ − ẏ)·e                                          eq. (12)
+ *   ṡ  = (ẋ − ẏ)·t − (θ̇_x R_x + θ̇_y R_y)                    eq. (13)
+ *   F_n += k_n ṅ Δt  (incremental law)                      eqs (14), (16), (18)
+ *   F_n  = k_n δ0 (δ/δ0)^ν, δ = R_x + R_y − D (power law)   MLH eq. (2)
+ *   F_s += k_s ṡ Δt, |F_s| ≤ F_n tan φ_μ + c                 eqs (15), (17)–(19)
+ *   D_n = c_n ṅ, D_s = c_s ṡ (0 while sliding)              eqs (26)–(28)
+ *
+ * F_n + D_n and F_s + D_s act on x in the directions −e and −t (Fig. 3);
+ * the moment on x and on y is (F_s + D_s) R (the text after eq. 19).
+ *
+ * Choices the paper leaves open, written down here:
+ * - A contact exists while D < R_x + R_y (eq. 8, strict); when it opens its
+ *   history is reset to zero, so a new contact starts from F_n = F_s = 0 and
+ *   its first increment is k_n ṅ Δt, exactly as in the worked example of
+ *   Fig. 1 (eqs 1, 5–7).
+ * - The incremental F_n never becomes tensile: it is kept ≥ 0 (cohesion acts
+ *   only through the shear limit of eq. 19).  Dashpot forces are not
+ *   clipped, as in the paper.
+ * - The Coulomb limit uses the elastic F_n (eq. 19).
+ * - A pair with tan φ_μ = 0 and c = 0 carries no shear force and no shear
+ *   dashpot (it would slide at any tangential motion) and is not flagged
+ *   as sliding.
+ *
+ * Velocities are those at t_{N−1/2} (C&S eqs 26–27 note the half step).
+ *
+ * The disc–disc loop is compiled in 8 variants (normal law × shear on/off ×
+ * damping on/off) and one is chosen when the simulation is created, so a
+ * scene without friction or damping never runs their code or touches their
+ * arrays.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sim.h"
+
+/* ------------------------------------------------------------------ */
+/* Candidate lists                                                     */
+/* ------------------------------------------------------------------ */
+
+enum bal_status bal_pairs_reserve(struct bal_pairs *p, long cap)
+{
+    if (cap <= p->cap)
+        return BAL_OK;
+    size_t c = (size_t)cap;
+    void *k = realloc(p->key, c * sizeof *p->key);
+    if (k)
+        p->key = k;
+    void *i = realloc(p->i, c * sizeof *p->i);
+    if (i)
+        p->i = i;
+    void *j = realloc(p->j, c * sizeof *p->j);
+    if (j)
+        p->j = j;
+    void *fn = realloc(p->fn, c * sizeof *p->fn);
+    if (fn)
+        p->fn = fn;
+    void *fs = realloc(p->fs, c * sizeof *p->fs);
+    if (fs)
+        p->fs = fs;
+    void *dn = realloc(p->dn, c * sizeof *p->dn);
+    if (dn)
+        p->dn = dn;
+    void *ds = realloc(p->ds, c * sizeof *p->ds);
+    if (ds)
+        p->ds = ds;
+    void *fl = realloc(p->flags, c * sizeof *p->flags);
+    if (fl)
+        p->flags = fl;
+    if (!k || !i || !j || !fn || !fs || !dn || !ds || !fl)
+        return BAL_ENOMEM;
+    p->cap = cap;
+    return BAL_OK;
+}
+
+void bal_pairs_free(struct bal_pairs *p)
+{
+    free(p->key);
+    free(p->i);
+    free(p->j);
+    free(p->fn);
+    free(p->fs);
+    free(p->dn);
+    free(p->ds);
+    free(p->flags);
+    memset(p, 0, sizeof *p);
+}
+
+/* Copy the history of every contact of `old` whose key is also in `fresh`.
+ * Both lists are sorted by key, so one linear pass suffices.  Contacts of
+ * `fresh` that are new start with zero history. */
+void bal_pairs_merge_history(struct bal_pairs *fresh, const struct bal_pairs *old)
+{
+    long a = 0;
+    for (long c = 0; c < fresh->n; c++) {
+        uint64_t k = fresh->key[c];
+        while (a < old->n && old->key[a] < k)
+            a++;
+        if (a < old->n && old->key[a] == k) {
+            fresh->fn[c] = old->fn[a];
+            fresh->fs[c] = old->fs[a];
+            fresh->dn[c] = old->dn[a];
+            fresh->ds[c] = old->ds[a];
+            fresh->flags[c] = old->flags[a];
+        } else {
+            fresh->fn[c] = 0;
+            fresh->fs[c] = 0;
+            fresh->dn[c] = 0;
+            fresh->ds[c] = 0;
+            fresh->flags[c] = 0;
+        }
+    }
+}
+
+/* ------------------------------------------------------------------ */
+/* Disc–disc force–displacement law                                    */
+/* ------------------------------------------------------------------ */
+
+static inline double power_force(double kn, double delta, double delta0, double nu)
+{
+    if (nu == 1.0)
+        return kn * delta;
+    if (nu == 1.5)
+        return kn * delta * sqrt(delta / delta0);
+    if (nu == 2.0)
+        return kn * delta * (delta / delta0);
+    return kn * delta0 * pow(delta / delta0, nu);
+}
+
+static inline __attribute__((always_inline)) void
+pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int damp)
+{
+    struct bal_pairs *restrict p = &s->pp;
+    const double *restrict x = s->x, *restrict y = s->y;
+    const double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
+    const double *restrict r = s->r;
+    const int32_t *restrict mat = s->mat;
+    double *restrict fx = s->fx, *restrict fy = s->fy, *restrict tq = s->tq;
+    const double dt = s->dt, nu = s->nu, delta0 = s->delta0;
+    const int n_mat = s->n_mat;
+    const struct bal_pair_law *restrict laws = s->law;
+
+    for (long c = 0; c < p->n; c++) {
+        const int i = p->i[c], j = p->j[c];
+        const double dx = x[j] - x[i], dy = y[j] - y[i];
+        const double rs = r[i] + r[j];
+        const double d2 = dx * dx + dy * dy;
+        if (d2 >= rs * rs) {
+            /* Not in contact (eq. 8): history is reset. */
+            p->fn[c] = 0;
+            p->fs[c] = 0;
+            p->dn[c] = 0;
+            p->ds[c] = 0;
+            p->flags[c] = 0;
+            continue;
+        }
+        const struct bal_pair_law *L = &laws[mat[i] * n_mat + mat[j]];
+        const double dist = sqrt(d2);
+        const double ex = dx / dist, ey = dy / dist;
+        const double rvx = vx[i] - vx[j], rvy = vy[i] - vy[j];
+        const double ndot = rvx * ex + rvy * ey;
+
+        double fn;
+        if (law == BAL_NORMAL_INCREMENTAL) {
+            fn = p->fn[c] + L->kn * ndot * dt;
+            if (fn < 0)
+                fn = 0;
+        } else {
+            fn = power_force(L->kn, rs - dist, delta0, nu);
+        }
+        p->fn[c] = fn;
+        double ftn = fn, fts = 0;
+        uint8_t flags = BAL_PAIR_TOUCHING;
+        if (damp) {
+            const double dn = L->cn * ndot;
+            p->dn[c] = dn;
+            ftn += dn;
+        }
+        if (shear && L->shear) {
+            const double tx = ey, ty = -ex;
+            const double sdot = rvx * tx + rvy * ty - (w[i] * r[i] + w[j] * r[j]);
+            double fs = p->fs[c] + L->ks * sdot * dt;
+            const double fmax = fn * L->tan_phi + L->cohesion;
+            if (fabs(fs) > fmax) {
+                fs = copysign(fmax, fs);
+                flags |= BAL_PAIR_SLIDING;
+            }
+            p->fs[c] = fs;
+            fts = fs;
+            if (damp) {
+                const double ds = (flags & BAL_PAIR_SLIDING) ? 0.0 : L->cs * sdot;
+                p->ds[c] = ds;
+                fts += ds;
+            }
+        }
+        p->flags[c] = flags;
+
+        /* Force on y is +(ftn e + fts t); on x the opposite (Fig. 3). */
+        const double fcx = ftn * ex + fts * ey;
+        const double fcy = ftn * ey - fts * ex;
+        fx[i] -= fcx;
+        fy[i] -= fcy;
+        fx[j] += fcx;
+        fy[j] += fcy;
+        if (shear) {
+            tq[i] += fts * r[i];
+            tq[j] += fts * r[j];
+        }
+    }
+}
+
+#define PAIR_VARIANT(name, law, shear, damp) \
+    static void name(struct bal_sim *s) { pair_loop(s, law, shear, damp); }
+
+PAIR_VARIANT(loop_inc, BAL_NORMAL_INCREMENTAL, 0, 0)
+PAIR_VARIANT(loop_inc_d, BAL_NORMAL_INCREMENTAL, 0, 1)
+PAIR_VARIANT(loop_inc_s, BAL_NORMAL_INCREMENTAL, 1, 0)
+PAIR_VARIANT(loop_inc_sd, BAL_NORMAL_INCREMENTAL, 1, 1)
+PAIR_VARIANT(loop_pow, BAL_NORMAL_POWER, 0, 0)
+PAIR_VARIANT(loop_pow_d, BAL_NORMAL_POWER, 0, 1)
+PAIR_VARIANT(loop_pow_s, BAL_NORMAL_POWER, 1, 0)
+PAIR_VARIANT(loop_pow_sd, BAL_NORMAL_POWER, 1, 1)
+
+bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping)
+{
+    static const bal_pair_loop_fn table[2][2][2] = {
+        {{loop_inc, loop_inc_d}, {loop_inc_s, loop_inc_sd}},
+        {{loop_pow, loop_pow_d}, {loop_pow_s, loop_pow_sd}},
+    };
+    return table[normal_law == BAL_NORMAL_POWER][shear != 0][damping != 0];
+}
+
+/* ------------------------------------------------------------------ */
+/* Disc–wall contacts                                                  */
+/* ------------------------------------------------------------------ */
+
+/* The wall is body y: its "radius" is zero and the velocity of its contact
+ * point V + ω × (c − P) replaces ẏ and θ̇_y R_y of eqs (11)–(13).  Walls are
+ * few and so are their contacts; one generic loop serves every law. */
+void bal_contacts_walls(struct bal_sim *s)
+{
+    struct bal_pairs *p = &s->pw;
+    const double dt = s->dt;
+    for (int k = 0; k < s->n_walls; k++) {
+        struct bal_wall *W = &s->walls[k];
+        W->f[0] = W->f[1] = W->moment = W->fn_sum = W->fn_s_sum = 0;
+    }
+    for (long c = 0; c < p->n; c++) {
+        const int i = p->i[c];
+        struct bal_wall *W = &s->walls[p->j[c]];
+        double cx, cy;
+        const double d2 = bal_walls_closest(W, s->x[i], s->y[i], &cx, &cy);
+        const double ri = s->r[i];
+        if (d2 >= ri * ri) {
+            p->fn[c] = p->fs[c] = p->dn[c] = p->ds[c] = 0;
+            p->flags[c] = 0;
+            continue;
+        }
+        const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + W->material];
+        double ex, ey;
+        const double dist = sqrt(d2);
+        if (dist > 0) {
+            ex = (cx - s->x[i]) / dist;
+            ey = (cy - s->y[i]) / dist;
+        } else {
+            /* Centre exactly on the wall: push along the wall's normal. */
+            ex = -W->e[1];
+            ey = W->e[0];
+        }
+        const double tx = ey, ty = -ex;
+        const double wvx = W->v[0] - W->omega * (cy - W->p[1]);
+        const double wvy = W->v[1] + W->omega * (cx - W->p[0]);
+        const double rvx = s->vx[i] - wvx, rvy = s->vy[i] - wvy;
+        const double ndot = rvx * ex + rvy * ey;
+        const double sdot = rvx * tx + rvy * ty - s->w[i] * ri;
+
+        double fn;
+        if (s->normal_law == BAL_NORMAL_INCREMENTAL) {
+            fn = p->fn[c] + L->kn * ndot * dt;
+            if (fn < 0)
+                fn = 0;
+        } else {
+            fn = power_force(L->kn, ri - dist, s->delta0, s->nu);
+        }
+        /* A frictionless, cohesionless pair carries no shear force and no
+         * shear dashpot, as in the disc–disc loop without shear. */
+        const double fmax = fn * L->tan_phi + L->cohesion;
+        const int shear = L->shear;
+        double fs = shear ? p->fs[c] + L->ks * sdot * dt : 0.0;
+        uint8_t flags = BAL_PAIR_TOUCHING;
+        if (shear && fabs(fs) > fmax) {
+            fs = copysign(fmax, fs);
+            flags |= BAL_PAIR_SLIDING;
+        }
+        const double dn = L->cn * ndot;
+        const double ds = (!shear || (flags & BAL_PAIR_SLIDING)) ? 0.0 : L->cs * sdot;
+        p->fn[c] = fn;
+        p->fs[c] = fs;
+        p->dn[c] = dn;
+        p->ds[c] = ds;
+        p->flags[c] = flags;
+
+        const double ftn = fn + dn, fts = fs + ds;
+        const double fcx = ftn * ex + fts * tx;
+        const double fcy = ftn * ey + fts * ty;
+        s->fx[i] -= fcx;
+        s->fy[i] -= fcy;
+        s->tq[i] += fts * ri;
+        W->f[0] += fcx;
+        W->f[1] += fcy;
+        W->moment += (cx - W->p[0]) * fcy - (cy - W->p[1]) * fcx;
+        const double along = (cx - W->p[0]) * W->e[0] + (cy - W->p[1]) * W->e[1];
+        W->fn_sum += ftn;
+        W->fn_s_sum += ftn * along;
+    }
+}

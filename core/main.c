@@ -1,0 +1,237 @@
+/*
+ * main.c — the `ballast` command: the only place that parses the command
+ * line, touches signals and maps a status to an exit code.
+ *
+ *   ballast run SCENE --out DIR [--set KEY=VALUE ...]
+ *   ballast info SCENE [--set KEY=VALUE ...]
+ *   ballast keys          (every scene key, as Markdown tables)
+ *   ballast --version
+ *
+ * Exit codes: 0 success; 1 the run failed (unstable); 2 bad input or usage;
+ * 3 input/output error; 4 out of memory; 130 interrupted.
+ * A scene that fails to load or validate writes nothing.  A run that
+ * starts writes run.json saying how it ended; series.tsv, discs.tsv and
+ * contacts.tsv appear only when the run completed.
+ */
+#include <errno.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "ballast.h"
+
+static volatile sig_atomic_t stop_requested;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    stop_requested = 1;
+}
+
+static int exit_code(enum bal_status st)
+{
+    switch (st) {
+    case BAL_OK: return 0;
+    case BAL_EUNSTABLE: return 1;
+    case BAL_EINVAL: return 2;
+    case BAL_EIO: return 3;
+    case BAL_ENOMEM: return 4;
+    case BAL_EINTR: return 130;
+    }
+    return 1;
+}
+
+static int usage(void)
+{
+    fputs("usage: ballast run SCENE --out DIR [--set KEY=VALUE ...]\n"
+          "       ballast info SCENE [--set KEY=VALUE ...]\n"
+          "       ballast keys\n"
+          "       ballast --version\n",
+          stderr);
+    return 2;
+}
+
+/* mkdir -p */
+static int make_dirs(const char *path)
+{
+    char buf[1024];
+    if (strlen(path) >= sizeof buf)
+        return -1;
+    strcpy(buf, path);
+    for (char *p = buf + 1; *p; p++) {
+        if (*p == '/') {
+            *p = '\0';
+            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+                return -1;
+            *p = '/';
+        }
+    }
+    if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+        return -1;
+    return 0;
+}
+
+struct args {
+    const char *cmd, *scene, *out;
+    int n_sets;
+    char **sets;
+};
+
+static int parse_args(int argc, char **argv, struct args *a)
+{
+    memset(a, 0, sizeof *a);
+    if (argc < 2)
+        return 0;
+    a->cmd = argv[1];
+    a->sets = calloc((size_t)argc, sizeof *a->sets);
+    if (!a->sets)
+        return 0;
+    for (int k = 2; k < argc; k++) {
+        if (strcmp(argv[k], "--out") == 0 && k + 1 < argc)
+            a->out = argv[++k];
+        else if (strcmp(argv[k], "--set") == 0 && k + 1 < argc)
+            a->sets[a->n_sets++] = argv[++k];
+        else if (argv[k][0] != '-' && !a->scene)
+            a->scene = argv[k];
+        else {
+            fprintf(stderr, "ballast: unexpected argument '%s'\n", argv[k]);
+            return 0;
+        }
+    }
+    return 1;
+}
+
+static enum bal_status load(struct bal_scene *sc, const struct args *a, struct bal_error *err)
+{
+    bal_scene_default(sc);
+    if (bal_scene_load(sc, a->scene, err))
+        return err->code;
+    for (int k = 0; k < a->n_sets; k++)
+        if (bal_scene_set(sc, a->sets[k], err))
+            return err->code;
+    return bal_scene_validate(sc, err);
+}
+
+static int cmd_info(const struct args *a)
+{
+    struct bal_scene sc;
+    struct bal_error err = {0};
+    struct bal_sim *sim = NULL;
+    if (load(&sc, a, &err) || bal_sim_create(&sim, &sc, &err)) {
+        fprintf(stderr, "%s\n", err.msg);
+        bal_scene_free(&sc);
+        return exit_code(err.code);
+    }
+    struct bal_run_info in;
+    bal_sim_info(sim, &in);
+    long cycles = 0;
+    for (int g = 0; g < sc.n_stages; g++)
+        cycles += sc.stages[g].cycles;
+    printf("scene          %s\n", sc.path);
+    printf("discs          %d\n", in.n_discs);
+    printf("walls          %d\n", in.n_walls);
+    printf("materials      %d\n", sc.n_materials);
+    printf("normal law     %s\n", sc.settings.normal_law == BAL_NORMAL_POWER ? "power" : "incremental");
+    printf("neighbours     %s (%ld candidate pairs)\n", in.grid_used ? "cell grid" : "all pairs",
+           in.n_candidates);
+    printf("dt estimate    %.17g   (min over discs of 2 sqrt(m/k), C&S p. 53)\n", in.dt_estimate);
+    printf("dt fraction    %.17g\n", in.dt_fraction);
+    printf("dt used        %.17g\n", in.dt);
+    printf("stages         %d (%ld cycles)\n", sc.n_stages, cycles);
+    bal_sim_free(sim);
+    bal_scene_free(&sc);
+    return 0;
+}
+
+static int cmd_run(const struct args *a)
+{
+    struct bal_scene sc;
+    struct bal_error err = {0};
+    struct bal_sim *sim = NULL;
+    if (!a->out) {
+        fputs("ballast run: --out DIR is required\n", stderr);
+        return 2;
+    }
+    if (load(&sc, a, &err) || bal_sim_create(&sim, &sc, &err)) {
+        fprintf(stderr, "%s\n", err.msg);
+        bal_scene_free(&sc);
+        return exit_code(err.code);
+    }
+    if (make_dirs(a->out) != 0) {
+        fprintf(stderr, "ballast: %s: cannot create directory: %s\n", a->out, strerror(errno));
+        bal_sim_free(sim);
+        bal_scene_free(&sc);
+        return 3;
+    }
+    /* Remove results of an earlier run so nothing stale is read as new. */
+    const char *names[] = {"series.tsv", "discs.tsv", "contacts.tsv", "run.json"};
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
+        char p[1200];
+        snprintf(p, sizeof p, "%s/%s", a->out, names[k]);
+        remove(p);
+    }
+
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+
+    char tmp[1200];
+    snprintf(tmp, sizeof tmp, "%s/series.tsv.tmp", a->out);
+    FILE *series = fopen(tmp, "w");
+    enum bal_status st;
+    if (!series) {
+        st = bal_error(&err, BAL_EIO, "%s: cannot write: %s", tmp, strerror(errno));
+    } else {
+        bal_output_series_header(sim, series);
+        st = bal_sim_run(sim, series, &stop_requested, &err);
+        int bad = ferror(series);
+        bad |= fclose(series) != 0;
+        if (st == BAL_OK && bad)
+            st = bal_error(&err, BAL_EIO, "%s: write failed", tmp);
+        if (st == BAL_OK)
+            st = bal_output_commit(a->out, "series.tsv", &err);
+        if (st == BAL_OK)
+            st = bal_output_state(sim, a->out, &err);
+        if (st != BAL_OK)
+            remove(tmp);
+    }
+    struct bal_error jerr = {0};
+    enum bal_status js = bal_output_run_json(sim, a->out, sc.path, a->n_sets, a->sets, st,
+                                             st == BAL_OK ? "" : err.msg, &jerr);
+    if (st != BAL_OK)
+        fprintf(stderr, "%s\n", err.msg);
+    if (js != BAL_OK)
+        fprintf(stderr, "%s\n", jerr.msg);
+    bal_sim_free(sim);
+    bal_scene_free(&sc);
+    return exit_code(st != BAL_OK ? st : js);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc == 2 && strcmp(argv[1], "--version") == 0) {
+        printf("ballast %s\n", BAL_VERSION);
+        return 0;
+    }
+    if (argc == 2 && strcmp(argv[1], "keys") == 0) {
+        bal_scene_print_keys(stdout);
+        return 0;
+    }
+    struct args a;
+    int ok = parse_args(argc, argv, &a);
+    int rc;
+    if (!ok || !a.scene)
+        rc = usage();
+    else if (strcmp(a.cmd, "run") == 0)
+        rc = cmd_run(&a);
+    else if (strcmp(a.cmd, "info") == 0)
+        rc = cmd_info(&a);
+    else
+        rc = usage();
+    free(a.sets);
+    return rc;
+}

@@ -1,0 +1,246 @@
+/*
+ * output.c — the files a run writes.
+ *
+ *   series.tsv    header line of column names (cycle, time, then one column
+ *                 per [probe], in file order), one row per output interval
+ *   discs.tsv     final state of every disc, in scene order
+ *   contacts.tsv  every touching contact of the final state
+ *   run.json      version, build, scene, overrides, how the run ended,
+ *                 steps, time step and its estimate, timings, energies
+ *
+ * Numbers are printed with %.17g, so a file read back gives the same
+ * doubles: outputs compare bitwise across runs.  Every file is written
+ * under NAME.tmp and renamed when complete, so a reader never takes a
+ * half-written file for a result.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "scene.h"
+#include "sim.h"
+
+#ifndef BAL_BUILD_FLAGS
+#define BAL_BUILD_FLAGS "unknown"
+#endif
+
+void bal_output_disc_name(const struct bal_sim *s, int id, char *buf, size_t size)
+{
+    const struct bal_scene *sc = s->scene;
+    if (id < sc->n_discs) {
+        snprintf(buf, size, "%s", sc->discs[id].name);
+        return;
+    }
+    long k = id - sc->n_discs;
+    for (int f = 0; f < sc->n_fills; f++) {
+        if (k < sc->fills[f].n) {
+            snprintf(buf, size, "%s.%ld", sc->fills[f].name, k);
+            return;
+        }
+        k -= sc->fills[f].n;
+    }
+    snprintf(buf, size, "?%d", id);
+}
+
+void bal_output_series_header(const struct bal_sim *s, FILE *f)
+{
+    fputs("cycle\ttime", f);
+    for (int p = 0; p < s->scene->n_probes; p++)
+        fprintf(f, "\t%s", s->scene->probes[p].name);
+    fputc('\n', f);
+}
+
+void bal_output_series_row(const struct bal_sim *s, FILE *f)
+{
+    fprintf(f, "%ld\t%.17g", s->step, s->time);
+    for (int p = 0; p < s->n_probes; p++)
+        fprintf(f, "\t%.17g", bal_measure_probe(s, p));
+    fputc('\n', f);
+}
+
+static FILE *open_tmp(const char *dir, const char *name, struct bal_error *err)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s.tmp", dir, name);
+    FILE *f = fopen(path, "w");
+    if (!f)
+        bal_error(err, BAL_EIO, "%s: cannot write: %s", path, strerror(errno));
+    return f;
+}
+
+static enum bal_status close_tmp(FILE *f, const char *dir, const char *name,
+                                 struct bal_error *err)
+{
+    int bad = ferror(f);
+    bad |= fclose(f) != 0;
+    if (bad) {
+        char path[1024];
+        snprintf(path, sizeof path, "%s/%s.tmp", dir, name);
+        remove(path);
+        return bal_error(err, BAL_EIO, "%s: write failed", path);
+    }
+    return bal_output_commit(dir, name, err);
+}
+
+enum bal_status bal_output_commit(const char *dir, const char *name, struct bal_error *err)
+{
+    char from[1024], to[1024];
+    snprintf(from, sizeof from, "%s/%s.tmp", dir, name);
+    snprintf(to, sizeof to, "%s/%s", dir, name);
+    if (rename(from, to) != 0)
+        return bal_error(err, BAL_EIO, "%s: cannot rename to %s: %s", from, to, strerror(errno));
+    return BAL_OK;
+}
+
+static void body_name(const struct bal_sim *s, int is_wall, int index, char *buf, size_t size)
+{
+    if (is_wall)
+        snprintf(buf, size, "%s", s->walls[index].name);
+    else
+        bal_output_disc_name(s, s->id[index], buf, size);
+}
+
+static void write_contacts(const struct bal_sim *s, FILE *f)
+{
+    fputs("a\tb\tkind\tx\ty\tnx\tny\tfn\tfs\tdn\tds\tsliding\n", f);
+    char a[2 * BAL_NAME_MAX], b[2 * BAL_NAME_MAX];
+    for (long c = 0; c < s->pp.n; c++) {
+        if (!(s->pp.flags[c] & BAL_PAIR_TOUCHING))
+            continue;
+        const int i = s->pp.i[c], j = s->pp.j[c];
+        const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
+        const double d = hypot(dx, dy), delta = s->r[i] + s->r[j] - d;
+        const double ex = dx / d, ey = dy / d, at = s->r[i] - delta / 2;
+        body_name(s, 0, i, a, sizeof a);
+        body_name(s, 0, j, b, sizeof b);
+        fprintf(f, "%s\t%s\tdisc\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d\n", a,
+                b, s->x[i] + at * ex, s->y[i] + at * ey, ex, ey, s->pp.fn[c], s->pp.fs[c],
+                s->pp.dn[c], s->pp.ds[c], (s->pp.flags[c] & BAL_PAIR_SLIDING) != 0);
+    }
+    for (long c = 0; c < s->pw.n; c++) {
+        if (!(s->pw.flags[c] & BAL_PAIR_TOUCHING))
+            continue;
+        const int i = s->pw.i[c];
+        const struct bal_wall *W = &s->walls[s->pw.j[c]];
+        double cx, cy;
+        const double d = sqrt(bal_walls_closest(W, s->x[i], s->y[i], &cx, &cy));
+        double ex = -W->e[1], ey = W->e[0];
+        if (d > 0) {
+            ex = (cx - s->x[i]) / d;
+            ey = (cy - s->y[i]) / d;
+        }
+        /* Halfway between the disc's surface point and the wall point
+         * (C&S p. 49, contact A of Fig. 1). */
+        const double at = 0.5 * (s->r[i] + d);
+        body_name(s, 0, i, a, sizeof a);
+        fprintf(f, "%s\t%s\twall\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d\n", a,
+                W->name, s->x[i] + at * ex, s->y[i] + at * ey, ex, ey, s->pw.fn[c], s->pw.fs[c],
+                s->pw.dn[c], s->pw.ds[c], (s->pw.flags[c] & BAL_PAIR_SLIDING) != 0);
+    }
+}
+
+static void write_discs(const struct bal_sim *s, FILE *f)
+{
+    fputs("id\tname\tx\ty\tr\ttheta\tvx\tvy\tomega\tm\tfixed\n", f);
+    char name[2 * BAL_NAME_MAX];
+    for (int k = 0; k < s->n; k++) {
+        const int i = s->slot[k];
+        bal_output_disc_name(s, k, name, sizeof name);
+        fprintf(f, "%d\t%s\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d\n", k, name,
+                s->x[i], s->y[i], s->r[i], s->th[i] * (180 / BAL_PI),
+                s->have_old ? 0.5 * (s->vx[i] + s->vx_old[i]) : s->vx[i],
+                s->have_old ? 0.5 * (s->vy[i] + s->vy_old[i]) : s->vy[i],
+                s->have_old ? 0.5 * (s->w[i] + s->w_old[i]) : s->w[i], s->m[i], s->fixed[i]);
+    }
+}
+
+enum bal_status bal_output_state(const struct bal_sim *s, const char *dir, struct bal_error *err)
+{
+    FILE *f = open_tmp(dir, "contacts.tsv", err);
+    if (!f)
+        return err->code;
+    write_contacts(s, f);
+    if (close_tmp(f, dir, "contacts.tsv", err))
+        return err->code;
+    f = open_tmp(dir, "discs.tsv", err);
+    if (!f)
+        return err->code;
+    write_discs(s, f);
+    return close_tmp(f, dir, "discs.tsv", err);
+}
+
+static void json_string(FILE *f, const char *v)
+{
+    fputc('"', f);
+    for (const unsigned char *c = (const unsigned char *)v; *c; c++) {
+        if (*c == '"' || *c == '\\')
+            fprintf(f, "\\%c", *c);
+        else if (*c < 0x20)
+            fprintf(f, "\\u%04x", *c);
+        else
+            fputc(*c, f);
+    }
+    fputc('"', f);
+}
+
+static void json_number(FILE *f, double v)
+{
+    if (isfinite(v))
+        fprintf(f, "%.17g", v);
+    else
+        fputs("null", f);
+}
+
+enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
+                                    const char *scene_path, int n_sets, char *const *sets,
+                                    enum bal_status status, const char *message,
+                                    struct bal_error *err)
+{
+    FILE *f = open_tmp(dir, "run.json", err);
+    if (!f)
+        return err->code;
+    fputs("{\n  \"version\": ", f);
+    json_string(f, BAL_VERSION);
+    fputs(",\n  \"build\": ", f);
+    json_string(f, BAL_BUILD_FLAGS);
+    fputs(",\n  \"scene\": ", f);
+    json_string(f, scene_path);
+    fputs(",\n  \"sets\": [", f);
+    for (int k = 0; k < n_sets; k++) {
+        if (k)
+            fputs(", ", f);
+        json_string(f, sets[k]);
+    }
+    fputs("],\n  \"status\": ", f);
+    json_string(f, status == BAL_OK ? "ok" : bal_strerror(status));
+    fputs(",\n  \"message\": ", f);
+    json_string(f, message ? message : "");
+    if (s) {
+        struct bal_run_info in;
+        bal_sim_info(s, &in);
+        fprintf(f, ",\n  \"steps\": %ld,\n  \"time\": ", in.steps);
+        json_number(f, in.time);
+        fputs(",\n  \"dt\": ", f);
+        json_number(f, in.dt);
+        fputs(",\n  \"dt_estimate\": ", f);
+        json_number(f, in.dt_estimate);
+        fputs(",\n  \"dt_fraction\": ", f);
+        json_number(f, in.dt_fraction);
+        fputs(",\n  \"wall_seconds\": ", f);
+        json_number(f, in.wall_seconds);
+        fprintf(f, ",\n  \"n_discs\": %d,\n  \"n_walls\": %d,\n  \"grid\": %s,\n"
+                   "  \"rebuilds\": %ld,\n  \"candidates\": %ld,\n  \"particle_steps_per_s\": ",
+                in.n_discs, in.n_walls, in.grid_used ? "true" : "false", in.rebuilds,
+                in.n_candidates);
+        json_number(f, in.wall_seconds > 0 ? (double)in.steps * in.n_discs / in.wall_seconds : 0);
+        fputs(",\n  \"energy_kinetic\": ", f);
+        json_number(f, bal_measure_kinetic(s));
+        fputs(",\n  \"energy_elastic\": ", f);
+        json_number(f, bal_measure_elastic(s));
+        fputs(",\n  \"unbalanced\": ", f);
+        json_number(f, bal_measure_unbalanced(s));
+    }
+    fputs("\n}\n", f);
+    return close_tmp(f, dir, "run.json", err);
+}

@@ -1,0 +1,786 @@
+/*
+ * scene.c — text scene → struct bal_scene, --set overrides, validation.
+ *
+ * Format (documented key by key in the README, generated from
+ * scene_keys.c):
+ *
+ *     # a comment runs to the end of the line
+ *     [settings]
+ *     dt_fraction = 0.1
+ *     [material grain]
+ *     kn = 1e9
+ *     [disc x]
+ *     x = 50 50
+ *     ...
+ *
+ * Define, default, validate: bal_scene_default() gives an empty scene with
+ * default settings; each new section starts from the defaults in the key
+ * table; bal_scene_parse() checks syntax, types and ranges line by line;
+ * bal_scene_validate() checks what needs the whole file (required keys,
+ * references between sections, stages).  Every message names the file, the
+ * line and the key and says what was expected.
+ */
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scene.h"
+
+/* Longest line a scene file may hold; longer lines are refused, not cut. */
+#define LINE_MAX_CHARS 4096
+
+/* ------------------------------------------------------------------ */
+/* Section storage                                                     */
+/* ------------------------------------------------------------------ */
+
+struct section_array {
+    void **items;
+    int *count;
+    int *cap;
+};
+
+static struct section_array section_array(struct bal_scene *s,
+                                          enum bal_section_kind k)
+{
+    struct section_array a = {NULL, NULL, NULL};
+    switch (k) {
+    case BAL_SEC_MATERIAL:
+        a = (struct section_array){(void **)&s->materials, &s->n_materials, &s->cap_materials};
+        break;
+    case BAL_SEC_DISC:
+        a = (struct section_array){(void **)&s->discs, &s->n_discs, &s->cap_discs};
+        break;
+    case BAL_SEC_WALL:
+        a = (struct section_array){(void **)&s->walls, &s->n_walls, &s->cap_walls};
+        break;
+    case BAL_SEC_FILL:
+        a = (struct section_array){(void **)&s->fills, &s->n_fills, &s->cap_fills};
+        break;
+    case BAL_SEC_STAGE:
+        a = (struct section_array){(void **)&s->stages, &s->n_stages, &s->cap_stages};
+        break;
+    case BAL_SEC_PROBE:
+        a = (struct section_array){(void **)&s->probes, &s->n_probes, &s->cap_probes};
+        break;
+    case BAL_SEC_SETTINGS:
+    case BAL_SEC_COUNT:
+        break;
+    }
+    return a;
+}
+
+static void *section_item(const struct bal_scene *s, enum bal_section_kind k, int i)
+{
+    struct section_array a = section_array((struct bal_scene *)s, k);
+    if (k == BAL_SEC_SETTINGS)
+        return (void *)&s->settings;
+    return (char *)*a.items + (size_t)i * bal_scene_sections[k].size;
+}
+
+static int section_count(const struct bal_scene *s, enum bal_section_kind k)
+{
+    if (k == BAL_SEC_SETTINGS)
+        return 1;
+    return *section_array((struct bal_scene *)s, k).count;
+}
+
+static char *item_name(void *item)
+{
+    /* Every named section struct starts with char name[BAL_NAME_MAX]. */
+    return (char *)item;
+}
+
+static uint32_t *item_given(void *item, enum bal_section_kind k)
+{
+    return (uint32_t *)((char *)item + bal_scene_sections[k].given_offset);
+}
+
+static int *item_key_line(void *item, enum bal_section_kind k)
+{
+    return (int *)((char *)item + bal_scene_sections[k].key_line_offset);
+}
+
+int bal_scene_find(const struct bal_scene *s, enum bal_section_kind sec,
+                   const char *name)
+{
+    int n = section_count(s, sec);
+    for (int i = 0; i < n; i++)
+        if (strcmp(item_name(section_item(s, sec, i)), name) == 0)
+            return i;
+    return -1;
+}
+
+/* ------------------------------------------------------------------ */
+/* Values                                                              */
+/* ------------------------------------------------------------------ */
+
+struct where {
+    const char *file;
+    int line;             /* 0: from --set */
+};
+
+static enum bal_status where_error(struct bal_error *err, struct where w,
+                                   const char *key, const char *fmt,
+                                   const char *detail)
+{
+    char what[BAL_MSG_MAX / 2];
+    snprintf(what, sizeof what, fmt, detail);
+    if (w.line > 0)
+        return bal_error(err, BAL_EINVAL, "%s:%d: %s: %s", w.file, w.line, key, what);
+    return bal_error(err, BAL_EINVAL, "%s: --set %s: %s", w.file, key, what);
+}
+
+static char *trim(char *p)
+{
+    while (isspace((unsigned char)*p))
+        p++;
+    char *e = p + strlen(p);
+    while (e > p && isspace((unsigned char)e[-1]))
+        *--e = '\0';
+    return p;
+}
+
+/* Parse one finite number from *p, advancing past it. */
+static int parse_number(const char **p, double *out)
+{
+    while (isspace((unsigned char)**p))
+        (*p)++;
+    if (**p == '\0')
+        return 0;
+    char *end;
+    errno = 0;
+    double v = strtod(*p, &end);
+    if (end == *p || errno == ERANGE || !isfinite(v))
+        return 0;
+    if (*end != '\0' && !isspace((unsigned char)*end))
+        return 0;
+    *p = end;
+    *out = v;
+    return 1;
+}
+
+static int at_end(const char *p)
+{
+    while (isspace((unsigned char)*p))
+        p++;
+    return *p == '\0';
+}
+
+static int valid_name(const char *v)
+{
+    if (!*v || strlen(v) >= BAL_NAME_MAX)
+        return 0;
+    for (const char *c = v; *c; c++)
+        if (!(isalnum((unsigned char)*c) || *c == '_' || *c == '-'))
+            return 0;
+    return 1;
+}
+
+static enum bal_status check_range(const struct bal_key *key, double v,
+                                   struct where w, struct bal_error *err)
+{
+    if (v < key->min || v > key->max) {
+        char range[160];
+        snprintf(range, sizeof range, "%.6g is out of range: expected %.6g <= value <= %.6g",
+                 v, key->min, key->max);
+        return where_error(err, w, key->name, "%s", range);
+    }
+    return BAL_OK;
+}
+
+/* Store `value` into the key's field of `item`. */
+static enum bal_status set_value(void *item, const struct bal_key *key,
+                                 const char *value, struct where w,
+                                 struct bal_error *err)
+{
+    char *field = (char *)item + key->offset;
+    const char *p = value;
+    double v[4];
+
+    switch (key->type) {
+    case BAL_KEY_DOUBLE:
+        if (!parse_number(&p, &v[0]) || !at_end(p))
+            return where_error(err, w, key->name, "expected one finite number, got '%s'", value);
+        if (check_range(key, v[0], w, err))
+            return err->code;
+        memcpy(field, &v[0], sizeof(double));
+        return BAL_OK;
+    case BAL_KEY_LONG: {
+        if (!parse_number(&p, &v[0]) || !at_end(p) || v[0] != floor(v[0]))
+            return where_error(err, w, key->name, "expected an integer, got '%s'", value);
+        if (check_range(key, v[0], w, err))
+            return err->code;
+        long l = (long)v[0];
+        memcpy(field, &l, sizeof l);
+        return BAL_OK;
+    }
+    case BAL_KEY_VEC2:
+        if (!parse_number(&p, &v[0]) || !parse_number(&p, &v[1]) || !at_end(p))
+            return where_error(err, w, key->name, "expected two finite numbers, got '%s'", value);
+        if (check_range(key, v[0], w, err) || check_range(key, v[1], w, err))
+            return err->code;
+        memcpy(field, v, 2 * sizeof(double));
+        return BAL_OK;
+    case BAL_KEY_NAME:
+        if (*value && !valid_name(value))
+            return where_error(err, w, key->name,
+                               "expected a name of letters, digits, '_' or '-' "
+                               "(at most 47), got '%s'", value);
+        strcpy(field, value);
+        return BAL_OK;
+    case BAL_KEY_ENUM: {
+        size_t n = strlen(value);
+        int idx = 0;
+        for (const char *c = key->choices; *c;) {
+            const char *e = strchr(c, ' ');
+            size_t len = e ? (size_t)(e - c) : strlen(c);
+            if (len == n && strncmp(c, value, n) == 0) {
+                memcpy(field, &idx, sizeof idx);
+                return BAL_OK;
+            }
+            idx++;
+            c += len + (e ? 1 : 0);
+        }
+        char msg[BAL_MSG_MAX / 2];
+        snprintf(msg, sizeof msg, "expected one of {%s}, got '%%s'", key->choices);
+        return where_error(err, w, key->name, msg, value);
+    }
+    case BAL_KEY_MOVE: {
+        struct bal_stage_def *st = item;
+        char wall[BAL_NAME_MAX + 1];
+        int n_read = 0;
+        if (sscanf(value, "%48s%n", wall, &n_read) != 1 || !valid_name(wall))
+            return where_error(err, w, key->name,
+                               "expected 'WALL v1 v2 omega', got '%s'", value);
+        p = value + n_read;
+        if (!parse_number(&p, &v[0]) || !parse_number(&p, &v[1]) ||
+            !parse_number(&p, &v[2]) || !at_end(p))
+            return where_error(err, w, key->name,
+                               "expected 'WALL v1 v2 omega' with three finite numbers, got '%s'",
+                               value);
+        if (st->n_moves >= BAL_MAX_MOVES)
+            return where_error(err, w, key->name, "more than %s moves in one stage", "16");
+        for (int i = 0; i < st->n_moves; i++)
+            if (strcmp(st->moves[i].wall, wall) == 0)
+                return where_error(err, w, key->name, "wall '%s' is moved twice in this stage", wall);
+        struct bal_move_def *m = &st->moves[st->n_moves++];
+        strcpy(m->wall, wall);
+        m->line = w.line;
+        m->v[0] = v[0];
+        m->v[1] = v[1];
+        m->omega = v[2];
+        return BAL_OK;
+    }
+    }
+    return where_error(err, w, key->name, "%s", "unknown key type");
+}
+
+/* Give a fresh section its defaults from the key table. */
+static void apply_defaults(void *item, enum bal_section_kind k)
+{
+    for (int i = 0;; i++) {
+        const struct bal_key *key = bal_scene_key_at(k, i);
+        if (!key)
+            break;
+        if (key->def) {
+            struct bal_error ignored;
+            struct where w = {"(defaults)", 1};
+            /* Defaults are in range by construction; a failure here is a bug
+             * in the table, which the scene tests catch. */
+            (void)set_value(item, key, key->def, w, &ignored);
+        }
+    }
+    *item_given(item, k) = 0;
+}
+
+void bal_scene_default(struct bal_scene *s)
+{
+    memset(s, 0, sizeof *s);
+    apply_defaults(&s->settings, BAL_SEC_SETTINGS);
+}
+
+void bal_scene_free(struct bal_scene *s)
+{
+    free(s->materials);
+    free(s->discs);
+    free(s->walls);
+    free(s->fills);
+    free(s->stages);
+    free(s->probes);
+    memset(s, 0, sizeof *s);
+}
+
+static enum bal_status new_section(struct bal_scene *s, enum bal_section_kind k,
+                                   const char *name, struct where w,
+                                   void **out, struct bal_error *err)
+{
+    if (k == BAL_SEC_SETTINGS) {
+        if (s->settings.key_line[BAL_KEYS_MAX - 1] != 0)
+            return bal_error(err, BAL_EINVAL, "%s:%d: [settings]: given twice (first on line %d)",
+                             w.file, w.line, s->settings.key_line[BAL_KEYS_MAX - 1]);
+        /* The last key_line slot of settings records its header line. */
+        s->settings.key_line[BAL_KEYS_MAX - 1] = w.line;
+        *out = &s->settings;
+        return BAL_OK;
+    }
+    if (!valid_name(name))
+        return bal_error(err, BAL_EINVAL,
+                         "%s:%d: [%s]: expected a name of letters, digits, '_' or '-' "
+                         "(at most 47), got '%s'",
+                         w.file, w.line, bal_scene_sections[k].name, name);
+    int prev = bal_scene_find(s, k, name);
+    if (prev >= 0)
+        return bal_error(err, BAL_EINVAL, "%s:%d: [%s %s]: name used twice",
+                         w.file, w.line, bal_scene_sections[k].name, name);
+    struct section_array a = section_array(s, k);
+    size_t size = bal_scene_sections[k].size;
+    if (*a.count == *a.cap) {
+        int cap = *a.cap ? 2 * *a.cap : 8;
+        void *p = realloc(*a.items, (size_t)cap * size);
+        if (!p)
+            return bal_error(err, BAL_ENOMEM, "%s:%d: out of memory", w.file, w.line);
+        *a.items = p;
+        *a.cap = cap;
+    }
+    void *item = (char *)*a.items + (size_t)(*a.count) * size;
+    memset(item, 0, size);
+    (*a.count)++;
+    strcpy(item_name(item), name);
+    *(int *)((char *)item + BAL_NAME_MAX) = w.line; /* `line` follows `name` */
+    apply_defaults(item, k);
+    *out = item;
+    return BAL_OK;
+}
+
+static enum bal_status assign(void *item, enum bal_section_kind k,
+                              const char *key_name, const char *value,
+                              struct where w, struct bal_error *err)
+{
+    int ki = bal_scene_key_index(k, key_name);
+    if (ki < 0) {
+        char msg[BAL_MSG_MAX / 2];
+        int n = snprintf(msg, sizeof msg, "unknown key in [%s]; expected one of:",
+                         bal_scene_sections[k].name);
+        for (int i = 0; n > 0 && (size_t)n < sizeof msg; i++) {
+            const struct bal_key *kk = bal_scene_key_at(k, i);
+            if (!kk)
+                break;
+            n += snprintf(msg + n, sizeof msg - (size_t)n, " %s", kk->name);
+        }
+        return where_error(err, w, key_name, "%s", msg);
+    }
+    const struct bal_key *key = bal_scene_key_at(k, ki);
+    uint32_t *given = item_given(item, k);
+    if ((*given & (1u << ki)) && key->type != BAL_KEY_MOVE && w.line > 0) {
+        char first[32];
+        snprintf(first, sizeof first, "%d", item_key_line(item, k)[ki]);
+        return where_error(err, w, key_name, "given twice in this section (first on line %s)",
+                           first);
+    }
+    if (set_value(item, key, value, w, err))
+        return err->code;
+    *given |= 1u << ki;
+    item_key_line(item, k)[ki] = w.line;
+    return BAL_OK;
+}
+
+/* ------------------------------------------------------------------ */
+/* Parsing                                                             */
+/* ------------------------------------------------------------------ */
+
+static int section_kind(const char *word)
+{
+    for (int k = 0; k < BAL_SEC_COUNT; k++)
+        if (strcmp(bal_scene_sections[k].name, word) == 0)
+            return k;
+    return -1;
+}
+
+enum bal_status bal_scene_parse(struct bal_scene *s, const char *text,
+                                const char *name, struct bal_error *err)
+{
+    snprintf(s->path, sizeof s->path, "%s", name);
+    struct where w = {s->path, 0};
+    void *item = NULL;
+    enum bal_section_kind kind = BAL_SEC_SETTINGS;
+    char line[LINE_MAX_CHARS + 2];
+
+    const char *p = text;
+    while (*p) {
+        w.line++;
+        const char *nl = strchr(p, '\n');
+        size_t len = nl ? (size_t)(nl - p) : strlen(p);
+        if (len > LINE_MAX_CHARS)
+            return bal_error(err, BAL_EINVAL, "%s:%d: line longer than %d characters",
+                             w.file, w.line, LINE_MAX_CHARS);
+        memcpy(line, p, len);
+        line[len] = '\0';
+        p += len + (nl ? 1 : 0);
+        if (memchr(line, '\0', len) != NULL && strlen(line) != len)
+            return bal_error(err, BAL_EINVAL, "%s:%d: NUL byte in the file", w.file, w.line);
+
+        char *hash = strchr(line, '#');
+        if (hash)
+            *hash = '\0';
+        char *l = trim(line);
+        if (*l == '\0')
+            continue;
+
+        if (*l == '[') {
+            char *close = strchr(l, ']');
+            if (!close || !at_end(close + 1))
+                return bal_error(err, BAL_EINVAL,
+                                 "%s:%d: expected a section header '[kind name]', got '%s'",
+                                 w.file, w.line, l);
+            *close = '\0';
+            char *inner = trim(l + 1);
+            char *sp = inner;
+            while (*sp && !isspace((unsigned char)*sp))
+                sp++;
+            char *sec_name = "";
+            if (*sp) {
+                *sp = '\0';
+                sec_name = trim(sp + 1);
+            }
+            int k = section_kind(inner);
+            if (k < 0)
+                return bal_error(err, BAL_EINVAL,
+                                 "%s:%d: [%s]: unknown section; expected one of settings, "
+                                 "material, disc, wall, fill, stage, probe",
+                                 w.file, w.line, inner);
+            if (bal_scene_sections[k].named && !*sec_name)
+                return bal_error(err, BAL_EINVAL, "%s:%d: [%s]: a name is required: [%s NAME]",
+                                 w.file, w.line, inner, inner);
+            if (!bal_scene_sections[k].named && *sec_name)
+                return bal_error(err, BAL_EINVAL, "%s:%d: [%s]: takes no name, got '%s'",
+                                 w.file, w.line, inner, sec_name);
+            kind = (enum bal_section_kind)k;
+            if (new_section(s, kind, sec_name, w, &item, err))
+                return err->code;
+            continue;
+        }
+
+        char *eq = strchr(l, '=');
+        if (!eq)
+            return bal_error(err, BAL_EINVAL, "%s:%d: expected 'key = value', got '%s'",
+                             w.file, w.line, l);
+        *eq = '\0';
+        char *key = trim(l);
+        char *value = trim(eq + 1);
+        if (!item)
+            return bal_error(err, BAL_EINVAL,
+                             "%s:%d: %s: a key outside any section; start with a "
+                             "header such as [settings]", w.file, w.line, key);
+        if (*value == '\0')
+            return where_error(err, w, key, "%s", "expected a value after '='");
+        if (assign(item, kind, key, value, w, err))
+            return err->code;
+    }
+    return BAL_OK;
+}
+
+enum bal_status bal_scene_load(struct bal_scene *s, const char *path,
+                               struct bal_error *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return bal_error(err, BAL_EIO, "%s: cannot open: %s", path, strerror(errno));
+    size_t cap = 1 << 16, n = 0;
+    char *buf = malloc(cap);
+    if (!buf) {
+        fclose(f);
+        return bal_error(err, BAL_ENOMEM, "%s: out of memory", path);
+    }
+    for (;;) {
+        if (n + 1 >= cap) {
+            char *nb = realloc(buf, cap *= 2);
+            if (!nb) {
+                free(buf);
+                fclose(f);
+                return bal_error(err, BAL_ENOMEM, "%s: out of memory", path);
+            }
+            buf = nb;
+        }
+        size_t got = fread(buf + n, 1, cap - n - 1, f);
+        n += got;
+        if (got == 0)
+            break;
+    }
+    int bad = ferror(f);
+    fclose(f);
+    if (bad) {
+        free(buf);
+        return bal_error(err, BAL_EIO, "%s: read error", path);
+    }
+    if (memchr(buf, '\0', n)) {
+        free(buf);
+        return bal_error(err, BAL_EINVAL, "%s: contains a NUL byte; not a scene file", path);
+    }
+    buf[n] = '\0';
+    enum bal_status st = bal_scene_parse(s, buf, path, err);
+    free(buf);
+    return st;
+}
+
+enum bal_status bal_scene_set(struct bal_scene *s, const char *assignment,
+                              struct bal_error *err)
+{
+    struct where w = {s->path, 0};
+    char buf[LINE_MAX_CHARS];
+    if (strlen(assignment) >= sizeof buf)
+        return bal_error(err, BAL_EINVAL, "%s: --set: assignment too long", s->path);
+    strcpy(buf, assignment);
+    char *eq = strchr(buf, '=');
+    if (!eq)
+        return bal_error(err, BAL_EINVAL, "%s: --set %s: expected KEY=VALUE", s->path, assignment);
+    *eq = '\0';
+    char *path = trim(buf);
+    char *value = trim(eq + 1);
+    char *dot1 = strchr(path, '.');
+    if (!dot1)
+        return bal_error(err, BAL_EINVAL,
+                         "%s: --set %s: expected section.key or section.name.key", s->path, path);
+    *dot1 = '\0';
+    int k = section_kind(path);
+    if (k < 0)
+        return bal_error(err, BAL_EINVAL, "%s: --set %s: unknown section '%s'", s->path,
+                         assignment, path);
+    char *rest = dot1 + 1;
+    void *item;
+    char *key;
+    if (bal_scene_sections[k].named) {
+        char *dot2 = strchr(rest, '.');
+        if (!dot2)
+            return bal_error(err, BAL_EINVAL, "%s: --set %s: expected %s.NAME.key", s->path,
+                             assignment, path);
+        *dot2 = '\0';
+        int i = bal_scene_find(s, (enum bal_section_kind)k, rest);
+        if (i < 0)
+            return bal_error(err, BAL_EINVAL, "%s: --set %s: no [%s %s] in the scene", s->path,
+                             assignment, path, rest);
+        item = section_item(s, (enum bal_section_kind)k, i);
+        key = dot2 + 1;
+    } else {
+        item = &s->settings;
+        key = rest;
+    }
+    if (*value == '\0')
+        return where_error(err, w, key, "%s", "expected a value after '='");
+    return assign(item, (enum bal_section_kind)k, key, value, w, err);
+}
+
+/* ------------------------------------------------------------------ */
+/* Validation                                                          */
+/* ------------------------------------------------------------------ */
+
+static int line_of(void *item, enum bal_section_kind k, const char *key)
+{
+    int ki = bal_scene_key_index(k, key);
+    int l = ki >= 0 ? item_key_line(item, k)[ki] : 0;
+    return l > 0 ? l : *(int *)((char *)item + BAL_NAME_MAX);
+}
+
+/* FAIL_AT(item, kind, key, fmt, args...): at least one argument after fmt. */
+#define FAIL_AT(item, k, key, fmt, ...) \
+    bal_error(err, BAL_EINVAL, "%s:%d: %s: " fmt, s->path, line_of(item, k, key), key, __VA_ARGS__)
+
+static enum bal_status check_required(const struct bal_scene *s, enum bal_section_kind k,
+                                      struct bal_error *err)
+{
+    int n = section_count(s, k);
+    for (int i = 0; i < n; i++) {
+        void *item = section_item(s, k, i);
+        uint32_t given = *item_given(item, k);
+        for (int ki = 0;; ki++) {
+            const struct bal_key *key = bal_scene_key_at(k, ki);
+            if (!key)
+                break;
+            if (key->required && !(given & (1u << ki))) {
+                int line = k == BAL_SEC_SETTINGS ? s->settings.key_line[BAL_KEYS_MAX - 1]
+                                                 : *(int *)((char *)item + BAL_NAME_MAX);
+                return bal_error(err, BAL_EINVAL, "%s:%d: [%s %s]: %s: required key is missing (%s)",
+                                 s->path, line, bal_scene_sections[k].name,
+                                 k == BAL_SEC_SETTINGS ? "" : item_name(item), key->name,
+                                 key->doc);
+            }
+        }
+    }
+    return BAL_OK;
+}
+
+static enum bal_status check_material_ref(const struct bal_scene *s, void *item,
+                                          enum bal_section_kind k, const char *key,
+                                          const char *value, int need_density,
+                                          struct bal_error *err)
+{
+    int m = bal_scene_find(s, BAL_SEC_MATERIAL, value);
+    if (m < 0)
+        return FAIL_AT(item, k, key, "no [material %s] in the scene", value);
+    if (need_density && !(s->materials[m].density > 0))
+        return FAIL_AT(item, k, key,
+                       "material '%s' has no density > 0, which a disc needs for its mass",
+                       value);
+    return BAL_OK;
+}
+
+/* Is `name` a disc, a wall, or a wall made by a fill's box? */
+static int body_exists(const struct bal_scene *s, const char *name, int *is_wall)
+{
+    if (bal_scene_find(s, BAL_SEC_DISC, name) >= 0) {
+        *is_wall = 0;
+        return 1;
+    }
+    if (bal_scene_find(s, BAL_SEC_WALL, name) >= 0) {
+        *is_wall = 1;
+        return 1;
+    }
+    static const char *const sides[] = {"_bottom", "_right", "_top", "_left"};
+    for (int f = 0; f < s->n_fills; f++) {
+        if (!s->fills[f].box)
+            continue;
+        for (int k = 0; k < 4; k++) {
+            char nm[2 * BAL_NAME_MAX];
+            snprintf(nm, sizeof nm, "%s%s", s->fills[f].name, sides[k]);
+            if (strcmp(nm, name) == 0) {
+                *is_wall = 1;
+                return 1;
+            }
+        }
+    }
+    return 0;
+}
+
+enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *err)
+{
+    for (int k = 0; k < BAL_SEC_COUNT; k++)
+        if (check_required(s, (enum bal_section_kind)k, err))
+            return err->code;
+
+    const struct bal_settings *st = &s->settings;
+    if (st->normal_law == BAL_NORMAL_POWER && st->nu != 1.0 &&
+        !(st->given & (1u << bal_scene_key_index(BAL_SEC_SETTINGS, "delta0"))))
+        return bal_error(err, BAL_EINVAL,
+                         "%s:%d: delta0: required with normal_law = power and nu != 1 "
+                         "(the force scale k_n delta0 depends on it)",
+                         s->path, st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "nu")]);
+
+    for (int i = 0; i < s->n_discs; i++) {
+        struct bal_disc_def *d = &s->discs[i];
+        if (check_material_ref(s, d, BAL_SEC_DISC, "material", d->material, 1, err))
+            return err->code;
+    }
+    for (int i = 0; i < s->n_walls; i++) {
+        struct bal_wall_def *w = &s->walls[i];
+        if (!(w->h2 > w->h1))
+            return FAIL_AT(w, BAL_SEC_WALL, "h2", "expected h2 > h1 (a wall of positive length), "
+                                                  "got h1 = %g, h2 = %g", w->h1, w->h2);
+        if (check_material_ref(s, w, BAL_SEC_WALL, "material", w->material, 0, err))
+            return err->code;
+    }
+    for (int i = 0; i < s->n_fills; i++) {
+        struct bal_fill_def *f = &s->fills[i];
+        if (!(f->rmax >= f->rmin))
+            return FAIL_AT(f, BAL_SEC_FILL, "rmax", "expected rmax >= rmin, got %g < %g",
+                           f->rmax, f->rmin);
+        if (check_material_ref(s, f, BAL_SEC_FILL, "material", f->material, 1, err))
+            return err->code;
+        if (f->box) {
+            if (!*f->wall_material)
+                return FAIL_AT(f, BAL_SEC_FILL, "wall_material", "%s", "required with box = 1");
+            if (check_material_ref(s, f, BAL_SEC_FILL, "wall_material", f->wall_material, 0, err))
+                return err->code;
+        }
+    }
+    for (int i = 0; i < s->n_materials; i++) {
+        struct bal_material_def *m = &s->materials[i];
+        if (!(m->ks > 0 || m->ks == -1))
+            return FAIL_AT(m, BAL_SEC_MATERIAL, "ks", "expected ks > 0 (or omit it for ks = kn), "
+                                                      "got %g", m->ks);
+    }
+    if (s->n_stages == 0)
+        return bal_error(err, BAL_EINVAL, "%s: no [stage] section: the run would never start; "
+                                          "add e.g. [stage run] with cycles = N", s->path);
+    for (int i = 0; i < s->n_stages; i++) {
+        struct bal_stage_def *g = &s->stages[i];
+        for (int m = 0; m < g->n_moves; m++) {
+            int is_wall = 0;
+            if (!body_exists(s, g->moves[m].wall, &is_wall) || !is_wall)
+                return bal_error(err, BAL_EINVAL, "%s:%d: move: no wall named '%s'", s->path,
+                                 g->moves[m].line, g->moves[m].wall);
+        }
+    }
+    for (int i = 0; i < s->n_probes; i++) {
+        struct bal_probe_def *p = &s->probes[i];
+        int k = p->kind, wa = 0, wb = 0;
+        int contact = k == BAL_PROBE_CONTACT_FN || k == BAL_PROBE_CONTACT_FS ||
+                      k == BAL_PROBE_CONTACT_SLIDING;
+        int wall = k >= BAL_PROBE_WALL_F1 && k <= BAL_PROBE_WALL_ECC;
+        int disc = k >= BAL_PROBE_DISC_X && k <= BAL_PROBE_DISC_OMEGA;
+        if (contact || wall || disc) {
+            if (!*p->a)
+                return FAIL_AT(p, BAL_SEC_PROBE, "a", "%s", "this quantity needs a body in 'a'");
+            if (!body_exists(s, p->a, &wa))
+                return FAIL_AT(p, BAL_SEC_PROBE, "a", "no disc or wall named '%s'", p->a);
+            if (wall && !wa)
+                return FAIL_AT(p, BAL_SEC_PROBE, "a", "'%s' is a disc; this quantity needs a wall",
+                               p->a);
+            if (disc && wa)
+                return FAIL_AT(p, BAL_SEC_PROBE, "a", "'%s' is a wall; this quantity needs a disc",
+                               p->a);
+        }
+        if (contact) {
+            if (!*p->b)
+                return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "a contact probe needs a second body in 'b'");
+            if (!body_exists(s, p->b, &wb))
+                return FAIL_AT(p, BAL_SEC_PROBE, "b", "no disc or wall named '%s'", p->b);
+            if (wa && wb)
+                return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "two walls never make a contact");
+            if (strcmp(p->a, p->b) == 0)
+                return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "a body cannot touch itself");
+        } else if (*p->b) {
+            return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "only contact probes take a second body");
+        }
+    }
+    if (s->n_discs == 0 && s->n_fills == 0)
+        return bal_error(err, BAL_EINVAL, "%s: no discs: add [disc NAME] or [fill NAME] sections",
+                         s->path);
+    return BAL_OK;
+}
+
+/* ------------------------------------------------------------------ */
+/* Key list                                                            */
+/* ------------------------------------------------------------------ */
+
+void bal_scene_print_keys(FILE *out)
+{
+    static const char *const type_names[] = {"number", "integer", "two numbers", "name",
+                                             "word", "WALL v1 v2 omega"};
+    for (int k = 0; k < BAL_SEC_COUNT; k++) {
+        const struct bal_section_info *sec = &bal_scene_sections[k];
+        fprintf(out, "\n`[%s%s]` — %s\n\n", sec->name, sec->named ? " NAME" : "", sec->doc);
+        fprintf(out, "| key | type | default | range | meaning |\n|---|---|---|---|---|\n");
+        for (int i = 0;; i++) {
+            const struct bal_key *key = bal_scene_key_at((enum bal_section_kind)k, i);
+            if (!key)
+                break;
+            char range[96] = "";
+            if (key->type == BAL_KEY_ENUM)
+                snprintf(range, sizeof range, "%s", key->choices);
+            else if (key->type == BAL_KEY_DOUBLE || key->type == BAL_KEY_LONG) {
+                char lo[32] = "", hi[32] = "";
+                if (key->min > -1e300)
+                    snprintf(lo, sizeof lo, "%g", key->min);
+                if (key->max < 1e300)
+                    snprintf(hi, sizeof hi, "%g", key->max);
+                if (*lo || *hi)
+                    snprintf(range, sizeof range, "[%s, %s]", *lo ? lo : "-inf", *hi ? hi : "inf");
+            }
+            fprintf(out, "| `%s` | %s | %s | %s | %s |\n", key->name, type_names[key->type],
+                    key->def ? (*key->def ? key->def : "(none)") : (key->required ? "required" : "(none)"),
+                    range, key->doc);
+        }
+    }
+}

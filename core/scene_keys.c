@@ -1,0 +1,172 @@
+/*
+ * scene_keys.c — every key a scene file may contain, in one table.
+ *
+ * The parser, the range checks, `ballast keys` and the key list in the
+ * README all read this table, so they cannot drift apart.  A default is
+ * written as text and parsed like a value from a file; a key without a
+ * default and with `required` set must be given.
+ *
+ * Paper references: C&S = Cundall & Strack (1979); MLH = Matuttis, Luding
+ * & Herrmann (2000).
+ */
+#include <float.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "scene.h"
+
+#define BIG DBL_MAX
+#define LBIG 2147483647.0
+
+#define S(field) offsetof(struct bal_settings, field)
+#define M(field) offsetof(struct bal_material_def, field)
+#define D(field) offsetof(struct bal_disc_def, field)
+#define W(field) offsetof(struct bal_wall_def, field)
+#define F(field) offsetof(struct bal_fill_def, field)
+#define G(field) offsetof(struct bal_stage_def, field)
+#define P(field) offsetof(struct bal_probe_def, field)
+
+const struct bal_key bal_scene_keys[] = {
+    /* [settings] */
+    {BAL_SEC_SETTINGS, "dt", BAL_KEY_DOUBLE, S(dt), "0", 0, 0, BIG, NULL,
+     "time step; 0 = dt_fraction x the critical-step estimate"},
+    {BAL_SEC_SETTINGS, "dt_fraction", BAL_KEY_DOUBLE, S(dt_fraction), "0.1", 0, 1e-9, 1, NULL,
+     "fraction of the critical-step estimate 2*sqrt(m/k) (C&S p. 53)"},
+    {BAL_SEC_SETTINGS, "alpha", BAL_KEY_DOUBLE, S(alpha), "0", 0, 0, BIG, NULL,
+     "global damping alpha, C = alpha m, C* = alpha I (C&S eqs 34-36), 1/time"},
+    {BAL_SEC_SETTINGS, "beta", BAL_KEY_DOUBLE, S(beta), "0", 0, 0, BIG, NULL,
+     "contact damping beta, c_n = beta k_n, c_s = beta k_s (C&S eq. 28), time"},
+    {BAL_SEC_SETTINGS, "gravity", BAL_KEY_VEC2, S(gravity), "0 0", 0, -BIG, BIG, NULL,
+     "body-force acceleration g_1 g_2 (C&S p. 52)"},
+    {BAL_SEC_SETTINGS, "normal_law", BAL_KEY_ENUM, S(normal_law), "incremental", 0, 0, 0,
+     "incremental power",
+     "incremental: F_n += k_n n' dt (C&S eqs 14, 16, 18); power: F_n = k_n d0 (d/d0)^nu (MLH eq. 2)"},
+    {BAL_SEC_SETTINGS, "nu", BAL_KEY_DOUBLE, S(nu), "1", 0, 1, 3, NULL,
+     "exponent nu of the power law (1 linear, 1.5 Hertz, 2 conical)"},
+    {BAL_SEC_SETTINGS, "delta0", BAL_KEY_DOUBLE, S(delta0), "1", 0, 1e-300, BIG, NULL,
+     "normalisation length delta0 of the power law"},
+    {BAL_SEC_SETTINGS, "grid", BAL_KEY_ENUM, S(grid), "auto", 0, 0, 0, "auto on off",
+     "neighbour search: auto = all pairs for few discs, a cell grid for many"},
+    {BAL_SEC_SETTINGS, "skin", BAL_KEY_DOUBLE, S(skin), "0", 0, 0, BIG, NULL,
+     "Verlet skin of the cell grid, length; 0 = 0.2 x the largest radius"},
+    {BAL_SEC_SETTINGS, "output_every", BAL_KEY_LONG, S(output_every), "1", 0, 1, LBIG, NULL,
+     "cycles between rows of series.tsv"},
+
+    /* [material NAME] */
+    {BAL_SEC_MATERIAL, "kn", BAL_KEY_DOUBLE, M(kn), NULL, 1, 1e-300, BIG, NULL,
+     "normal stiffness k_n, force/length (C&S eq. 16)"},
+    {BAL_SEC_MATERIAL, "ks", BAL_KEY_DOUBLE, M(ks), "-1", 0, -1, BIG, NULL,
+     "shear stiffness k_s (C&S eq. 17); default: equal to kn"},
+    {BAL_SEC_MATERIAL, "friction", BAL_KEY_DOUBLE, M(friction), "0", 0, 0, BIG, NULL,
+     "tan(phi_mu); a contact uses the smaller of its two bodies' (C&S eq. 19)"},
+    {BAL_SEC_MATERIAL, "cohesion", BAL_KEY_DOUBLE, M(cohesion), "0", 0, 0, BIG, NULL,
+     "cohesion c, force; a contact uses the smaller of its two bodies' (C&S eq. 19)"},
+    {BAL_SEC_MATERIAL, "density", BAL_KEY_DOUBLE, M(density), "0", 0, 0, BIG, NULL,
+     "mass per unit area of a disc (m = density pi r^2); required for disc materials"},
+
+    /* [disc NAME] */
+    {BAL_SEC_DISC, "x", BAL_KEY_VEC2, D(x), NULL, 1, -BIG, BIG, NULL, "centre x_1 x_2"},
+    {BAL_SEC_DISC, "r", BAL_KEY_DOUBLE, D(r), NULL, 1, 1e-300, BIG, NULL, "radius"},
+    {BAL_SEC_DISC, "material", BAL_KEY_NAME, D(material), NULL, 1, 0, 0, NULL,
+     "name of a [material] section"},
+    {BAL_SEC_DISC, "v", BAL_KEY_VEC2, D(v), "0 0", 0, -BIG, BIG, NULL,
+     "initial velocity (at t = dt/2, C&S eq. 22)"},
+    {BAL_SEC_DISC, "theta", BAL_KEY_DOUBLE, D(theta), "0", 0, -BIG, BIG, NULL,
+     "initial rotation, degrees"},
+    {BAL_SEC_DISC, "omega", BAL_KEY_DOUBLE, D(omega), "0", 0, -BIG, BIG, NULL,
+     "initial angular velocity, rad/time, counter-clockwise"},
+    {BAL_SEC_DISC, "fixed", BAL_KEY_LONG, D(fixed), "0", 0, 0, 1, NULL,
+     "1: the disc is held (its velocity stays zero; it still feels forces)"},
+
+    /* [wall NAME] */
+    {BAL_SEC_WALL, "p", BAL_KEY_VEC2, W(p), NULL, 1, -BIG, BIG, NULL,
+     "point P of the wall (C&S Fig. 4)"},
+    {BAL_SEC_WALL, "angle", BAL_KEY_DOUBLE, W(angle), NULL, 1, -BIG, BIG, NULL,
+     "alpha of the unit vector e = (cos alpha, sin alpha), degrees"},
+    {BAL_SEC_WALL, "h1", BAL_KEY_DOUBLE, W(h1), NULL, 1, -BIG, BIG, NULL,
+     "end A = P + h1 e"},
+    {BAL_SEC_WALL, "h2", BAL_KEY_DOUBLE, W(h2), NULL, 1, -BIG, BIG, NULL,
+     "end B = P + h2 e (h2 > h1)"},
+    {BAL_SEC_WALL, "material", BAL_KEY_NAME, W(material), NULL, 1, 0, 0, NULL,
+     "name of a [material] section (density unused)"},
+
+    /* [fill NAME] */
+    {BAL_SEC_FILL, "n", BAL_KEY_LONG, F(n), NULL, 1, 1, 100000000.0, NULL, "number of discs"},
+    {BAL_SEC_FILL, "columns", BAL_KEY_LONG, F(columns), NULL, 1, 1, 100000000.0, NULL,
+     "discs per lattice row (rows = ceil(n / columns))"},
+    {BAL_SEC_FILL, "origin", BAL_KEY_VEC2, F(origin), "0 0", 0, -BIG, BIG, NULL,
+     "lower-left corner of the lattice region"},
+    {BAL_SEC_FILL, "rmin", BAL_KEY_DOUBLE, F(rmin), NULL, 1, 1e-300, BIG, NULL,
+     "smallest radius (radii uniform in [rmin, rmax])"},
+    {BAL_SEC_FILL, "rmax", BAL_KEY_DOUBLE, F(rmax), NULL, 1, 1e-300, BIG, NULL,
+     "largest radius; the lattice spacing is 2 rmax"},
+    {BAL_SEC_FILL, "headroom", BAL_KEY_DOUBLE, F(headroom), "0", 0, 0, BIG, NULL,
+     "extra height of the box above the lattice"},
+    {BAL_SEC_FILL, "vmax", BAL_KEY_DOUBLE, F(vmax), "0", 0, 0, BIG, NULL,
+     "initial speeds uniform in [0, vmax), directions uniform"},
+    {BAL_SEC_FILL, "seed", BAL_KEY_LONG, F(seed), "1", 0, 0, 4294967295.0, NULL,
+     "seed of the generator (same seed, same discs)"},
+    {BAL_SEC_FILL, "box", BAL_KEY_LONG, F(box), "0", 0, 0, 1, NULL,
+     "1: add four walls around the region (named NAME_bottom/_right/_top/_left)"},
+    {BAL_SEC_FILL, "material", BAL_KEY_NAME, F(material), NULL, 1, 0, 0, NULL,
+     "material of the discs"},
+    {BAL_SEC_FILL, "wall_material", BAL_KEY_NAME, F(wall_material), "", 0, 0, 0, NULL,
+     "material of the box walls (required with box = 1)"},
+
+    /* [stage NAME] */
+    {BAL_SEC_STAGE, "cycles", BAL_KEY_LONG, G(cycles), NULL, 1, 1, 1e15, NULL,
+     "number of calculation cycles in this stage"},
+    {BAL_SEC_STAGE, "move", BAL_KEY_MOVE, G(moves), NULL, 0, -BIG, BIG, NULL,
+     "repeatable: WALL v1 v2 omega; velocity of P and angular velocity about P (C&S p. 53); "
+     "walls not named are at rest"},
+
+    /* [probe NAME] */
+    {BAL_SEC_PROBE, "quantity", BAL_KEY_ENUM, P(kind), NULL, 1, 0, 0,
+     "contact_fn contact_fs contact_sliding wall_f1 wall_f2 wall_moment wall_ecc "
+     "disc_x disc_y disc_vx disc_vy disc_theta disc_omega "
+     "energy_kinetic energy_elastic unbalanced n_contacts",
+     "what the series column holds"},
+    {BAL_SEC_PROBE, "a", BAL_KEY_NAME, P(a), "", 0, 0, 0, NULL,
+     "body: the disc (disc_*), the wall (wall_*), or the first body of a contact"},
+    {BAL_SEC_PROBE, "b", BAL_KEY_NAME, P(b), "", 0, 0, 0, NULL,
+     "second body of a contact (contact_*)"},
+};
+
+const size_t bal_scene_n_keys = sizeof bal_scene_keys / sizeof bal_scene_keys[0];
+
+#define SEC(type) sizeof(struct type), offsetof(struct type, given), \
+    offsetof(struct type, key_line)
+
+const struct bal_section_info bal_scene_sections[BAL_SEC_COUNT] = {
+    {"settings", 0, SEC(bal_settings), "global settings of the run (at most once)"},
+    {"material", 1, SEC(bal_material_def), "a group of physical properties (C&S p. 53)"},
+    {"disc", 1, SEC(bal_disc_def), "one disc"},
+    {"wall", 1, SEC(bal_wall_def), "a straight rigid wall (C&S Fig. 4)"},
+    {"fill", 1, SEC(bal_fill_def), "a generator of many discs on a lattice"},
+    {"stage", 1, SEC(bal_stage_def), "a stage of the loading protocol, run in file order"},
+    {"probe", 1, SEC(bal_probe_def), "a column of series.tsv, in file order"},
+};
+
+int bal_scene_key_index(enum bal_section_kind sec, const char *name)
+{
+    int k = 0;
+    for (size_t i = 0; i < bal_scene_n_keys; i++) {
+        if (bal_scene_keys[i].section != sec)
+            continue;
+        if (strcmp(bal_scene_keys[i].name, name) == 0)
+            return k;
+        k++;
+    }
+    return -1;
+}
+
+const struct bal_key *bal_scene_key_at(enum bal_section_kind sec, int k)
+{
+    for (size_t i = 0; i < bal_scene_n_keys; i++) {
+        if (bal_scene_keys[i].section != sec)
+            continue;
+        if (k-- == 0)
+            return &bal_scene_keys[i];
+    }
+    return NULL;
+}

@@ -1,0 +1,574 @@
+/*
+ * sim.c — the simulation life cycle and the calculation cycle.
+ *
+ * bal_sim_create() turns a validated scene into state: discs from [disc]
+ * and [fill] sections (sorted into cell order when the grid is used), walls
+ * from [wall] sections and fill boxes, the contact parameters of every pair
+ * of materials, the time step, the candidate lists.  All memory is reserved
+ * here or, for neighbour lists that outgrow their first size, in a rebuild.
+ *
+ * One calculation cycle (C&S p. 49: the force–displacement law and the law
+ * of motion, alternately), cycle N:
+ *
+ *   1. positions   x_N = x_{N−1} + v_{N−1/2} Δt; walls move (integrate.c)
+ *   2. neighbours  rebuild the candidate lists if the skin is used up (grid.c)
+ *   3. contacts    force–displacement law at t_N from v_{N−1/2} (contacts.c)
+ *   4. motion      v_{N+1/2} from the force sums (integrate.c)
+ *
+ * So after cycle N the forces are those of t_N, as in the worked example of
+ * Fig. 1: cycle 1 gives F_n = k_n v Δt at the walls (eq. 1).
+ *
+ * bal_sim_run() runs the stages of the loading protocol in order and writes
+ * a series row every output_every cycles; it stops early, with a status,
+ * on a signal or when the state stops being finite.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "scene.h"
+#include "sim.h"
+
+/* How often (in cycles) the run checks that the state is finite between
+ * output rows.  A blown-up run is caught within this many cycles. */
+#define FINITE_CHECK_EVERY 256
+
+/* Default Verlet skin as a share of the largest radius: a wider skin means
+ * fewer rebuilds but more candidate pairs to test every cycle. */
+#define SKIN_SHARE_OF_RMAX 0.2
+
+/* A small, seedable generator (SplitMix64) kept in a local variable: no
+ * global state, the same seed gives the same discs on every platform. */
+static uint64_t splitmix64(uint64_t *state)
+{
+    uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+static double uniform01(uint64_t *state)
+{
+    return (double)(splitmix64(state) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static double *alloc_doubles(size_t n, int *ok)
+{
+    double *p = calloc(n ? n : 1, sizeof *p);
+    if (!p)
+        *ok = 0;
+    return p;
+}
+
+void bal_sim_free(struct bal_sim *s)
+{
+    if (!s)
+        return;
+    double **arrays[] = {&s->x, &s->y, &s->th, &s->vx, &s->vy, &s->w, &s->r, &s->m,
+                         &s->inv_m, &s->inertia, &s->inv_i, &s->fx, &s->fy, &s->tq,
+                         &s->vx_old, &s->vy_old, &s->w_old, &s->x_ref, &s->y_ref};
+    for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
+        free(*arrays[k]);
+    free(s->id);
+    free(s->slot);
+    free(s->mat);
+    free(s->fixed);
+    free(s->walls);
+    free(s->law);
+    free(s->probes);
+    bal_grid_free(&s->grid);
+    bal_pairs_free(&s->pp);
+    bal_pairs_free(&s->pw);
+    bal_pairs_free(&s->scratch);
+    free(s);
+}
+
+static long fill_rows(const struct bal_fill_def *f)
+{
+    return (f->n + f->columns - 1) / f->columns;
+}
+
+static void add_wall(struct bal_sim *s, const char *name, double px, double py,
+                     double angle_rad, double h1, double h2, int material)
+{
+    struct bal_wall *w = &s->walls[s->n_walls++];
+    memset(w, 0, sizeof *w);
+    snprintf(w->name, sizeof w->name, "%s", name);
+    w->p[0] = px;
+    w->p[1] = py;
+    w->alpha = angle_rad;
+    w->e[0] = cos(angle_rad);
+    w->e[1] = sin(angle_rad);
+    w->h1 = h1;
+    w->h2 = h2;
+    w->material = material;
+}
+
+static int wall_index(const struct bal_sim *s, const char *name)
+{
+    for (int k = 0; k < s->n_walls; k++)
+        if (strcmp(s->walls[k].name, name) == 0)
+            return k;
+    return -1;
+}
+
+/* Fill the material-pair table (C&S eqs 19, 28).  Stiffnesses of two
+ * different materials combine as springs in series scaled so that equal
+ * materials give their own value: k = 2 k_a k_b / (k_a + k_b). */
+static void build_laws(struct bal_sim *s, const struct bal_scene *sc)
+{
+    for (int a = 0; a < s->n_mat; a++) {
+        for (int b = 0; b < s->n_mat; b++) {
+            const struct bal_material_def *A = &sc->materials[a], *B = &sc->materials[b];
+            const double ksa = A->ks < 0 ? A->kn : A->ks, ksb = B->ks < 0 ? B->kn : B->ks;
+            struct bal_pair_law *L = &s->law[a * s->n_mat + b];
+            L->kn = 2 * A->kn * B->kn / (A->kn + B->kn);
+            L->ks = 2 * ksa * ksb / (ksa + ksb);
+            L->tan_phi = fmin(A->friction, B->friction);
+            L->cohesion = fmin(A->cohesion, B->cohesion);
+            L->cn = s->beta * L->kn;
+            L->cs = s->beta * L->ks;
+            L->shear = L->tan_phi > 0 || L->cohesion > 0;
+            if (L->shear)
+                s->has_shear = 1;
+        }
+    }
+}
+
+/* A disc's cell and its scene-order index, for sorting into cell order. */
+struct cell_key {
+    long cell;
+    int id;
+};
+
+static int cell_key_cmp(const void *a, const void *b)
+{
+    const struct cell_key *p = a, *q = b;
+    if (p->cell != q->cell)
+        return p->cell < q->cell ? -1 : 1;
+    return (p->id > q->id) - (p->id < q->id);
+}
+
+/* The permutation that puts discs in row-major cell order, so that
+ * neighbours in space are neighbours in memory.  Ties keep scene order, so
+ * the order is deterministic. */
+static int cell_order(const double *x, const double *y, int n, double h, int32_t *order)
+{
+    struct cell_key *keys = malloc((size_t)(n ? n : 1) * sizeof *keys);
+    if (!keys)
+        return 0;
+    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY;
+    for (int i = 0; i < n; i++) {
+        x0 = fmin(x0, x[i]);
+        y0 = fmin(y0, y[i]);
+        x1 = fmax(x1, x[i]);
+    }
+    const long nx = (long)((x1 - x0) / h) + 1;
+    for (int i = 0; i < n; i++)
+        keys[i] = (struct cell_key){(long)((y[i] - y0) / h) * nx + (long)((x[i] - x0) / h), i};
+    qsort(keys, (size_t)n, sizeof *keys, cell_key_cmp);
+    for (int i = 0; i < n; i++)
+        order[i] = keys[i].id;
+    free(keys);
+    return 1;
+}
+
+/* Discs in scene order before sorting: [disc] sections, then each [fill]. */
+struct disc_init {
+    double *x, *y, *r, *vx, *vy, *th, *w;
+    int32_t *mat;
+    uint8_t *fixed;
+};
+
+static enum bal_status gather_discs(const struct bal_scene *sc, int n, struct disc_init *d,
+                                    struct bal_error *err)
+{
+    int ok = 1;
+    d->x = alloc_doubles((size_t)n, &ok);
+    d->y = alloc_doubles((size_t)n, &ok);
+    d->r = alloc_doubles((size_t)n, &ok);
+    d->vx = alloc_doubles((size_t)n, &ok);
+    d->vy = alloc_doubles((size_t)n, &ok);
+    d->th = alloc_doubles((size_t)n, &ok);
+    d->w = alloc_doubles((size_t)n, &ok);
+    d->mat = calloc((size_t)(n ? n : 1), sizeof *d->mat);
+    d->fixed = calloc((size_t)(n ? n : 1), sizeof *d->fixed);
+    if (!ok || !d->mat || !d->fixed)
+        return bal_error(err, BAL_ENOMEM, "%s: out of memory for %d discs", sc->path, n);
+    int k = 0;
+    for (int i = 0; i < sc->n_discs; i++, k++) {
+        const struct bal_disc_def *dd = &sc->discs[i];
+        d->x[k] = dd->x[0];
+        d->y[k] = dd->x[1];
+        d->r[k] = dd->r;
+        d->vx[k] = dd->v[0];
+        d->vy[k] = dd->v[1];
+        d->th[k] = dd->theta * (BAL_PI / 180);
+        d->w[k] = dd->omega;
+        d->mat[k] = bal_scene_find(sc, BAL_SEC_MATERIAL, dd->material);
+        d->fixed[k] = (uint8_t)(dd->fixed != 0);
+    }
+    for (int f = 0; f < sc->n_fills; f++) {
+        const struct bal_fill_def *fd = &sc->fills[f];
+        uint64_t rng = (uint64_t)fd->seed;
+        const int m = bal_scene_find(sc, BAL_SEC_MATERIAL, fd->material);
+        const double pitch = 2 * fd->rmax;
+        for (long q = 0; q < fd->n; q++, k++) {
+            const long row = q / fd->columns, col = q % fd->columns;
+            d->x[k] = fd->origin[0] + fd->rmax + (double)col * pitch;
+            d->y[k] = fd->origin[1] + fd->rmax + (double)row * pitch;
+            d->r[k] = fd->rmin + (fd->rmax - fd->rmin) * uniform01(&rng);
+            if (fd->vmax > 0) {
+                const double speed = fd->vmax * uniform01(&rng);
+                const double dir = 2 * BAL_PI * uniform01(&rng);
+                d->vx[k] = speed * cos(dir);
+                d->vy[k] = speed * sin(dir);
+            }
+            d->mat[k] = m;
+        }
+    }
+    return BAL_OK;
+}
+
+static void free_init(struct disc_init *d)
+{
+    free(d->x);
+    free(d->y);
+    free(d->r);
+    free(d->vx);
+    free(d->vy);
+    free(d->th);
+    free(d->w);
+    free(d->mat);
+    free(d->fixed);
+}
+
+static enum bal_status resolve_body(const struct bal_sim *s, const struct bal_scene *sc,
+                                    const char *name, int *is_wall, int *index)
+{
+    int i = bal_scene_find(sc, BAL_SEC_DISC, name);
+    if (i >= 0) {
+        *is_wall = 0;
+        *index = s->slot[i];
+        return BAL_OK;
+    }
+    int k = wall_index(s, name);
+    if (k >= 0) {
+        *is_wall = 1;
+        *index = k;
+        return BAL_OK;
+    }
+    return BAL_EINVAL;
+}
+
+enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
+                               struct bal_error *err)
+{
+    *out = NULL;
+    if (bal_scene_validate(sc, err))
+        return err->code;
+    struct bal_sim *s = calloc(1, sizeof *s);
+    if (!s)
+        return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
+    s->scene = sc;
+    const struct bal_settings *st = &sc->settings;
+    s->alpha = st->alpha;
+    s->beta = st->beta;
+    s->g[0] = st->gravity[0];
+    s->g[1] = st->gravity[1];
+    s->normal_law = st->normal_law;
+    s->nu = st->nu;
+    s->delta0 = st->delta0;
+    s->has_damping = st->beta > 0;
+
+    long n_total = sc->n_discs;
+    for (int f = 0; f < sc->n_fills; f++)
+        n_total += sc->fills[f].n;
+    if (n_total > 100000000L) {
+        bal_sim_free(s);
+        return bal_error(err, BAL_EINVAL, "%s: %ld discs; at most 100000000", sc->path, n_total);
+    }
+    const int n = (int)n_total;
+    s->n = n;
+
+    /* Materials and their pair laws. */
+    s->n_mat = sc->n_materials;
+    s->law = calloc((size_t)s->n_mat * (size_t)s->n_mat, sizeof *s->law);
+    if (!s->law) {
+        bal_sim_free(s);
+        return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
+    }
+    build_laws(s, sc);
+
+    /* Walls: [wall] sections, then four per boxed fill. */
+    int n_walls = sc->n_walls;
+    for (int f = 0; f < sc->n_fills; f++)
+        n_walls += sc->fills[f].box ? 4 : 0;
+    s->walls = calloc((size_t)(n_walls ? n_walls : 1), sizeof *s->walls);
+    if (!s->walls) {
+        bal_sim_free(s);
+        return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
+    }
+    for (int k = 0; k < sc->n_walls; k++) {
+        const struct bal_wall_def *wd = &sc->walls[k];
+        add_wall(s, wd->name, wd->p[0], wd->p[1], wd->angle * (BAL_PI / 180), wd->h1, wd->h2,
+                 bal_scene_find(sc, BAL_SEC_MATERIAL, wd->material));
+    }
+    for (int f = 0; f < sc->n_fills; f++) {
+        const struct bal_fill_def *fd = &sc->fills[f];
+        if (!fd->box)
+            continue;
+        const int m = bal_scene_find(sc, BAL_SEC_MATERIAL, fd->wall_material);
+        const double wd = (double)fd->columns * 2 * fd->rmax;
+        const double ht = (double)fill_rows(fd) * 2 * fd->rmax + fd->headroom;
+        const double ox = fd->origin[0], oy = fd->origin[1];
+        char nm[2 * BAL_NAME_MAX];
+        snprintf(nm, sizeof nm, "%s_bottom", fd->name);
+        add_wall(s, nm, ox, oy, 0, 0, wd, m);
+        snprintf(nm, sizeof nm, "%s_right", fd->name);
+        add_wall(s, nm, ox + wd, oy, BAL_PI / 2, 0, ht, m);
+        snprintf(nm, sizeof nm, "%s_top", fd->name);
+        add_wall(s, nm, ox, oy + ht, 0, 0, wd, m);
+        snprintf(nm, sizeof nm, "%s_left", fd->name);
+        add_wall(s, nm, ox, oy, BAL_PI / 2, 0, ht, m);
+    }
+
+    /* Discs, in cell order when the grid is used. */
+    struct disc_init d = {0};
+    if (gather_discs(sc, n, &d, err)) {
+        free_init(&d);
+        bal_sim_free(s);
+        return err->code;
+    }
+    s->r_max = 0;
+    for (int i = 0; i < n; i++)
+        s->r_max = fmax(s->r_max, d.r[i]);
+    s->use_grid = st->grid == BAL_GRID_ON || (st->grid == BAL_GRID_AUTO && n >= BAL_GRID_CROSSOVER);
+    s->skin = st->skin > 0 ? st->skin : SKIN_SHARE_OF_RMAX * s->r_max;
+
+    int ok = 1;
+    double **arrays[] = {&s->x, &s->y, &s->th, &s->vx, &s->vy, &s->w, &s->r, &s->m,
+                         &s->inv_m, &s->inertia, &s->inv_i, &s->fx, &s->fy, &s->tq,
+                         &s->vx_old, &s->vy_old, &s->w_old, &s->x_ref, &s->y_ref};
+    for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
+        *arrays[k] = alloc_doubles((size_t)n, &ok);
+    s->id = calloc((size_t)(n ? n : 1), sizeof *s->id);
+    s->slot = calloc((size_t)(n ? n : 1), sizeof *s->slot);
+    s->mat = calloc((size_t)(n ? n : 1), sizeof *s->mat);
+    s->fixed = calloc((size_t)(n ? n : 1), sizeof *s->fixed);
+    s->grid.cell = calloc((size_t)(n ? n : 1), sizeof *s->grid.cell);
+    s->grid.list = calloc((size_t)(n ? n : 1), sizeof *s->grid.list);
+    if (!ok || !s->id || !s->slot || !s->mat || !s->fixed || !s->grid.cell || !s->grid.list) {
+        free_init(&d);
+        bal_sim_free(s);
+        return bal_error(err, BAL_ENOMEM, "%s: out of memory for %d discs", sc->path, n);
+    }
+    if (s->use_grid) {
+        if (!cell_order(d.x, d.y, n, 2 * s->r_max + s->skin, s->id)) {
+            free_init(&d);
+            bal_sim_free(s);
+            return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
+        }
+    } else {
+        for (int i = 0; i < n; i++)
+            s->id[i] = i;
+    }
+    for (int i = 0; i < n; i++) {
+        const int k = s->id[i];
+        s->slot[k] = i;
+        s->x[i] = d.x[k];
+        s->y[i] = d.y[k];
+        s->r[i] = d.r[k];
+        s->vx[i] = d.vx[k];
+        s->vy[i] = d.vy[k];
+        s->th[i] = d.th[k];
+        s->w[i] = d.w[k];
+        s->mat[i] = d.mat[k];
+        s->fixed[i] = d.fixed[k];
+        const double density = sc->materials[d.mat[k]].density;
+        s->m[i] = density * BAL_PI * d.r[k] * d.r[k];
+        s->inertia[i] = 0.5 * s->m[i] * d.r[k] * d.r[k];
+        s->inv_m[i] = 1 / s->m[i];
+        s->inv_i[i] = 1 / s->inertia[i];
+    }
+    free_init(&d);
+
+    /* Time step. */
+    s->dt_estimate = bal_timestep_estimate(s);
+    s->dt = st->dt > 0 ? st->dt : st->dt_fraction * s->dt_estimate;
+    if (!(s->dt > 0 && isfinite(s->dt))) {
+        bal_sim_free(s);
+        return bal_error(err, BAL_EINVAL, "%s: time step %g is not a positive number", sc->path,
+                         s->dt);
+    }
+
+    /* Law and candidates. */
+    s->pair_loop = bal_contacts_select(s->normal_law, s->has_shear, s->has_damping);
+    if (bal_grid_rebuild(s, err)) {
+        bal_sim_free(s);
+        return err->code;
+    }
+
+    /* Probes. */
+    s->n_probes = sc->n_probes;
+    s->probes = calloc((size_t)(sc->n_probes ? sc->n_probes : 1), sizeof *s->probes);
+    if (!s->probes) {
+        bal_sim_free(s);
+        return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
+    }
+    for (int p = 0; p < sc->n_probes; p++) {
+        const struct bal_probe_def *pd = &sc->probes[p];
+        struct bal_probe_ref *pr = &s->probes[p];
+        pr->kind = pd->kind;
+        if (*pd->a && resolve_body(s, sc, pd->a, &pr->a_wall, &pr->a)) {
+            bal_sim_free(s);
+            return bal_error(err, BAL_EINVAL, "%s:%d: a: no body '%s'", sc->path, pd->line, pd->a);
+        }
+        if (*pd->b && resolve_body(s, sc, pd->b, &pr->b_wall, &pr->b)) {
+            bal_sim_free(s);
+            return bal_error(err, BAL_EINVAL, "%s:%d: b: no body '%s'", sc->path, pd->line, pd->b);
+        }
+    }
+    s->stage = -1;
+    *out = s;
+    return BAL_OK;
+}
+
+void bal_sim_set_stage(struct bal_sim *s, int stage)
+{
+    const struct bal_stage_def *g = &s->scene->stages[stage];
+    for (int k = 0; k < s->n_walls; k++) {
+        s->walls[k].v[0] = s->walls[k].v[1] = 0;
+        s->walls[k].omega = 0;
+    }
+    for (int m = 0; m < g->n_moves; m++) {
+        const int k = wall_index(s, g->moves[m].wall);
+        if (k < 0)
+            continue; /* refused by bal_scene_validate */
+        s->walls[k].v[0] = g->moves[m].v[0];
+        s->walls[k].v[1] = g->moves[m].v[1];
+        s->walls[k].omega = g->moves[m].omega;
+    }
+    s->stage = stage;
+}
+
+enum bal_status bal_sim_cycle(struct bal_sim *s, int keep_old, struct bal_error *err)
+{
+    /* 1. positions x_N from v_{N-1/2}; walls move */
+    bal_integrate_positions(s);
+    /* 2. neighbours */
+    if (s->need_rebuild && bal_grid_rebuild(s, err))
+        return err->code;
+    /* 3. contacts: the force–displacement law at t_N */
+    memset(s->fx, 0, (size_t)s->n * sizeof *s->fx);
+    memset(s->fy, 0, (size_t)s->n * sizeof *s->fy);
+    memset(s->tq, 0, (size_t)s->n * sizeof *s->tq);
+    s->pair_loop(s);
+    bal_contacts_walls(s);
+    /* 4. motion: v_{N+1/2} */
+    bal_integrate_velocities(s, keep_old);
+    s->have_old = keep_old;
+    s->step++;
+    s->time += s->dt;
+    return BAL_OK;
+}
+
+enum bal_status bal_sim_step(struct bal_sim *s, struct bal_error *err)
+{
+    if (s->stage < 0 && s->scene->n_stages > 0)
+        bal_sim_set_stage(s, 0);
+    return bal_sim_cycle(s, 1, err);
+}
+
+/* Is every position and velocity finite?  Names the first disc that is not. */
+static enum bal_status check_finite(const struct bal_sim *s, struct bal_error *err)
+{
+    for (int i = 0; i < s->n; i++) {
+        if (!isfinite(s->x[i] + s->y[i] + s->vx[i] + s->vy[i] + s->w[i])) {
+            char name[2 * BAL_NAME_MAX];
+            bal_output_disc_name(s, s->id[i], name, sizeof name);
+            return bal_error(err, BAL_EUNSTABLE,
+                             "%s: disc %s: position or velocity is not finite at step %ld "
+                             "(time step too large for the stiffness?)",
+                             s->scene->path, name, s->step);
+        }
+    }
+    return BAL_OK;
+}
+
+enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_atomic_t *stop,
+                            struct bal_error *err)
+{
+    const struct bal_scene *sc = s->scene;
+    const long every = sc->settings.output_every;
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    enum bal_status status = BAL_OK;
+    for (int g = 0; g < sc->n_stages && status == BAL_OK; g++) {
+        bal_sim_set_stage(s, g);
+        const long cycles = sc->stages[g].cycles;
+        for (long c = 0; c < cycles; c++) {
+            if (stop && *stop) {
+                status = bal_error(err, BAL_EINTR, "%s: interrupted at step %ld", sc->path,
+                                   s->step);
+                break;
+            }
+            const int last = g == sc->n_stages - 1 && c == cycles - 1;
+            const int row = series && ((s->step + 1) % every == 0 || last);
+            if ((status = bal_sim_cycle(s, row, err)) != BAL_OK)
+                break;
+            if ((row || s->step % FINITE_CHECK_EVERY == 0) &&
+                (status = check_finite(s, err)) != BAL_OK)
+                break;
+            if (row)
+                bal_output_series_row(s, series);
+        }
+    }
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    s->wall_seconds += (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    return status;
+}
+
+void bal_sim_info(const struct bal_sim *s, struct bal_run_info *info)
+{
+    info->steps = s->step;
+    info->time = s->time;
+    info->dt = s->dt;
+    info->dt_estimate = s->dt_estimate;
+    info->dt_fraction = s->dt / s->dt_estimate;
+    info->wall_seconds = s->wall_seconds;
+    info->rebuilds = s->rebuilds;
+    info->grid_used = s->use_grid;
+    info->n_discs = s->n;
+    info->n_walls = s->n_walls;
+    info->n_candidates = s->pp.n;
+}
+
+static long find_key(const struct bal_pairs *p, uint64_t key)
+{
+    long lo = 0, hi = p->n;
+    while (lo < hi) {
+        long mid = lo + (hi - lo) / 2;
+        if (p->key[mid] < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < p->n && p->key[lo] == key ? lo : -1;
+}
+
+long bal_sim_find_contact(const struct bal_sim *s, int a_wall, int a, int b_wall, int b,
+                          const struct bal_pairs **list)
+{
+    if (a_wall && b_wall)
+        return -1;
+    if (a_wall || b_wall) {
+        const int disc = a_wall ? b : a, wall = a_wall ? a : b;
+        *list = &s->pw;
+        return find_key(&s->pw, ((uint64_t)(uint32_t)disc << 32) | (uint32_t)wall);
+    }
+    const int lo = a < b ? a : b, hi = a < b ? b : a;
+    *list = &s->pp;
+    return find_key(&s->pp, ((uint64_t)(uint32_t)lo << 32) | (uint32_t)hi);
+}

@@ -1,0 +1,180 @@
+/*
+ * sim.h — internal: the simulation state and the module interfaces of the
+ * step pipeline.  Not part of the public API; the Check tests include it.
+ *
+ * Layout.  Discs are struct-of-arrays, stored in cell order (sorted once at
+ * creation along a row-major cell grid so that neighbours are near each
+ * other in memory).  `id[i]` is the disc's index in scene order (discs of
+ * [disc] sections first, then those of each [fill]); outputs are written in
+ * that order.  Array index i is stable for the lifetime of the simulation,
+ * so contact keys built from indices are stable too.
+ *
+ * Contacts.  Two flat candidate lists, disc–disc and disc–wall, each sorted
+ * by key = (lo << 32) | hi.  A candidate carries the contact's history
+ * (F_n for the incremental law, F_s) in parallel arrays; a candidate whose
+ * bodies do not overlap has zero history.  When the neighbour list is
+ * rebuilt, the new candidate list is merged with the old one in one linear
+ * pass, so history survives rebuilds (contacts.c).
+ */
+#ifndef BAL_SIM_H
+#define BAL_SIM_H
+
+#include <stdint.h>
+
+#include "ballast.h"
+
+#define BAL_PI 3.14159265358979323846
+
+/* Contact parameters of one pair of materials (C&S eqs 16–19, 28). */
+struct bal_pair_law {
+    double kn, ks;         /* stiffnesses of the contact */
+    double tan_phi;        /* smaller tan φ_μ of the two */
+    double cohesion;       /* smaller c of the two */
+    double cn, cs;         /* dashpots β k_n, β k_s */
+    int shear;             /* 1 if tan φ_μ > 0 or c > 0: the pair has a shear force */
+};
+
+/* A candidate list with its contact history.  Flags: bit 0 touching,
+ * bit 1 sliding (|F_s| at the Coulomb limit). */
+struct bal_pairs {
+    long n, cap;
+    uint64_t *key;         /* (lo << 32) | hi, sorted ascending */
+    int32_t *i, *j;        /* disc index; j: disc index or wall index */
+    double *fn, *fs;       /* F_n (history of the incremental law), F_s */
+    double *dn, *ds;       /* dashpot forces D_n, D_s of the last cycle */
+    uint8_t *flags;
+};
+
+#define BAL_PAIR_TOUCHING 1u
+#define BAL_PAIR_SLIDING 2u
+
+struct bal_wall {
+    char name[BAL_NAME_MAX];
+    double p[2];           /* point P */
+    double alpha;          /* direction of e, radians */
+    double e[2];           /* (cos α, sin α) */
+    double h1, h2;         /* end multipliers */
+    int material;
+    double v[2], omega;    /* current motion (from the stage) */
+    /* Resultant of the contact forces exerted by the discs on the wall,
+     * accumulated in the last cycle. */
+    double f[2];           /* F1, F2 */
+    double moment;         /* about P, counter-clockwise */
+    double fn_sum;         /* Σ F_n over its contacts */
+    double fn_s_sum;       /* Σ F_n s, s = position of the contact along e from P */
+    double disp;           /* largest displacement of any of its points since rebuild */
+};
+
+struct bal_grid {
+    double x0, y0, h;      /* origin and cell size */
+    int nx, ny;
+    long cells_cap;        /* allocated length of `start` */
+    int32_t *start;        /* nx*ny + 1 offsets into `list` */
+    int32_t *list;         /* disc indices sorted by cell */
+    int32_t *cell;         /* cell of each disc (scratch) */
+};
+
+typedef void (*bal_pair_loop_fn)(struct bal_sim *s);
+
+/* A probe with its bodies resolved: kind, and for each body whether it is a
+ * wall and its array slot (disc) or wall index. */
+struct bal_probe_ref {
+    int kind;
+    int a_wall, a;
+    int b_wall, b;
+};
+
+struct bal_sim {
+    const struct bal_scene *scene;
+
+    /* discs */
+    int n;
+    int32_t *id;                 /* scene-order index of array slot i */
+    int32_t *slot;               /* array slot of scene-order index */
+    double *x, *y, *th;          /* position, rotation */
+    double *vx, *vy, *w;         /* velocities at t_{N-1/2} (t_{N+1/2} after a step) */
+    double *r, *m, *inv_m, *inertia, *inv_i;
+    double *fx, *fy, *tq;        /* force and moment sums of the last cycle */
+    double *vx_old, *vy_old, *w_old; /* velocities before the last update (for t_N averages) */
+    double *x_ref, *y_ref;       /* positions at the last rebuild */
+    int32_t *mat;
+    uint8_t *fixed;
+    double r_max;
+
+    /* walls */
+    int n_walls;
+    struct bal_wall *walls;
+
+    /* materials */
+    int n_mat;
+    struct bal_pair_law *law;    /* n_mat × n_mat */
+
+    /* contacts and neighbours */
+    struct bal_pairs pp, pw;     /* disc–disc, disc–wall candidates */
+    struct bal_pairs scratch;    /* rebuild target, swapped with pp/pw */
+    struct bal_grid grid;
+    int use_grid;
+    double skin;
+    long rebuilds;
+    int need_rebuild;
+    bal_pair_loop_fn pair_loop;
+
+    /* settings */
+    double dt, dt_estimate;
+    double alpha, beta;
+    double g[2];
+    int normal_law;
+    double nu, delta0;
+    int has_shear;               /* any material pair with k_s and a non-zero cap */
+    int has_damping;             /* β > 0 */
+
+    /* probes */
+    int n_probes;
+    struct bal_probe_ref *probes;
+    int have_old;                /* vx_old etc. hold v_{N-1/2} of the last step */
+
+    /* progress */
+    long step;
+    double time;
+    int stage;
+    double wall_seconds;
+};
+
+/* contacts.c */
+enum bal_status bal_pairs_reserve(struct bal_pairs *p, long cap);
+void bal_pairs_free(struct bal_pairs *p);
+void bal_pairs_sort(struct bal_pairs *p);
+void bal_pairs_merge_history(struct bal_pairs *fresh, const struct bal_pairs *old);
+bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping);
+void bal_contacts_walls(struct bal_sim *s);
+
+/* grid.c */
+enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err);
+void bal_grid_free(struct bal_grid *g);
+/* With fewer discs than this, `grid = auto` uses all pairs.  Measured with
+ * `build/bench --grid cases/bench/dense.scene` (README, "Neighbour search"):
+ * the Verlet-listed grid was faster at every N >= 4, settled or falling
+ * (1.2-1.5x at N = 4-16, 14x at N = 256), so all pairs serve only scenes of
+ * two or three discs, whose single list is built once. */
+#define BAL_GRID_CROSSOVER 4
+
+/* walls.c */
+void bal_walls_move(struct bal_sim *s);
+/* Closest point of wall w to (x, y); returns squared distance. */
+double bal_walls_closest(const struct bal_wall *w, double x, double y,
+                         double *cx, double *cy);
+
+/* integrate.c */
+void bal_integrate_positions(struct bal_sim *s);
+void bal_integrate_velocities(struct bal_sim *s, int keep_old);
+
+/* timestep.c */
+double bal_timestep_estimate(const struct bal_sim *s);
+
+/* sim.c */
+enum bal_status bal_sim_cycle(struct bal_sim *s, int keep_old, struct bal_error *err);
+/* Candidate index of the contact between two bodies, or -1. */
+long bal_sim_find_contact(const struct bal_sim *s, int a_wall, int a, int b_wall, int b,
+                          const struct bal_pairs **list);
+
+#endif /* BAL_SIM_H */

@@ -1,0 +1,197 @@
+"""The command line: python3 -m harness {list,run,check,report,validate,rebaseline,sweep}.
+
+Each command is a small function that loads the catalogue and references, picks the
+cases, and hands over to runner, gate, report or rebaseline.  Errors in case.txt or .ref
+files (named file:line) and unknown case names end the command with status 2.
+"""
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_root
+from . import catalogue, references
+from .compare import RunStore, evaluate_all, folder_locator
+from .gate import gate, sweep_table
+from .ini import IniError
+from .rebaseline import rebaseline
+from .report import write_report
+from .runner import jobs_for, run_all, sweep_jobs
+
+USAGE_ERROR = 2
+
+
+# ---------------------------------------------------------------- loading
+
+def load_cases():
+    return catalogue.load(cases_root())
+
+
+def load_checks(cases):
+    """Every reference check, validated against the catalogue."""
+    checks = references.load(reference_root())
+    references.validate(checks, cases)
+    return checks
+
+
+def selected(args, cases):
+    return catalogue.select(cases, getattr(args, "cases", []) or [], args.tier)
+
+
+def default_store():
+    return RunStore(folder_locator(runs_root()))
+
+
+# ---------------------------------------------------------------- commands
+
+def cmd_list(args):
+    cases = selected(args, load_cases())
+    rows = [("CASE", "TIER", "VARIANTS", "RUNTIME", "CHECKS")]
+    rows += [(c.name, c.tier, " ".join(c.variant_names()), f"{c.runtime:g} s", c.checks) for c in cases]
+    widths = [max(len(r[i]) for r in rows) for i in range(4)]
+    for r in rows:
+        print("  ".join(x.ljust(w) for x, w in zip(r, widths)) + "  " + r[4])
+    print(f"{len(cases)} case(s), about {sum(c.runtime for c in cases):g} s of runs on the reference machine")
+    return 0
+
+
+def cmd_run(args):
+    cases = selected(args, load_cases())
+    if not cases:
+        print("no cases selected", file=sys.stderr)
+        return 1
+    outcomes = run_all(jobs_for(cases, runs_root()), args.bin, args.jobs, sys.stdout)
+    return 0 if all(o.ok for o in outcomes) else 1
+
+
+def cmd_check(args):
+    all_cases = load_cases()
+    checks = load_checks(all_cases)
+    cases = selected(args, all_cases)
+    return gate(references.for_cases(checks, cases), default_store(), reports_root(), sys.stdout)
+
+
+def cmd_report(args):
+    all_cases = load_cases()
+    checks = load_checks(all_cases)
+    cases = selected(args, all_cases)
+    write_report(cases, references.for_cases(checks, cases), default_store(), runs_root(), reports_root(), sys.stdout)
+    return 0
+
+
+def cmd_validate(args):
+    load_checks(load_cases())          # a broken reference file stops us before any run
+    run_status = cmd_run(args)
+    check_status = cmd_check(args)
+    cmd_report(args)
+    return run_status or check_status
+
+
+def cmd_rebaseline(args):
+    cases = load_cases()
+    case = catalogue.select(cases, [args.case])[0]
+    return rebaseline(case, load_checks(cases), default_store(), sys.stdout)
+
+
+def cmd_sweep(args):
+    cases = load_cases()
+    case = catalogue.select(cases, [args.case])[0]
+    variant = sweep_variant(case, args.variant)
+    key, values = parse_sweep(args.set)
+    jobs = sweep_jobs(case, variant, key, values, reports_root() / "sweeps")
+    outcomes = run_all(jobs, args.bin, args.jobs, sys.stdout)
+    checks = [c for c in load_checks(cases) if c.case == case.name and c.run_variants == [variant.name]]
+    print_sweep(case, variant, checks, jobs)
+    return 0 if all(o.ok for o in outcomes) else 1
+
+
+def sweep_variant(case, name):
+    if name:
+        if not case.variant(name):
+            raise catalogue.CatalogueError(f"case '{case.name}' has no variant '{name}' "
+                                           f"(has: {', '.join(case.variant_names())})")
+        return case.variant(name)
+    if len(case.variants) > 1:
+        raise catalogue.CatalogueError(f"case '{case.name}' has several variants: pick one with --variant "
+                                       f"({', '.join(case.variant_names())})")
+    return case.variants[0]
+
+
+def parse_sweep(text):
+    """'KEY=V1,V2,...' -> (KEY, [V1, V2, ...])."""
+    key, sep, values = text.partition("=")
+    values = [v.strip() for v in values.split(",") if v.strip()]
+    if not sep or not key or not values or any("/" in v for v in values):
+        raise catalogue.CatalogueError(f"--set needs KEY=V1,V2,... (no '/' in values), got '{text}'")
+    return key, values
+
+
+def print_sweep(case, variant, checks, jobs):
+    if not checks:
+        print(f"no checks of {case.name} use only variant '{variant.name}'")
+        return
+    by_label = {}
+    for job in jobs:
+        store = RunStore(lambda c, v, folder=job.out: folder)
+        by_label[job.variant] = evaluate_all(checks, store)
+    print(sweep_table([j.variant for j in jobs], checks, by_label))
+
+
+# ---------------------------------------------------------------- arguments
+
+def parser():
+    p = argparse.ArgumentParser(prog="ballast-harness",
+                                description="ballast validation harness: run the cases, check them, report.")
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    _selection(_command(sub, "list", cmd_list, "table of the cases: tier, variants, expected run time, what each checks"),
+               default_tier="full", names=False)
+    _runs(_selection(_command(sub, "run", cmd_run, "run every variant of the selected cases")))
+    _selection(_command(sub, "check", cmd_check,
+                        "evaluate the checks, print the gate table, write summary.json and junit.xml"))
+    _selection(_command(sub, "report", cmd_report, "render figures, write reports/summary.md and reports/index.html"))
+    _runs(_selection(_command(sub, "validate", cmd_validate, "run + check + report")))
+    rebase = _command(sub, "rebaseline", cmd_rebaseline, "rewrite the regression values of CASE from its current outputs")
+    rebase.add_argument("case", metavar="CASE")
+    sweep = _command(sub, "sweep", cmd_sweep, "run one variant once per value of a --set key and tabulate its checks")
+    sweep.add_argument("case", metavar="CASE")
+    sweep.add_argument("--set", required=True, metavar="KEY=V1,V2,...")
+    sweep.add_argument("--variant", metavar="NAME", help="the variant to sweep (needed when the case has several)")
+    _runs(sweep)
+    return p
+
+
+def _command(sub, name, fn, text):
+    p = sub.add_parser(name, help=text, description=text)
+    p.set_defaults(fn=fn)
+    return p
+
+
+def _selection(p, default_tier="standard", names=True):
+    if names:
+        p.add_argument("cases", nargs="*", metavar="CASE", help="case names (default: all cases of tier <= --tier)")
+    p.add_argument("--tier", choices=TIERS, default=default_tier, help=f"highest tier (default {default_tier})")
+    return p
+
+
+def _runs(p):
+    p.add_argument("-j", "--jobs", type=int, default=os.cpu_count(), help="parallel runs (default: CPU count)")
+    p.add_argument("--bin", type=Path, default=None, help="the core executable (default $BALLAST_BIN or bin/ballast)")
+    return p
+
+
+def main(argv=None):
+    args = parser().parse_args(argv)
+    if hasattr(args, "bin") and args.bin is None:
+        args.bin = bin_path()
+    try:
+        return args.fn(args)
+    except (IniError, catalogue.CatalogueError) as exc:
+        print(f"ballast-harness: {exc}", file=sys.stderr)
+        return USAGE_ERROR
+    except KeyboardInterrupt:
+        print("\nballast-harness: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,303 @@
+"""Checks against run outputs: expression evaluation, tolerance kinds, verdicts.
+
+A quantity is a Python expression evaluated without builtins in a namespace holding
+every series.tsv column (numpy array) and the functions of the spec (at, first, last,
+after, upto, between, mean, max, min, std, abs, sqrt, amp, run).  evaluate_check()
+turns one Check into a Verdict; anything that goes wrong (missing output, failed run,
+missing column, an expression that raises, a NaN/inf value) is a FAIL whose message
+says which, never a pass and never a skip.
+"""
+import ast
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .tables import RunProblem, load_run
+
+
+class EvalError(Exception):
+    """A quantity could not be evaluated to one finite number."""
+
+
+@dataclass
+class Verdict:
+    case: str
+    variant: str
+    check: str
+    quantity: str
+    value: object        # float, list of floats (trend), or None when it could not be computed
+    reference: object    # float, [lo, hi] (interval), or None (trend)
+    tolerance: str
+    kind: str
+    provenance: str
+    passed: bool
+    message: str
+
+    def as_dict(self):
+        """The summary.json record (keys as in the spec; non-finite numbers as null)."""
+        return {"case": self.case, "variant": self.variant, "check": self.check,
+                "quantity": self.quantity, "value": _json_number(self.value),
+                "reference": _json_number(self.reference), "tolerance": self.tolerance,
+                "kind": self.kind, "provenance": self.provenance, "pass": self.passed,
+                "message": self.message}
+
+    @classmethod
+    def from_dict(cls, d):
+        return cls(d["case"], d["variant"], d["check"], d["quantity"], d["value"], d["reference"],
+                   d["tolerance"], d["kind"], d["provenance"], d["pass"], d["message"])
+
+
+def _json_number(x):
+    if isinstance(x, list):
+        return [_json_number(v) for v in x]
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    return x
+
+
+# ---------------------------------------------------------------- run outputs
+
+class RunStore:
+    """Loads each run folder once; locate(case, variant) gives the folder."""
+
+    def __init__(self, locate):
+        self.locate = locate
+        self._cache = {}
+
+    def get(self, case, variant):
+        """The Run of case/variant, or raise its RunProblem."""
+        key = (case, variant)
+        if key not in self._cache:
+            try:
+                self._cache[key] = load_run(self.locate(case, variant))
+            except RunProblem as problem:
+                self._cache[key] = problem
+        found = self._cache[key]
+        if isinstance(found, RunProblem):
+            raise found
+        return found
+
+
+def folder_locator(runs_root):
+    """locate() for the usual layout runs_root/<case>/<variant>."""
+    return lambda case, variant: Path(runs_root) / case / variant
+
+
+# ---------------------------------------------------------------- expressions
+
+def namespace(run):
+    """Columns by header name, then the expression functions (functions win a clash)."""
+    names = dict(run.columns)
+    names.update(REDUCERS)
+    names.update(_selectors(run.columns["cycle"]))
+    names["run"] = _run_field(run.info)
+    return names
+
+
+def _nonempty(arr, fname):
+    arr = np.atleast_1d(np.asarray(arr, dtype=float))
+    if arr.size == 0:
+        raise EvalError(f"{fname}(): no rows selected")
+    return arr
+
+
+def _reducer(fn, fname):
+    """fn over one array (or over several numbers, as in max(a, b)); empty is an error."""
+    def reduce(*args):
+        arr = args[0] if len(args) == 1 else np.array(args, dtype=float)
+        return float(fn(_nonempty(arr, fname)))
+    return reduce
+
+
+REDUCERS = {
+    "first": _reducer(lambda a: a[0], "first"), "last": _reducer(lambda a: a[-1], "last"),
+    "mean": _reducer(np.mean, "mean"), "max": _reducer(np.max, "max"),
+    "min": _reducer(np.min, "min"), "std": _reducer(np.std, "std"),
+    "amp": _reducer(lambda a: (a.max() - a.min()) / 2, "amp"),
+    "abs": np.abs, "sqrt": np.sqrt,
+}
+
+
+def _selectors(cycle):
+    """at, after, upto, between: rows of a whole column chosen by the cycle column."""
+    def whole(col, fname):
+        col = np.asarray(col, dtype=float)
+        if col.shape != cycle.shape:
+            raise EvalError(f"{fname}(): first argument must be a whole series column")
+        return col
+
+    def at(col, c):
+        rows = np.flatnonzero(cycle == c)
+        if rows.size == 0:
+            raise EvalError(f"at(): no row with cycle == {c:g}")
+        return float(whole(col, "at")[rows[0]])
+
+    return {
+        "at": at,
+        "after": lambda col, c: whole(col, "after")[cycle > c],
+        "upto": lambda col, c: whole(col, "upto")[cycle <= c],
+        "between": lambda col, a, b: whole(col, "between")[(cycle >= a) & (cycle <= b)],
+    }
+
+
+def _run_field(info):
+    def run(key):
+        if key not in info:
+            raise EvalError(f"run(): run.json has no field '{key}'")
+        return info[key]
+    return run
+
+
+def _compile(expr, names):
+    """Compile expr; refuse private attributes and names the namespace lacks."""
+    try:
+        tree = ast.parse(expr, mode="eval")
+    except SyntaxError as exc:
+        raise EvalError(f"syntax error in '{expr}': {exc.msg}") from None
+    nodes = list(ast.walk(tree))
+    called = {id(n.func) for n in nodes if isinstance(n, ast.Call)}
+    bound = {n.id for n in nodes if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)}
+    for node in nodes:
+        if isinstance(node, ast.Attribute) and node.attr.startswith("_"):
+            raise EvalError(f"'{node.attr}' is not allowed in an expression")
+        if isinstance(node, ast.Name) and node.id not in names and node.id not in bound:
+            raise EvalError(_unknown_name(node.id, id(node) in called, names))
+    return compile(tree, "<quantity>", "eval")
+
+
+def _unknown_name(name, is_call, names):
+    if is_call:
+        functions = ", ".join(n for n in names if callable(names[n]))
+        return f"unknown function '{name}' (functions: {functions})"
+    columns = ", ".join(n for n in names if not callable(names[n]))
+    return f"column '{name}' missing from series.tsv (columns: {columns})"
+
+
+def evaluate(expr, run):
+    """The expression's value in run's outputs, as one finite float."""
+    names = namespace(run)
+    code = _compile(expr, names)
+    try:
+        with np.errstate(all="ignore"):
+            result = eval(code, {**names, "__builtins__": {}})  # noqa: S307 -- no builtins, vetted names
+    except EvalError:
+        raise
+    except Exception as exc:  # any failure of the expression is a FAIL with its reason
+        raise EvalError(f"'{expr}' raised {type(exc).__name__}: {exc}") from None
+    return _finite_scalar(result, expr)
+
+
+def _finite_scalar(result, expr):
+    try:
+        arr = np.asarray(result, dtype=float)
+    except (TypeError, ValueError):
+        raise EvalError(f"'{expr}' is not a number: {result!r}") from None
+    if arr.size != 1:
+        raise EvalError(f"'{expr}' gives {arr.size} values, not one")
+    value = float(arr.reshape(-1)[0])
+    if not math.isfinite(value):
+        raise EvalError(f"'{expr}' is {value} (not finite)")
+    return value
+
+
+def quantity_in(store, case, variant, expr):
+    """Evaluate expr in the outputs of case/variant; errors say which variant."""
+    run = store.get(case, variant)
+    try:
+        return evaluate(expr, run)
+    except EvalError as exc:
+        raise EvalError(f"{variant}: {exc}") from None
+
+
+# ---------------------------------------------------------------- tolerance kinds
+
+def _judge_abs(check, store):
+    q = quantity_in(store, check.case, check.variant, check.quantity)
+    err = abs(q - check.value)
+    ok = err <= check.width
+    return q, ok, f"|q - ref| = {err:.3g} {'<=' if ok else '>'} {check.width:g}"
+
+
+def _judge_rel(check, store):
+    q = quantity_in(store, check.case, check.variant, check.quantity)
+    return q, *_relative(q, check.value, check.width, "q")
+
+
+def _relative(q, ref, width, label):
+    err, bound = abs(q - ref), width * abs(ref)
+    ok = err <= bound
+    return ok, f"|{label} - ref| = {err:.3g} {'<=' if ok else '>'} {width:g}*|ref| = {bound:.3g}"
+
+
+def _judge_interval(check, store):
+    q = quantity_in(store, check.case, check.variant, check.quantity)
+    ok = (check.lo is None or check.lo <= q) and (check.hi is None or q <= check.hi)
+    lo = "-inf" if check.lo is None else f"{check.lo:.6g}"
+    hi = "+inf" if check.hi is None else f"{check.hi:.6g}"
+    return q, ok, f"{lo} <= {q:.6g} <= {hi}" if ok else f"{q:.6g} outside [{lo}, {hi}]"
+
+
+def _judge_ratio(check, store):
+    q = quantity_in(store, check.case, check.variant, check.quantity)
+    other = quantity_in(store, check.case, check.other_variant, check.other)
+    if other == 0:
+        raise EvalError(f"{check.other_variant}: other quantity '{check.other}' is zero")
+    ratio = q / other
+    ok, message = _relative(ratio, check.value, check.width, "q/other")
+    return ratio, ok, f"q = {q:.6g}, other = {other:.6g}; {message}"
+
+
+MONOTONE = {
+    "increasing": lambda a, b: b > a, "decreasing": lambda a, b: b < a,
+    "nondecreasing": lambda a, b: b >= a, "nonincreasing": lambda a, b: b <= a,
+}
+
+
+def _judge_trend(check, store):
+    values = [quantity_in(store, check.case, v, check.quantity) for v in check.variants]
+    step_ok = MONOTONE[check.direction]
+    for (va, a), (vb, b) in zip(zip(check.variants, values), zip(check.variants[1:], values[1:])):
+        if not step_ok(a, b):
+            return values, False, f"not {check.direction}: {va} = {a:.6g} then {vb} = {b:.6g}"
+    return values, True, f"{check.direction} over {', '.join(check.variants)}"
+
+
+JUDGES = {"abs": _judge_abs, "rel": _judge_rel, "interval": _judge_interval,
+          "ratio": _judge_ratio, "trend": _judge_trend}
+
+
+# ---------------------------------------------------------------- verdicts
+
+def reference_of(check):
+    """What the verdict shows as the reference value."""
+    if check.tolerance == "interval":
+        return [check.lo, check.hi]
+    if check.tolerance == "trend":
+        return None
+    return check.value
+
+
+def quantity_text(check):
+    if check.tolerance != "ratio":
+        return check.quantity
+    where = "" if check.other_variant == check.variant else f" [in {check.other_variant}]"
+    return f"({check.quantity}) / ({check.other}){where}"
+
+
+def evaluate_check(check, store):
+    """The Verdict of one check; any problem is a FAIL with its reason."""
+    try:
+        value, passed, message = JUDGES[check.tolerance](check, store)
+    except (RunProblem, EvalError) as exc:
+        value, passed, message = None, False, str(exc)
+    return Verdict(case=check.case, variant=check.variant_label, check=check.name,
+                   quantity=quantity_text(check), value=value, reference=reference_of(check),
+                   tolerance=check.tolerance_text, kind=check.kind, provenance=check.provenance,
+                   passed=bool(passed), message=message)
+
+
+def evaluate_all(checks, store):
+    """Verdicts of the checks, in the order given."""
+    return [evaluate_check(c, store) for c in checks]

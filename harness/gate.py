@@ -1,0 +1,143 @@
+"""The gate: verdicts printed as an aligned table, written as summary.json and junit.xml.
+
+gate() is the `check` command's work once the checks are chosen: evaluate them, print
+the table (last line 'N passed, M failed'), write both files, return the exit status
+(0 iff there is at least one check and every check passes).
+"""
+import json
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+from .compare import Verdict, evaluate_all
+
+COLUMNS = ("case", "variant", "check", "value", "reference", "tolerance", "kind", "result")
+RIGHT = {"value", "reference"}
+
+
+def fmt_number(x):
+    """~6 significant digits; '-' for nothing; lists joined; intervals as [lo, hi]."""
+    if x is None:
+        return "-"
+    if isinstance(x, (list, tuple)):
+        return ", ".join(fmt_number(v) for v in x)
+    if isinstance(x, bool) or not isinstance(x, (int, float)):
+        return str(x)
+    return f"{x:.6g}"
+
+
+def fmt_reference(v):
+    """The reference column: a number, or [lo, hi] for an interval."""
+    if isinstance(v.reference, list):
+        lo, hi = v.reference
+        return f"[{'-inf' if lo is None else fmt_number(lo)}, {'+inf' if hi is None else fmt_number(hi)}]"
+    return fmt_number(v.reference)
+
+
+def row(v):
+    return {"case": v.case, "variant": v.variant, "check": v.check, "value": fmt_number(v.value),
+            "reference": fmt_reference(v), "tolerance": v.tolerance, "kind": v.kind,
+            "result": "PASS" if v.passed else "FAIL"}
+
+
+def tally(verdicts):
+    passed = sum(v.passed for v in verdicts)
+    return passed, len(verdicts) - passed
+
+
+def table(verdicts):
+    """The gate table as text: aligned columns, failure reasons, then 'N passed, M failed'."""
+    rows = [row(v) for v in verdicts]
+    widths = {c: max([len(c)] + [len(r[c]) for r in rows]) for c in COLUMNS}
+    lines = [_line({c: c.upper() for c in COLUMNS}, widths), _line({c: "-" * widths[c] for c in COLUMNS}, widths)]
+    lines += [_line(r, widths) for r in rows]
+    failures = [v for v in verdicts if not v.passed]
+    if failures:
+        lines.append("")
+        lines += [f"FAIL {v.case}/{v.check}: {v.message}" for v in failures]
+    if not verdicts:
+        lines.append("no checks selected: nothing was verified")
+    passed, failed = tally(verdicts)
+    lines.append(f"{passed} passed, {failed} failed")
+    return "\n".join(lines)
+
+
+def _line(cells, widths):
+    parts = [cells[c].rjust(widths[c]) if c in RIGHT else cells[c].ljust(widths[c]) for c in COLUMNS]
+    return "  ".join(parts).rstrip()
+
+
+def write_summary(verdicts, path):
+    """summary.json: a list of one record per check."""
+    _write(path, json.dumps([v.as_dict() for v in verdicts], indent=1, allow_nan=False) + "\n")
+
+
+def read_summary(path):
+    """The verdicts of a summary.json."""
+    return [Verdict.from_dict(d) for d in json.loads(Path(path).read_text(encoding="utf-8"))]
+
+
+def junit(verdicts):
+    """junit.xml text: one testsuite per case, one testcase per check, <failure> on failure."""
+    root = ET.Element("testsuites", name="ballast", tests=str(len(verdicts)), failures=str(tally(verdicts)[1]))
+    for case in dict.fromkeys(v.case for v in verdicts):
+        mine = [v for v in verdicts if v.case == case]
+        suite = ET.SubElement(root, "testsuite", name=case, tests=str(len(mine)),
+                              failures=str(tally(mine)[1]), errors="0", skipped="0")
+        for v in mine:
+            _testcase(suite, v)
+    ET.indent(root)
+    return ET.tostring(root, encoding="unicode", xml_declaration=True) + "\n"
+
+
+def _testcase(suite, v):
+    case = ET.SubElement(suite, "testcase", classname=f"{v.case}.{v.variant.replace(' ', '+')}", name=v.check)
+    detail = (f"quantity: {v.quantity}\nvalue: {fmt_number(v.value)}\nreference: {fmt_reference(v)}\n"
+              f"tolerance: {v.tolerance}\nkind: {v.kind}\nprovenance: {v.provenance}\n{v.message}")
+    if v.passed:
+        ET.SubElement(case, "system-out").text = detail
+    else:
+        ET.SubElement(case, "failure", message=v.message, type="check").text = detail
+
+
+def write_junit(verdicts, path):
+    _write(path, junit(verdicts))
+
+
+def _write(path, text):
+    """Write text whole: to a temporary file, then rename."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    tmp.replace(path)
+
+
+def exit_status(verdicts):
+    """0 iff there is at least one check and all pass."""
+    passed, failed = tally(verdicts)
+    return 0 if verdicts and not failed else 1
+
+
+def gate(checks, store, reports_dir, out):
+    """Evaluate checks, print the table to out, write summary.json and junit.xml; the exit status."""
+    verdicts = evaluate_all(checks, store)
+    print(table(verdicts), file=out)
+    write_summary(verdicts, Path(reports_dir) / "summary.json")
+    write_junit(verdicts, Path(reports_dir) / "junit.xml")
+    return exit_status(verdicts)
+
+
+def sweep_table(labels, checks, verdicts_by_label):
+    """A sweep's table: one row per check, one column per swept value ('value PASS/FAIL')."""
+    header = ["check", "reference", "tolerance"] + list(labels)
+    rows = []
+    for i, check in enumerate(checks):
+        first = verdicts_by_label[labels[0]][i]
+        rows.append([check.name, fmt_reference(first), first.tolerance] +
+                    [_sweep_cell(verdicts_by_label[label][i]) for label in labels])
+    widths = [max(len(r[j]) for r in [header] + rows) for j in range(len(header))]
+    return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in [header] + rows)
+
+
+def _sweep_cell(v):
+    return f"{fmt_number(v.value)} {'PASS' if v.passed else 'FAIL'}"

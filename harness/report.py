@@ -1,0 +1,359 @@
+"""The report: gnuplot figures, reports/summary.md and a self-contained reports/index.html.
+
+Per case: title, what it checks, its figures (from its [figure] sections), the checks
+table (measured beside reference, tolerance, kind, provenance, PASS/FAIL) and each run's
+wall time and status; the page header has the git revision and the date.  Verdicts come
+from reports/summary.json when it is newer than the runs and the references of a case,
+otherwise they are evaluated here.  Figures are inlined into the HTML (SVG as a base64
+data URI, PNG as fallback), so index.html opens without a server or any other file.
+"""
+import base64
+import html
+import shutil
+import subprocess
+import tempfile
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from pathlib import Path
+
+from . import REPO_ROOT
+from .compare import evaluate_all
+from .gate import fmt_number, fmt_reference, read_summary, tally
+from .tables import RunProblem, read_harness_record, read_run_json
+
+STYLE = Path(__file__).resolve().parent / "gnuplot" / "style.gp"
+SIZE = "960,540"
+
+
+@dataclass
+class FigureOut:
+    name: str
+    title: str
+    svg: Path = None
+    png: Path = None
+    notes: list = field(default_factory=list)
+
+
+@dataclass
+class CaseReport:
+    case: object
+    runs: list
+    figures: list
+    verdicts: list
+    verdict_source: str
+
+
+# ---------------------------------------------------------------- header facts
+
+def git_revision(root=REPO_ROOT):
+    """`git rev-parse --short HEAD`, or 'unknown'."""
+    try:
+        done = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root,
+                              capture_output=True, text=True, timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+    return done.stdout.strip() if done.returncode == 0 and done.stdout.strip() else "unknown"
+
+
+def now_text():
+    return datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+
+
+# ---------------------------------------------------------------- runs
+
+def run_status(folder):
+    """One run's row: variant folder -> {status, wall, steps, dt, n_discs, message}."""
+    folder = Path(folder)
+    record = read_harness_record(folder) or {}
+    try:
+        info = read_run_json(folder)
+    except RunProblem:
+        info = None
+    if info is None:
+        status = "failed" if record else ("no run.json" if folder.is_dir() else "not run")
+        return {"status": status, "wall": record.get("wall_seconds"), "steps": None, "dt": None,
+                "n_discs": None, "message": record.get("cause", "")}
+    status = info.get("status", "?")
+    if record.get("returncode") not in (None, 0):
+        status = f"{status}, exit {record['returncode']}"
+    return {"status": status, "wall": info.get("wall_seconds", record.get("wall_seconds")),
+            "steps": info.get("steps"), "dt": info.get("dt"), "n_discs": info.get("n_discs"),
+            "message": info.get("message", "") or record.get("cause", "")}
+
+
+def run_rows(case, runs_root):
+    return [dict(variant=v.name, **run_status(Path(runs_root) / case.name / v.name)) for v in case.variants]
+
+
+# ---------------------------------------------------------------- figures
+
+def gp_string(text):
+    """A gnuplot single-quoted string."""
+    return "'" + str(text).replace("'", "''") + "'"
+
+
+def curve_title(variant, column, figure):
+    if len(figure.variants) == 1:
+        return column
+    return variant if len(figure.y) == 1 else f"{variant}: {column}"
+
+
+def figure_data(case, figure, store, workdir):
+    """Write one data file per variant (x then the y columns it has); the plot clauses and notes."""
+    clauses, notes = [], []
+    for variant in figure.variants:
+        try:
+            columns = store.get(case.name, variant).columns
+        except RunProblem as problem:
+            notes.append(f"{variant}: no data ({problem})")
+            continue
+        present = [y for y in figure.y if y in columns]
+        missing = [c for c in [figure.x] + figure.y if c not in columns]
+        if missing:
+            notes.append(f"{variant}: column(s) missing from series.tsv: {', '.join(missing)}")
+        if figure.x not in columns or not present:
+            continue
+        path = Path(workdir) / f"{variant}.dat"
+        _write_columns(path, [columns[figure.x]] + [columns[y] for y in present])
+        clauses += [f"{gp_string(path)} using 1:{i + 2} with lines title {gp_string(curve_title(variant, y, figure))}"
+                    for i, y in enumerate(present)]
+    return clauses, notes
+
+
+def _write_columns(path, arrays):
+    with open(path, "w", encoding="utf-8") as f:
+        for row in zip(*arrays):
+            f.write("\t".join(repr(float(x)) for x in row) + "\n")
+
+
+def gnuplot_script(figure, clauses, png, svg):
+    """The script rendering one figure to png then svg."""
+    return "\n".join([
+        f"set terminal pngcairo size {SIZE} noenhanced font 'sans,10'",
+        f"set output {gp_string(png)}",
+        f"load {gp_string(STYLE)}",
+        f"set title {gp_string(figure.title)}",
+        f"set xlabel {gp_string(figure.xlabel)}",
+        f"set ylabel {gp_string(figure.ylabel)}",
+        f"set xrange [{figure.xrange or '*:*'}]",
+        f"set yrange [{figure.yrange or '*:*'}]",
+        "plot " + ", \\\n     ".join(clauses),
+        f"set terminal svg size {SIZE} noenhanced font 'sans,10' background '#ffffff'",
+        f"set output {gp_string(svg)}",
+        "replot",
+        "unset output",
+        ""])
+
+
+def render_figure(case, figure, store, figures_dir):
+    """Render one [figure] into figures_dir/<case>_<figure>.png/.svg; a FigureOut with notes."""
+    out = FigureOut(figure.name, figure.title)
+    png, svg = (Path(figures_dir) / f"{case.name}_{figure.name}.{ext}" for ext in ("png", "svg"))
+    for old in (png, svg):
+        old.unlink(missing_ok=True)
+    if not shutil.which("gnuplot"):
+        out.notes.append("gnuplot not found: figure not rendered")
+        return out
+    with tempfile.TemporaryDirectory(prefix="ballast-fig-") as workdir:
+        clauses, out.notes = figure_data(case, figure, store, workdir)
+        if not clauses:
+            out.notes.append("nothing to plot")
+            return out
+        error = _run_gnuplot(gnuplot_script(figure, clauses, png, svg), workdir)
+    if error:
+        out.notes.append(f"gnuplot failed: {error}")
+    out.png = png if png.is_file() and png.stat().st_size else None
+    out.svg = svg if svg.is_file() and svg.stat().st_size else None
+    return out
+
+
+def _run_gnuplot(script, workdir):
+    """Run gnuplot on script; '' on success, else its complaint."""
+    path = Path(workdir) / "figure.gp"
+    path.write_text(script, encoding="utf-8")
+    try:
+        done = subprocess.run(["gnuplot", str(path)], capture_output=True, text=True, timeout=120)
+    except (OSError, subprocess.SubprocessError) as exc:
+        return str(exc)
+    return "" if done.returncode == 0 else (done.stderr.strip().splitlines() or ["exit %d" % done.returncode])[-1]
+
+
+# ---------------------------------------------------------------- verdicts
+
+def _newest(paths):
+    return max((p.stat().st_mtime for p in paths if p.is_file()), default=0.0)
+
+
+def verdicts_for(case, checks, summary, saved, runs_root, store):
+    """(verdicts, where they came from): summary.json if fresh for this case, else evaluated now."""
+    mine = [c for c in checks if c.case == case.name]
+    old = [v for v in saved if v.case == case.name]
+    inputs = [Path(runs_root) / case.name / v.name / f for v in case.variants for f in ("run.json", "harness.json")]
+    inputs += [Path(c.path) for c in mine]
+    fresh = summary.is_file() and summary.stat().st_mtime >= _newest(inputs)
+    if fresh and [v.check for v in old] == [c.name for c in mine]:
+        return old, "reports/summary.json"
+    return evaluate_all(mine, store), "evaluated by `report` (summary.json absent or older than the runs)"
+
+
+def _saved(summary):
+    try:
+        return read_summary(summary) if summary.is_file() else []
+    except (ValueError, KeyError, TypeError):
+        return []
+
+
+def gather(cases, checks, store, runs_root, reports_dir):
+    """A CaseReport per case: runs, rendered figures, verdicts."""
+    summary = Path(reports_dir) / "summary.json"
+    saved, figures_dir = _saved(summary), Path(reports_dir) / "figures"
+    figures_dir.mkdir(parents=True, exist_ok=True)
+    reports = []
+    for case in cases:
+        verdicts, source = verdicts_for(case, checks, summary, saved, runs_root, store)
+        figures = [render_figure(case, f, store, figures_dir) for f in case.figures]
+        reports.append(CaseReport(case, run_rows(case, runs_root), figures, verdicts, source))
+    return reports
+
+
+# ---------------------------------------------------------------- summary.md
+
+def markdown(reports, revision, date):
+    verdicts = [v for r in reports for v in r.verdicts]
+    passed, failed = tally(verdicts)
+    lines = ["# ballast validation report", "", f"Revision `{revision}`, {date}. **{passed} passed, {failed} failed.**", ""]
+    for r in reports:
+        lines += _markdown_case(r)
+    return "\n".join(lines) + "\n"
+
+
+def _md(text):
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def _markdown_case(r):
+    c = r.case
+    lines = [f"## {c.name}: {c.title}", "", f"*Checks:* {c.checks}  ", f"*Tier:* {c.tier}; *source:* `{c.source}`", "",
+             "| variant | status | wall s | steps | message |", "|---|---|---|---|---|"]
+    lines += [f"| {x['variant']} | {_md(x['status'])} | {fmt_number(x['wall'])} | {fmt_number(x['steps'])} | {_md(x['message'])} |"
+              for x in r.runs]
+    lines.append("")
+    for f in r.figures:
+        image = f"![{_md(f.title)}](figures/{f.png.name})" if f.png else "*(no figure)*"
+        lines += [f"**{_md(f.title)}**", "", image] + [f"- {_md(n)}" for n in f.notes] + [""]
+    lines += [f"Checks ({r.verdict_source}):", "",
+              "| check | variant | value | reference | tolerance | kind | result | provenance | message |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    lines += [f"| {v.check} | {v.variant} | {fmt_number(v.value)} | {fmt_reference(v)} | {v.tolerance} | {v.kind} | "
+              f"{'PASS' if v.passed else '**FAIL**'} | {_md(v.provenance)} | {_md(v.message)} |" for v in r.verdicts]
+    if not r.verdicts:
+        lines.append("| *(no checks for this case)* | | | | | | | | |")
+    return lines + [""]
+
+
+# ---------------------------------------------------------------- index.html
+
+CSS = """
+body{font-family:system-ui,sans-serif;margin:0 auto;max-width:1200px;padding:1em 2em;color:#222}
+h1{margin-bottom:.2em} h2{border-bottom:2px solid #ccc;padding-bottom:.2em;margin-top:2em}
+table{border-collapse:collapse;margin:.5em 0 1em;font-size:.9em}
+th,td{border:1px solid #ccc;padding:.25em .5em;text-align:left;vertical-align:top}
+th{background:#f2f2f2} td.num{text-align:right;font-family:monospace;white-space:nowrap}
+.PASS{background:#d9f2d9;font-weight:bold} .FAIL{background:#f8d0d0;font-weight:bold}
+.bad{color:#a00} figure{margin:1em 0} figure img{max-width:100%;border:1px solid #ddd}
+figcaption{font-size:.9em;color:#444} code{background:#f4f4f4;padding:0 .2em} .meta{color:#555}
+"""
+
+
+def esc(text):
+    return html.escape("" if text is None else str(text))
+
+
+def cell(text, cls=""):
+    return f"<td class=\"{cls}\">{esc(text)}</td>" if cls else f"<td>{esc(text)}</td>"
+
+
+def table_html(headers, rows):
+    head = "".join(f"<th>{esc(h)}</th>" for h in headers)
+    return f"<table><tr>{head}</tr>\n" + "\n".join(f"<tr>{''.join(r)}</tr>" for r in rows) + "</table>"
+
+
+def image_html(figure):
+    """The figure inlined: SVG as a data URI, else PNG, else only its notes."""
+    if figure.svg:
+        src = "data:image/svg+xml;base64," + base64.b64encode(figure.svg.read_bytes()).decode()
+    elif figure.png:
+        src = "data:image/png;base64," + base64.b64encode(figure.png.read_bytes()).decode()
+    else:
+        src = ""
+    img = f"<img alt=\"{esc(figure.title)}\" src=\"{src}\">" if src else "<p class=\"bad\">(no figure)</p>"
+    notes = "".join(f"<br><span class=\"bad\">{esc(n)}</span>" for n in figure.notes)
+    return f"<figure>{img}<figcaption><b>{esc(figure.title)}</b>{notes}</figcaption></figure>"
+
+
+def _runs_html(r):
+    rows = [[cell(x["variant"]), cell(x["status"], "PASS" if x["status"] == "ok" else "FAIL"),
+             cell(fmt_number(x["wall"]), "num"), cell(fmt_number(x["steps"]), "num"), cell(fmt_number(x["dt"]), "num"),
+             cell(fmt_number(x["n_discs"]), "num"), cell(x["message"])] for x in r.runs]
+    return table_html(["variant", "status", "wall s", "steps", "dt", "discs", "message"], rows)
+
+
+def _checks_html(r):
+    rows = [[cell(v.check), cell(v.variant), cell(v.quantity), cell(fmt_number(v.value), "num"),
+             cell(fmt_reference(v), "num"), cell(v.tolerance), cell(v.kind), cell(v.provenance),
+             cell("PASS" if v.passed else "FAIL", "PASS" if v.passed else "FAIL"), cell(v.message)]
+            for v in r.verdicts]
+    if not rows:
+        return "<p>(no checks for this case)</p>"
+    return table_html(["check", "variant", "quantity", "value", "reference", "tolerance", "kind",
+                       "provenance", "result", "message"], rows)
+
+
+def _case_html(r):
+    c = r.case
+    passed, failed = tally(r.verdicts)
+    return "\n".join([
+        f"<section id=\"case-{esc(c.name)}\"><h2>{esc(c.name)}: {esc(c.title)}</h2>",
+        f"<p><b>Checks:</b> {esc(c.checks)}</p>",
+        f"<p class=\"meta\">tier {esc(c.tier)} &middot; {passed} passed, {failed} failed &middot; "
+        f"defined at <code>{esc(c.source)}</code></p>",
+        "<h3>Runs</h3>", _runs_html(r),
+        "<h3>Figures</h3>" if r.figures else "", *[image_html(f) for f in r.figures],
+        f"<h3>Checks</h3><p class=\"meta\">verdicts: {esc(r.verdict_source)}</p>", _checks_html(r),
+        "</section>"])
+
+
+def _index_html(reports):
+    rows = []
+    for r in reports:
+        passed, failed = tally(r.verdicts)
+        runs_ok = sum(x["status"] == "ok" for x in r.runs)
+        state = "PASS" if r.verdicts and not failed else "FAIL"
+        rows.append([f"<td><a href=\"#case-{esc(r.case.name)}\">{esc(r.case.name)}</a></td>", cell(r.case.title),
+                     cell(r.case.tier), cell(f"{runs_ok}/{len(r.runs)}", "num"),
+                     cell(f"{passed} passed, {failed} failed", state)])
+    return table_html(["case", "title", "tier", "runs ok", "checks"], rows)
+
+
+def page(reports, revision, date):
+    passed, failed = tally([v for r in reports for v in r.verdicts])
+    return "\n".join([
+        "<!DOCTYPE html>", "<html lang=\"en\"><head><meta charset=\"utf-8\">",
+        "<title>ballast validation report</title>", f"<style>{CSS}</style></head><body>",
+        "<header><h1>ballast validation report</h1>",
+        f"<p class=\"meta\">git revision <code>{esc(revision)}</code> &middot; {esc(date)} &middot; "
+        f"<span class=\"{'PASS' if passed and not failed else 'FAIL'}\">{passed} passed, {failed} failed</span></p>",
+        "</header>", _index_html(reports), *[_case_html(r) for r in reports], "</body></html>", ""])
+
+
+def write_report(cases, checks, store, runs_root, reports_dir, out=None):
+    """Render figures, write summary.md and index.html; return the index path."""
+    reports_dir = Path(reports_dir)
+    reports = gather(cases, checks, store, runs_root, reports_dir)
+    revision, date = git_revision(), now_text()
+    (reports_dir / "summary.md").write_text(markdown(reports, revision, date), encoding="utf-8")
+    index = reports_dir / "index.html"
+    index.write_text(page(reports, revision, date), encoding="utf-8")
+    if out:
+        print(f"wrote {reports_dir / 'summary.md'} and {index}", file=out)
+    return index

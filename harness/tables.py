@@ -1,0 +1,120 @@
+"""Reading one run's outputs: series.tsv (columns as numpy arrays) and run.json.
+
+load_run() gathers a run folder into a Run, or raises RunProblem with a message that
+says exactly what is missing or wrong; the checks turn that message into a FAIL.
+harness.json is the runner's own record of a run (command, exit code, wall time).
+"""
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+
+class RunProblem(Exception):
+    """A run's outputs cannot be used: missing, failed, or malformed."""
+
+
+@dataclass
+class Run:
+    folder: Path
+    info: dict
+    columns: dict
+
+    @property
+    def names(self):
+        return list(self.columns)
+
+
+def read_series(path):
+    """series.tsv as {column name: float array}, in header order."""
+    path = Path(path)
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except OSError as exc:
+        raise RunProblem(f"series.tsv missing or unreadable: {path} ({exc.strerror})") from None
+    if not lines:
+        raise RunProblem(f"{path}:1: series.tsv is empty (no header)")
+    names = _header(path, lines[0])
+    rows = [_row(path, number, line, len(names))
+            for number, line in enumerate(lines[1:], start=2) if line.strip()]
+    data = np.array(rows, dtype=float).reshape(len(rows), len(names))
+    return {name: data[:, i] for i, name in enumerate(names)}
+
+
+def _header(path, line):
+    names = [n.strip() for n in line.split("\t")]
+    if names[:2] != ["cycle", "time"]:
+        raise RunProblem(f"{path}:1: header must start with 'cycle<TAB>time', got {names[:2]}")
+    if len(set(names)) != len(names) or "" in names:
+        raise RunProblem(f"{path}:1: empty or repeated column name in header")
+    return names
+
+
+def _row(path, number, line, width):
+    fields = line.split("\t")
+    if len(fields) != width:
+        raise RunProblem(f"{path}:{number}: {len(fields)} fields, header has {width}")
+    try:
+        return [float(f) for f in fields]
+    except ValueError:
+        raise RunProblem(f"{path}:{number}: not a number in '{line.strip()}'") from None
+
+
+def read_json(path):
+    """A JSON object from path; RunProblem if missing or malformed."""
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise RunProblem(f"{path.name} missing: {path}") from None
+    except (OSError, ValueError) as exc:
+        raise RunProblem(f"{path.name} unreadable: {path}: {exc}") from None
+    if not isinstance(data, dict):
+        raise RunProblem(f"{path.name} is not a JSON object: {path}")
+    return data
+
+
+def read_run_json(folder):
+    """run.json of a run folder, as a dict (RunProblem if missing or malformed)."""
+    return read_json(Path(folder) / "run.json")
+
+
+def read_harness_record(folder):
+    """The runner's record (harness.json) of a run folder, or None when absent or unreadable."""
+    try:
+        return read_json(Path(folder) / "harness.json")
+    except RunProblem:
+        return None
+
+
+def run_failure(folder, info):
+    """Why a run that wrote run.json still failed, or None when it succeeded."""
+    if info.get("status") != "ok":
+        message = info.get("message") or "no message"
+        return f"run failed: status '{info.get('status')}': {message} ({folder})"
+    record = read_harness_record(folder)
+    if record and record.get("returncode") not in (0, None):
+        return f"run failed: ballast exited with code {record['returncode']} ({folder})"
+    return None
+
+
+def load_run(folder):
+    """A successful run's outputs; RunProblem says what is missing or failed."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise RunProblem(f"run output missing: {folder} does not exist (run the case first)")
+    record = read_harness_record(folder)
+    if record and not record.get("ok", True):
+        raise RunProblem(f"run failed: {record.get('cause') or 'no cause recorded'} ({folder})")
+    info = read_run_json(folder)
+    failure = run_failure(folder, info)
+    if failure:
+        raise RunProblem(failure)
+    return Run(folder, info, read_series(folder / "series.tsv"))
+
+
+def is_finite_number(value):
+    """True for a real number that is neither NaN nor infinite."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)

@@ -1,0 +1,19 @@
+"""Fixtures: a fake project in a tmp dir, with the harness pointed at it by environment variables."""
+import pytest
+
+from harness.tests.fakes import env_for, make_project
+
+
+@pytest.fixture
+def project(tmp_path, monkeypatch):
+    """A fake project (see fakes.py); BALLAST_CASES/REFERENCE/BIN/REPORTS point into it."""
+    root = make_project(tmp_path / "project")
+    for key, value in env_for(root).items():
+        monkeypatch.setenv(key, value)
+    return root
+
+
+@pytest.fixture
+def runs(project):
+    """The runs root of the fake project (reports/runs)."""
+    return project / "reports" / "runs"

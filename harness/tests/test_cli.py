@@ -1,0 +1,99 @@
+"""The command line as a whole: list, sweep, validate, the wrapper script, and malformed series."""
+import os
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from harness.__main__ import main
+from harness.compare import RunStore, evaluate_check, folder_locator
+from harness.references import load
+from harness.tables import RunProblem, read_series
+from harness.tests.fakes import env_for, write_run
+
+WRAPPER = Path(__file__).resolve().parents[1] / "ballast-harness"
+
+
+def test_list(project, capsys):
+    assert main(["list"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].split() == ["CASE", "TIER", "VARIANTS", "RUNTIME", "CHECKS"]
+    assert lines[2].split()[:6] == ["spring", "quick", "soft", "stiff", "stiffer", "3"]
+    assert lines[2].endswith("F = k x at every cycle; trend in k")
+    assert lines[0].index("TIER") == lines[1].index("full") == lines[2].index("quick")   # aligned
+    assert main(["list", "--tier", "quick"]) == 0
+    assert "slow" not in capsys.readouterr().out
+
+
+def test_wrapper_script_runs_the_harness(project):
+    assert os.access(WRAPPER, os.X_OK)
+    done = subprocess.run([str(WRAPPER), "list"], capture_output=True, text=True,
+                          env={**os.environ, **env_for(project)}, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert "spring" in done.stdout and "slow" in done.stdout
+
+
+def test_validate_runs_checks_and_reports(project, capsys):
+    assert main(["validate", "-j", "3"]) == 0
+    out = capsys.readouterr().out
+    assert "3 runs: 3 ok" in out and "6 passed, 0 failed" in out
+    assert (project / "reports" / "index.html").exists() and (project / "reports" / "junit.xml").exists()
+
+
+def test_validate_with_failed_runs_still_checks_and_reports(project, capsys):
+    case = project / "cases" / "springs" / "case.txt"
+    case.write_text(case.read_text().replace("set = k=3", "set = k=3\nset = fail=4"))
+    assert main(["validate"]) == 1
+    out = capsys.readouterr().out
+    assert "FAILED spring/stiffer: exit code 4" in out and "5 passed, 1 failed" in out
+    assert (project / "reports" / "index.html").exists()
+
+
+def test_sweep(project, capsys):
+    assert main(["sweep", "spring", "--set", "k=1,2", "--variant", "soft"]) == 0
+    out = capsys.readouterr().out
+    sweeps = project / "reports" / "sweeps" / "spring"
+    assert (sweeps / "k=1" / "series.tsv").exists() and (sweeps / "k=2" / "series.tsv").exists()
+    table = out[out.index("check"):].splitlines()
+    assert table[0].split() == ["check", "reference", "tolerance", "k=1", "k=2"]
+    rows = {line.split()[0]: line for line in table[1:]}
+    assert set(rows) == {"abs_at2", "interval_ek", "regress_mean"}       # checks of soft alone
+    assert rows["abs_at2"].split()[-4:] == ["2", "PASS", "4", "FAIL"]
+
+
+def test_sweep_needs_a_variant_when_several(project, capsys):
+    assert main(["sweep", "spring", "--set", "k=1,2"]) == 2
+    assert "pick one with --variant" in capsys.readouterr().err
+    assert main(["sweep", "spring", "--set", "k", "--variant", "soft"]) == 2
+
+
+def test_unknown_case_is_a_usage_error(project, capsys):
+    assert main(["run", "nope"]) == 2
+    assert "unknown case(s): nope" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("text, words", [
+    ("", "series.tsv is empty"),
+    ("time\tcycle\tF\n1\t2\t3\n", ":1: header must start with 'cycle<TAB>time'"),
+    ("cycle\ttime\tF\n1\t0.1\t3\n2\t0.2\n", ":3: 2 fields, header has 3"),
+    ("cycle\ttime\tF\n1\t0.1\tabc\n", ":2: not a number"),
+    ("cycle\ttime\tF\tF\n", "repeated column name"),
+])
+def test_malformed_series_is_a_run_problem(tmp_path, text, words):
+    (tmp_path / "series.tsv").write_text(text)
+    with pytest.raises(RunProblem, match=words):
+        read_series(tmp_path / "series.tsv")
+
+
+def test_malformed_series_fails_the_check(project, runs):
+    write_run(runs / "spring" / "soft")
+    (runs / "spring" / "soft" / "series.tsv").write_text("cycle\ttime\tF\n1\t0.1\n")
+    check = next(c for c in load() if c.name == "abs_at2")
+    verdict = evaluate_check(check, RunStore(folder_locator(runs)))
+    assert not verdict.passed and "series.tsv:2: 2 fields" in verdict.message
+
+
+def test_series_with_header_only_has_empty_columns(tmp_path):
+    (tmp_path / "series.tsv").write_text("cycle\ttime\tEk\n")
+    columns = read_series(tmp_path / "series.tsv")
+    assert list(columns) == ["cycle", "time", "Ek"] and columns["Ek"].size == 0

@@ -1,0 +1,138 @@
+"""The runner, with the fake core: parallel runs, fresh folders, failures reported at once,
+progress lines on a tty and off it, results independent of -j."""
+import io
+import json
+import re
+
+from harness import catalogue
+from harness.__main__ import main
+from harness.runner import Job, Progress, Outcome, command, jobs_for, run_all
+from harness.tests.fakes import tree_snapshot
+
+
+def add_sets(project, variant, *sets):
+    """Give a variant of case 'spring' extra `set` lines."""
+    path = project / "cases" / "springs" / "case.txt"
+    lines = "".join(f"set = {s}\n" for s in sets)
+    path.write_text(path.read_text().replace(f"[variant {variant}]\n", f"[variant {variant}]\n{lines}"))
+
+
+def test_jobs_and_command_line(project, runs):
+    spring = catalogue.select(catalogue.load(), ["spring"])
+    jobs = jobs_for(spring, runs)
+    assert [j.label for j in jobs] == ["spring/soft", "spring/stiff", "spring/stiffer"]
+    assert jobs[1].out == runs / "spring" / "stiff" and jobs[1].expected == 1.0
+    assert command(jobs[1], "bin/ballast") == ["bin/ballast", "run", str(jobs[1].scene), "--out",
+                                               str(jobs[1].out), "--set", "k=2"]
+
+
+def test_run_writes_outputs_and_plain_progress_lines(project, runs, capsys):
+    assert main(["run", "spring", "-j", "2"]) == 0
+    out = capsys.readouterr().out
+    lines = out.splitlines()
+    assert "\r" not in out                                   # not a tty: plain lines
+    assert all(re.fullmatch(r"\[\d/3\] spring/\w+  \d+\.\d\d s  ETA \d+ s", l) for l in lines[:3]), lines
+    assert lines[-1].startswith("3 runs: 3 ok, 0 failed")
+    for variant in ("soft", "stiff", "stiffer"):
+        folder = runs / "spring" / variant
+        assert {"series.tsv", "run.json", "harness.json", "ballast.stdout", "ballast.stderr"} <= \
+            {p.name for p in folder.iterdir()}
+        record = json.loads((folder / "harness.json").read_text())
+        assert record["ok"] and record["returncode"] == 0 and record["command"][1] == "run"
+
+
+def test_failed_run_reports_its_cause_and_fails(project, runs, capsys):
+    add_sets(project, "stiff", "fail=3")
+    assert main(["run", "spring", "-j", "1"]) == 1
+    out = capsys.readouterr().out
+    assert "FAILED spring/stiff: exit code 3" in out
+    assert "spring.scene:3: fail: asked to fail" in out           # last stderr lines
+    assert out.index("FAILED spring/stiff") < out.index("spring/stiffer")   # printed at once
+    assert out.splitlines()[-1].startswith("3 runs: 2 ok, 1 failed")
+    record = json.loads((runs / "spring" / "stiff" / "harness.json").read_text())
+    assert not record["ok"] and record["returncode"] == 3
+
+
+def test_exit_zero_with_bad_status_is_a_failure(project, runs, capsys):
+    add_sets(project, "soft", "status=unstable")
+    assert main(["run", "spring"]) == 1
+    assert "FAILED spring/soft: run failed: status 'unstable'" in capsys.readouterr().out
+
+
+def test_missing_binary_fails_every_run(project, runs, capsys, tmp_path):
+    assert main(["run", "spring", "--bin", str(tmp_path / "no-such-ballast")]) == 1
+    out = capsys.readouterr().out
+    assert out.count("FAILED") == 6 and "cannot start" in out        # 3 cause lines + 3 progress lines
+
+
+def test_each_run_starts_from_a_fresh_folder(project, runs, capsys):
+    stale = runs / "spring" / "soft"
+    stale.mkdir(parents=True)
+    (stale / "old-file").write_text("stale")
+    (stale / "run.json").write_text('{"status": "ok"}')
+    add_sets(project, "soft", "fail=1")
+    main(["run", "spring"])
+    assert not (stale / "old-file").exists() and not (stale / "run.json").exists()
+
+
+def test_failed_run_then_check_is_a_fail_not_a_stale_pass(project, runs, capsys):
+    assert main(["run", "spring"]) == 0
+    add_sets(project, "soft", "fail=1")
+    main(["run", "spring"])
+    assert main(["check", "spring"]) == 1
+
+
+def test_results_do_not_depend_on_jobs(project, runs, capsys):
+    add_sets(project, "soft", "sleep=0.3")                  # soft finishes last with -j 3
+    outputs = {}
+    for jobs in ("1", "3"):
+        assert main(["run", "spring", "-j", jobs]) == 0
+        main(["check", "spring"])
+        outputs[jobs] = ((project / "reports" / "summary.json").read_text(),
+                         (project / "reports" / "junit.xml").read_text(),
+                         {v: (runs / "spring" / v / "series.tsv").read_text() for v in ("soft", "stiff", "stiffer")})
+    out = capsys.readouterr().out
+    assert outputs["1"] == outputs["3"]
+    assert "[3/3] spring/soft" in out                        # with -j 3 the slow run finished last
+
+
+def test_run_and_validate_never_write_reference(project, capsys):
+    before = tree_snapshot(project / "reference")
+    main(["run", "--tier", "full"])
+    main(["validate", "spring"])
+    assert tree_snapshot(project / "reference") == before
+
+
+def test_tty_progress_redraws_in_place(tmp_path):
+    jobs = [Job("c", v, tmp_path / "s", [], tmp_path / v, 1.0) for v in ("a", "b")]
+    stream = io.StringIO()
+    progress = Progress(jobs, stream, tty=True)
+    progress.finished(Outcome(jobs[0], True, 0, 0.5))
+    progress.finished(Outcome(jobs[1], False, 2, 0.7, "exit code 2"))
+    progress.close([])
+    text = stream.getvalue()
+    assert text.startswith("\r\x1b[K[1/2] c/a  0.50 s  ETA")
+    assert "\r\x1b[KFAILED c/b: exit code 2\n" in text
+    assert "[2/2] c/b  0.70 s  ETA 0 s  FAILED" in text
+
+
+def test_eta_scales_expected_runtimes(tmp_path):
+    jobs = [Job("c", v, tmp_path, [], tmp_path, e) for v, e in (("a", 1.0), ("b", 3.0))]
+    progress = Progress(jobs, io.StringIO(), tty=False)
+    progress.start -= 2.0                         # pretend 2 s have passed
+    progress.done, progress.expected_done = 1, 1.0
+    assert 5.9 < progress.eta() < 6.5             # 2 s per expected second, 3 expected seconds left
+
+
+def test_run_all_keeps_job_order(project, runs):
+    spring = catalogue.select(catalogue.load(), ["spring"])
+    outcomes = run_all(jobs_for(spring, runs), project / "bin" / "ballast", 3, io.StringIO())
+    assert [o.job.variant for o in outcomes] == ["soft", "stiff", "stiffer"] and all(o.ok for o in outcomes)
+
+
+def test_unwritable_output_folder_is_a_failed_run(project, tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    job = Job("c", "v", project / "cases" / "springs" / "spring.scene", [], blocker / "out")
+    outcome = run_all([job], project / "bin" / "ballast", 1, io.StringIO())[0]
+    assert not outcome.ok and "cannot prepare" in outcome.cause

@@ -1,0 +1,205 @@
+/*
+ * bench.c — the dense-packing benchmark behind `make bench`.
+ *
+ * For each N it loads the benchmark scene through the ordinary scene
+ * machinery (setting fill.pack.n and fill.pack.columns), runs every stage
+ * but the last untimed (the packing falls and settles under gravity), then
+ * times the last stage's physics: a calibration run picks a step count that
+ * takes about TARGET_SECONDS, and that many steps are timed REPEATS times.
+ * It prints one line per N with the median, min and max of the repeats:
+ *
+ *   bench dense N=20000 steps=S particle_steps_per_s=MEDIAN min=MIN max=MAX contacts_per_disc=Z
+ *
+ * and appends the same figures to reports/bench/<host>/dense.csv.  This is a
+ * benchmark, not a test: nothing here asserts a speed.
+ *
+ * usage: bench SCENE [N ...]      (default N: 5000 20000 80000)
+ *        bench --grid SCENE       (all pairs against the cell grid, small N:
+ *                                  where BAL_GRID_CROSSOVER comes from)
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "ballast.h"
+#include "sim.h"
+
+#define REPEATS 5
+#define TARGET_SECONDS 2.0
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double timed_steps(struct bal_sim *sim, long steps, struct bal_error *err)
+{
+    const double t0 = now();
+    for (long k = 0; k < steps; k++)
+        if (bal_sim_cycle(sim, 0, err))
+            return -1;
+    return now() - t0;
+}
+
+/* Extra override ("settings.grid=on"), or NULL, and the seconds per repeat. */
+struct options {
+    const char *extra;
+    const char *extra2;
+    double seconds;
+    int quiet;
+    double median;
+};
+
+static int run_one(const char *path, long n, FILE *csv, struct options *o)
+{
+    struct bal_scene sc;
+    struct bal_error err = {0};
+    struct bal_sim *sim = NULL;
+    char set[128];
+    const long columns = lround(sqrt(2.0 * (double)n));
+    bal_scene_default(&sc);
+    int ok = bal_scene_load(&sc, path, &err) == BAL_OK;
+    snprintf(set, sizeof set, "fill.pack.n=%ld", n);
+    ok = ok && bal_scene_set(&sc, set, &err) == BAL_OK;
+    snprintf(set, sizeof set, "fill.pack.columns=%ld", columns);
+    ok = ok && bal_scene_set(&sc, set, &err) == BAL_OK;
+    if (o->extra)
+        ok = ok && bal_scene_set(&sc, o->extra, &err) == BAL_OK;
+    if (o->extra2)
+        ok = ok && bal_scene_set(&sc, o->extra2, &err) == BAL_OK;
+    ok = ok && bal_sim_create(&sim, &sc, &err) == BAL_OK;
+    if (!ok) {
+        fprintf(stderr, "bench: %s\n", err.msg);
+        bal_scene_free(&sc);
+        return 1;
+    }
+
+    /* Settle: every stage but the last, untimed. */
+    for (int g = 0; g + 1 < sc.n_stages; g++) {
+        bal_sim_set_stage(sim, g);
+        for (long c = 0; c < sc.stages[g].cycles; c++)
+            if (bal_sim_cycle(sim, 0, &err)) {
+                fprintf(stderr, "bench: settling: %s\n", err.msg);
+                bal_sim_free(sim);
+                bal_scene_free(&sc);
+                return 1;
+            }
+    }
+    bal_sim_set_stage(sim, sc.n_stages - 1);
+
+    /* Calibrate the step count, then time the repeats. */
+    long steps = 50;
+    double t = timed_steps(sim, steps, &err);
+    if (t > 0)
+        steps = (long)fmax(100, o->seconds / (t / (double)steps));
+    double rate[REPEATS];
+    for (int k = 0; k < REPEATS; k++) {
+        t = timed_steps(sim, steps, &err);
+        if (t < 0) {
+            fprintf(stderr, "bench: %s\n", err.msg);
+            bal_sim_free(sim);
+            bal_scene_free(&sc);
+            return 1;
+        }
+        rate[k] = (double)steps * (double)sim->n / t;
+    }
+    qsort(rate, REPEATS, sizeof rate[0], cmp_double);
+
+    long touching = 0;
+    for (long c = 0; c < sim->pp.n; c++)
+        touching += 2 * ((sim->pp.flags[c] & BAL_PAIR_TOUCHING) != 0);
+    for (long c = 0; c < sim->pw.n; c++)
+        touching += (sim->pw.flags[c] & BAL_PAIR_TOUCHING) != 0;
+    const double z = (double)touching / (double)sim->n;
+    o->median = rate[REPEATS / 2];
+    if (!o->quiet)
+        printf("bench dense N=%d steps=%ld particle_steps_per_s=%.4g min=%.4g max=%.4g "
+           "contacts_per_disc=%.3f\n",
+           sim->n, steps, rate[REPEATS / 2], rate[0], rate[REPEATS - 1], z);
+    fflush(stdout);
+    if (csv)
+        fprintf(csv, "%ld,%d,%ld,%.6g,%.6g,%.6g,%.4f,%ld\n", (long)time(NULL), sim->n, steps,
+                rate[REPEATS / 2], rate[0], rate[REPEATS - 1], z, sim->rebuilds);
+    bal_sim_free(sim);
+    bal_scene_free(&sc);
+    return 0;
+}
+
+static FILE *open_csv(void)
+{
+    char host[128] = "unknown", dir[256], path[320];
+    gethostname(host, sizeof host - 1);
+    mkdir("reports", 0777);
+    mkdir("reports/bench", 0777);
+    snprintf(dir, sizeof dir, "reports/bench/%s", host);
+    mkdir(dir, 0777);
+    snprintf(path, sizeof path, "%s/dense.csv", dir);
+    struct stat st;
+    const int fresh = stat(path, &st) != 0;
+    FILE *f = fopen(path, "a");
+    if (f && fresh)
+        fputs("unix_time,n,steps,median,min,max,contacts_per_disc,rebuilds\n", f);
+    return f;
+}
+
+/* Where does the cell grid start to pay?  Time the same settled packing
+ * with grid = off (all pairs) and grid = on for small N. */
+static int grid_crossover(const char *path)
+{
+    static const long sizes[] = {4, 8, 16, 24, 32, 48, 64, 96, 128, 192, 256};
+    /* settled: time the packing at rest; falling: time the first cycles of
+     * the fall (settle stage cut to one cycle), when rebuilds are frequent. */
+    static const char *const phase[] = {NULL, "stage.settle.cycles=1"};
+    static const char *const phase_name[] = {"settled", "falling"};
+    for (int p = 0; p < 2; p++) {
+        printf("grid cross-over, %s packing (particle-steps/s, median of %d)\n", phase_name[p],
+               REPEATS);
+        printf("%6s %12s %12s %8s\n", "N", "all_pairs", "grid", "grid/all");
+        for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+            struct options off = {"settings.grid=off", phase[p], 0.2, 1, 0};
+            struct options on = {"settings.grid=on", phase[p], 0.2, 1, 0};
+            if (run_one(path, sizes[k], NULL, &off) || run_one(path, sizes[k], NULL, &on))
+                return 1;
+            printf("%6ld %12.4g %12.4g %8.3f\n", sizes[k], off.median, on.median,
+                   on.median / off.median);
+            fflush(stdout);
+        }
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fputs("usage: bench SCENE [N ...]\n       bench --grid SCENE\n", stderr);
+        return 2;
+    }
+    if (strcmp(argv[1], "--grid") == 0 && argc == 3)
+        return grid_crossover(argv[2]);
+    long sizes[16] = {5000, 20000, 80000};
+    int n_sizes = 3;
+    if (argc > 2) {
+        n_sizes = 0;
+        for (int k = 2; k < argc && n_sizes < 16; k++)
+            sizes[n_sizes++] = atol(argv[k]);
+    }
+    FILE *csv = open_csv();
+    int rc = 0;
+    for (int k = 0; k < n_sizes && rc == 0; k++)
+        rc = run_one(argv[1], sizes[k], csv, &(struct options){NULL, NULL, TARGET_SECONDS, 0, 0});
+    if (csv)
+        fclose(csv);
+    return rc;
+}

@@ -40,7 +40,7 @@ enum bal_status {
     BAL_EINVAL,        /* invalid input: scene syntax, value out of range */
     BAL_ENOMEM,        /* allocation failed */
     BAL_EIO,           /* a file could not be read or written */
-    BAL_EUNSTABLE,     /* the run blew up: NaN or an overlap beyond budget */
+    BAL_EUNSTABLE,     /* the run blew up: a position or velocity is not finite */
     BAL_EINTR          /* interrupted by a signal */
 };
 

@@ -671,6 +671,9 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
         struct bal_disc_def *d = &s->discs[i];
         if (check_material_ref(s, d, BAL_SEC_DISC, "material", d->material, 1, err))
             return err->code;
+        if (d->fixed && (d->v[0] != 0 || d->v[1] != 0 || d->omega != 0))
+            return FAIL_AT(d, BAL_SEC_DISC, "fixed", "%s",
+                           "a held disc cannot have a velocity (v and omega must be 0)");
     }
     for (int i = 0; i < s->n_walls; i++) {
         struct bal_wall_def *w = &s->walls[i];

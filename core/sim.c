@@ -525,6 +525,9 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
                 bal_output_series_row(s, series);
         }
     }
+    /* The periodic check may have missed the last cycles. */
+    if (status == BAL_OK)
+        status = check_finite(s, err);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     s->wall_seconds += (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
     return status;

@@ -1,0 +1,391 @@
+/*
+ * check_grid.c — suite "grid": the neighbour search (grid.c) and the
+ * contact history that the candidate lists carry across rebuilds
+ * (contacts.c, bal_pairs_merge_history).
+ *
+ * With the cell grid, disc–disc candidates are the pairs whose gap is below
+ * the Verlet skin at the last rebuild, disc–wall candidates likewise; the
+ * lists are rebuilt when a disc (or wall) may have closed the skin
+ * (2 max|Δx| ≥ skin, or max|Δx| + wall displacement ≥ skin).  Without the
+ * grid every pair is a candidate.  History (F_n, F_s, flags) follows a
+ * contact through rebuilds, so results must not depend on the mode.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check_main.h"
+
+/* The force law with identical inputs gives bitwise identical outputs; only
+ * the order in which a disc's contact forces are summed differs between
+ * modes (cell order vs scene order).  Each such sum rounds differently by
+ * ~1e-16 relative; 1e-12 relative bounds that after a few hundred cycles. */
+#define ROUNDOFF_REL 1e-12
+
+static int cmp_u64(const void *a, const void *b)
+{
+    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static struct bal_run_info info_of(const struct tfx *f)
+{
+    struct bal_run_info info;
+    bal_sim_info(f->sim, &info);
+    return info;
+}
+
+static const char *const fill_fmt =
+    "[settings]\ngrid = %s\n"
+    "[material g]\nkn = 1e5\ndensity = 1\n"
+    "[fill pack]\nn = %d\ncolumns = 8\nrmin = 0.8\nrmax = 1.0\nmaterial = g\n"
+    "[stage s]\ncycles = 1\n";
+
+/* auto: all pairs below BAL_GRID_CROSSOVER discs, the grid from there on;
+ * on and off force the mode. */
+START_TEST(grid_mode_selection)
+{
+    const int n_lo = BAL_GRID_CROSSOVER - 1, n_hi = BAL_GRID_CROSSOVER;
+    struct tfx *f = tfx_newf("auto", fill_fmt, "auto", n_lo);
+    struct bal_run_info info = info_of(f);
+    ck_assert_int_eq(info.grid_used, 0);
+    ck_assert_int_eq(info.n_candidates, (long)n_lo * (n_lo - 1) / 2);
+    tfx_release(f);
+    f = tfx_newf("auto", fill_fmt, "auto", n_hi);
+    ck_assert_int_eq(info_of(f).grid_used, 1);
+    tfx_release(f);
+    f = tfx_newf("on", fill_fmt, "on", 3);
+    ck_assert_int_eq(info_of(f).grid_used, 1);
+    tfx_release(f);
+    f = tfx_newf("off", fill_fmt, "off", n_hi + 20);
+    info = info_of(f);
+    ck_assert_int_eq(info.grid_used, 0);
+    ck_assert_int_eq(info.n_candidates, (long)(n_hi + 20) * (n_hi + 19) / 2);
+}
+END_TEST
+
+/* The candidates the grid finds, compared with brute force over all pairs:
+ * gap < skin for discs, closest distance < r + skin for walls; the list is
+ * sorted by key with i < j.  Returns 1 when they agree. */
+static int candidates_are_exact(const struct bal_sim *s, double skin, long *n_pairs, long *n_walls)
+{
+    long n_exp = 0;
+    uint64_t *expect = malloc((size_t)s->n * (size_t)s->n * sizeof *expect);
+    if (!expect)
+        return 0;
+    for (int i = 0; i < s->n; i++) {
+        for (int j = i + 1; j < s->n; j++) {
+            const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
+            const double reach = s->r[i] + s->r[j] + skin;
+            if (dx * dx + dy * dy < reach * reach)
+                expect[n_exp++] = ((uint64_t)(uint32_t)i << 32) | (uint32_t)j;
+        }
+    }
+    qsort(expect, (size_t)n_exp, sizeof *expect, cmp_u64);
+    int ok = s->pp.n == n_exp;
+    for (long c = 0; ok && c < n_exp; c++)
+        ok = s->pp.key[c] == expect[c] && s->pp.i[c] < s->pp.j[c];
+    free(expect);
+    long nw = 0;
+    for (int i = 0; i < s->n; i++) {
+        for (int k = 0; k < s->n_walls; k++) {
+            double cx, cy;
+            const double d2 = bal_walls_closest(&s->walls[k], s->x[i], s->y[i], &cx, &cy);
+            const double reach = s->r[i] + skin;
+            if (d2 < reach * reach) {
+                const uint64_t key = ((uint64_t)(uint32_t)i << 32) | (uint32_t)k;
+                ok &= nw < s->pw.n && s->pw.key[nw] == key;
+                nw++;
+            }
+        }
+    }
+    ok &= s->pw.n == nw;
+    *n_pairs = n_exp;
+    *n_walls = nw;
+    return ok;
+}
+
+/* At creation (discs on the fill's lattice) and again after 300 cycles of
+ * random motion under gravity (discs anywhere, rebuilt on the spot). */
+START_TEST(grid_candidates_match_brute_force)
+{
+    const double skin = 0.35;
+    struct tfx *f = tfx_new("[settings]\ngrid = on\nskin = 0.35\ngravity = 0 -9.81\n"
+                            "[material g]\nkn = 1e5\nfriction = 0.4\ndensity = 1\n"
+                            "[fill pack]\nn = 70\ncolumns = 9\nrmin = 0.3\nrmax = 0.5\n"
+                            "vmax = 6\nseed = 11\nbox = 1\nheadroom = 0.2\nmaterial = g\n"
+                            "wall_material = g\n"
+                            "[stage s]\ncycles = 1\n",
+                            "pack");
+    long np = 0, nw = 0;
+    ck_assert_msg(candidates_are_exact(f->sim, skin, &np, &nw), "at creation");
+    ck_assert_int_gt(np, 70); /* the skin makes lattice neighbours candidates */
+    ck_assert_int_gt(nw, 20);
+    ck_assert_int_eq(f->sim->n_walls, 4);
+    t_steps(f, 300);
+    ck_assert_int_eq(bal_grid_rebuild(f->sim, &f->err), BAL_OK);
+    ck_assert_msg(candidates_are_exact(f->sim, skin, &np, &nw), "after 300 cycles");
+    ck_assert_int_gt(np, 70);
+}
+END_TEST
+
+/* A sparse scene (discs up to 900 apart) makes the grid widen its cells
+ * to keep their number near 2 per disc; the candidates must still be
+ * exactly the pairs with gap < skin. */
+START_TEST(grid_candidates_sparse_scene)
+{
+    struct tfx *f = tfx_new("[settings]\ngrid = on\nskin = 0.25\n"
+                            "[material g]\nkn = 1e5\ndensity = 1\n"
+                            "[disc a]\nx = 0 0\nr = 0.5\nmaterial = g\n"
+                            "[disc b]\nx = 1.1 0.3\nr = 0.45\nmaterial = g\n"
+                            "[disc c]\nx = 900 -3\nr = 0.5\nmaterial = g\n"
+                            "[disc d]\nx = 900.9 -2.6\nr = 0.35\nmaterial = g\n"
+                            "[disc e]\nx = -40 870\nr = 0.5\nmaterial = g\n"
+                            "[disc f]\nx = -40.2 871.05\nr = 0.4\nmaterial = g\n"
+                            "[disc g]\nx = 450 450\nr = 0.5\nmaterial = g\n"
+                            "[disc h]\nx = 451.5 450\nr = 0.5\nmaterial = g\n"
+                            "[stage s]\ncycles = 1\n",
+                            "sparse");
+    const struct bal_sim *s = f->sim;
+    /* a–b (gap 0.19), c–d (gap 0.13), e–f (gap 0.17) are within the skin;
+     * g–h (gap 0.5) is not. */
+    long n_exp = 0;
+    int all_found = 1;
+    for (int i = 0; i < s->n; i++) {
+        for (int j = i + 1; j < s->n; j++) {
+            const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
+            const double reach = s->r[i] + s->r[j] + 0.25;
+            if (dx * dx + dy * dy < reach * reach) {
+                const struct bal_pairs *L;
+                n_exp++;
+                all_found &= bal_sim_find_contact(s, 0, i, 0, j, &L) >= 0;
+            }
+        }
+    }
+    ck_assert_int_eq(info_of(f).grid_used, 1);
+    ck_assert_int_eq(n_exp, 3);
+    ck_assert(all_found);
+    ck_assert_int_eq(s->pp.n, 3);
+}
+END_TEST
+
+/* When the lists are rebuilt.  skin = 0.2; `mover` runs at 0.7 with
+ * Δt = 1e-3: 2 · 0.7 · N Δt ≥ 0.2 first at N = ⌈142.86⌉ = 143, then every
+ * 143 cycles: 300 cycles → rebuilds at 143 and 286, plus the one at
+ * creation: 3.  A wall moving at 0.3 with the discs at rest: 0.3 N Δt ≥ 0.2
+ * at N = ⌈666.7⌉ = 667: 700 cycles → 1 + 1 = 2. */
+START_TEST(grid_rebuild_when_skin_used_up)
+{
+    struct tfx *f = tfx_new("[settings]\ngrid = on\nskin = 0.2\ndt = 1e-3\n"
+                            "[material g]\nkn = 1e5\ndensity = 1\n"
+                            "[disc mover]\nx = 0 0\nr = 0.5\nv = 0.7 0\nmaterial = g\n"
+                            "[disc a]\nx = 0 5\nr = 0.5\nmaterial = g\n"
+                            "[disc b]\nx = 5 5\nr = 0.5\nmaterial = g\n"
+                            "[stage s]\ncycles = 1\n",
+                            "mover");
+    ck_assert_int_eq(info_of(f).rebuilds, 1);
+    t_steps(f, 142);
+    ck_assert_int_eq(info_of(f).rebuilds, 1);
+    t_steps(f, 1);
+    ck_assert_int_eq(info_of(f).rebuilds, 2);
+    t_steps(f, 300 - 143);
+    ck_assert_int_eq(info_of(f).rebuilds, 3);
+    tfx_release(f);
+
+    f = tfx_new("[settings]\ngrid = on\nskin = 0.2\ndt = 1e-3\n"
+                "[material g]\nkn = 1e5\ndensity = 1\n"
+                "[wall w]\np = 0 -3\nangle = 0\nh1 = -2\nh2 = 2\nmaterial = g\n"
+                "[disc a]\nx = 0 0\nr = 0.5\nmaterial = g\n"
+                "[disc b]\nx = 5 5\nr = 0.5\nmaterial = g\n"
+                "[stage s]\ncycles = 700\nmove = w 0 0.3 0\n",
+                "wall");
+    t_steps(f, 666);
+    ck_assert_int_eq(info_of(f).rebuilds, 1);
+    t_steps(f, 1);
+    ck_assert_int_eq(info_of(f).rebuilds, 2);
+    t_steps(f, 700 - 667);
+    ck_assert_int_eq(info_of(f).rebuilds, 2);
+}
+END_TEST
+
+/* bal_pairs_merge_history on hand-made lists: keys present in the old
+ * list keep their history, new keys start from zero. */
+START_TEST(grid_merge_history)
+{
+    struct bal_pairs old = {0}, fresh = {0};
+    int ok = bal_pairs_reserve(&old, 4) == BAL_OK && bal_pairs_reserve(&fresh, 4) == BAL_OK;
+    const uint64_t ko[3] = {(0ull << 32) | 1, (0ull << 32) | 3, (2ull << 32) | 5};
+    const uint64_t kf[4] = {(0ull << 32) | 1, (1ull << 32) | 2, (2ull << 32) | 5, (3ull << 32) | 4};
+    double fn[4] = {0}, fs[4] = {0}, ds[4] = {0};
+    int flags[4] = {0};
+    if (ok) {
+        old.n = 3;
+        for (int c = 0; c < 3; c++) {
+            old.key[c] = ko[c];
+            old.fn[c] = 1.25 + c;
+            old.fs[c] = -0.375 - c;
+            old.dn[c] = 0.0625 * c;
+            old.ds[c] = 0.5 + c;
+            old.flags[c] = (uint8_t)(c == 2 ? 3 : 1);
+        }
+        fresh.n = 4;
+        for (int c = 0; c < 4; c++) {
+            fresh.key[c] = kf[c];
+            fresh.fn[c] = fresh.fs[c] = fresh.dn[c] = fresh.ds[c] = 99; /* garbage */
+            fresh.flags[c] = 7;
+        }
+        bal_pairs_merge_history(&fresh, &old);
+        for (int c = 0; c < 4; c++) {
+            fn[c] = fresh.fn[c];
+            fs[c] = fresh.fs[c];
+            ds[c] = fresh.ds[c];
+            flags[c] = fresh.flags[c];
+        }
+    }
+    bal_pairs_free(&old);
+    bal_pairs_free(&fresh);
+    ck_assert(ok);
+    ck_assert_double_eq(fn[0], 1.25);
+    ck_assert_double_eq(fs[0], -0.375);
+    ck_assert_double_eq(ds[0], 0.5);
+    ck_assert_int_eq(flags[0], 1);
+    ck_assert_double_eq(fn[1], 0.0);
+    ck_assert_double_eq(fs[1], 0.0);
+    ck_assert_int_eq(flags[1], 0);
+    ck_assert_double_eq(fn[2], 3.25);
+    ck_assert_double_eq(fs[2], -2.375);
+    ck_assert_double_eq(ds[2], 2.5);
+    ck_assert_int_eq(flags[2], 3);
+    ck_assert_double_eq(fn[3], 0.0);
+    ck_assert_int_eq(flags[3], 0);
+}
+END_TEST
+
+/* A sticking frictional contact (p pressed against q, p spinning slowly:
+ * |F_s| ≈ 0.2 F_n < 0.8 F_n; the collision lasts ~0.03, longer than the
+ * 48 cycles of 1e-4 looked at) among a few distant discs, grid on.  A rebuild
+ * — called directly, or forced through need_rebuild — must leave F_n, F_s
+ * and the flags of the contact untouched, and the run must match the same
+ * scene run with grid = off. */
+static const char *const sticking_fmt =
+    "[settings]\ngrid = %s\ndt = 1e-4\n"
+    "[material g]\nkn = 1e4\nks = 0.8e4\nfriction = 0.8\ndensity = 2.385\n"
+    "[disc f1]\nx = 9.5 0.2\nr = 0.5\nmaterial = g\n"
+    "[disc q]\nx = 0.99 0.013\nr = 0.5\nv = -0.05 0\nmaterial = g\n"
+    "[disc f2]\nx = -0.3 8.7\nr = 0.45\nmaterial = g\n"
+    "[disc p]\nx = 0 0\nr = 0.5\nv = 0.05 0\nomega = 0.05\nmaterial = g\n"
+    "[disc f3]\nx = 9.1 9.3\nr = 0.55\nmaterial = g\n"
+    "[stage s]\ncycles = 1\n"
+    "[probe fn]\nquantity = contact_fn\na = p\nb = q\n"
+    "[probe fs]\nquantity = contact_fs\na = p\nb = q\n"
+    "[probe slide]\nquantity = contact_sliding\na = p\nb = q\n";
+
+START_TEST(grid_history_survives_rebuild)
+{
+    struct tfx *on = tfx_newf("on", sticking_fmt, "on");
+    struct tfx *off = tfx_newf("off", sticking_fmt, "off");
+    ck_assert_int_eq(info_of(on).grid_used, 1);
+    ck_assert_int_eq(info_of(off).grid_used, 0);
+    t_steps(on, 8);
+    t_steps(off, 8);
+    const double fn = t_probe_value(on, "fn"), fs = t_probe_value(on, "fs");
+    ck_assert(fn > 0);
+    ck_assert(fs != 0);
+    ck_assert_double_eq(t_probe_value(on, "slide"), 0.0);
+
+    const long before = info_of(on).rebuilds;
+    ck_assert_int_eq(bal_grid_rebuild(on->sim, &on->err), BAL_OK);
+    ck_assert_int_eq(info_of(on).rebuilds, before + 1);
+    ck_assert_double_eq(t_probe_value(on, "fn"), fn);
+    ck_assert_double_eq(t_probe_value(on, "fs"), fs);
+    const struct bal_pairs *L;
+    const long c = t_contact(on, "p", "q", &L);
+    ck_assert_int_eq(L->flags[c], BAL_PAIR_TOUCHING);
+
+    /* Keep going, forcing a rebuild every 5 cycles in the grid run. */
+    for (int k = 0; k < 8; k++) {
+        on->sim->need_rebuild = 1;
+        t_steps(on, 5);
+        t_steps(off, 5);
+        const double fn_off = t_probe_value(off, "fn"), fs_off = t_probe_value(off, "fs");
+        ck_assert_double_eq_tol(t_probe_value(on, "fn"), fn_off, ROUNDOFF_REL * fabs(fn_off));
+        ck_assert_double_eq_tol(t_probe_value(on, "fs"), fs_off, ROUNDOFF_REL * fabs(fs_off));
+    }
+    ck_assert_int_ge(info_of(on).rebuilds, before + 9);
+    ck_assert_double_eq(t_probe_value(on, "slide"), 0.0);
+    ck_assert(t_probe_value(on, "fs") != 0);
+}
+END_TEST
+
+/* A small random packing falling under gravity in a box (a [fill]),
+ * grid = on against grid = off: the same contacts and, disc by disc in
+ * scene order, the same positions and velocities to round-off after 400
+ * cycles (the difference can only come from the order of force sums). */
+static const char *const packing_fmt =
+    "[settings]\ngrid = %s\ngravity = 0 -9.81\n"
+    "[material g]\nkn = 1e5\nks = 0.8e5\nfriction = 0.5\ndensity = 1\n"
+    "[material w]\nkn = 1e5\nfriction = 0.3\n"
+    "[fill pack]\nn = 60\ncolumns = 8\nrmin = 0.9\nrmax = 1.0\nvmax = 4.0\nseed = 7\nbox = 1\n"
+    "material = g\nwall_material = w\n"
+    "[stage s]\ncycles = 400\n";
+
+/* Positions are O(10), velocities O(1): 1e-9 absolute is ~1e-10 relative,
+ * far above the ~1e-15 round-off a different summation order leaves after
+ * a few hundred cycles, far below a missed or doubled contact (a force of
+ * ~1 for one cycle moves a disc by F Δt²/m ~ 1e-7). */
+#define AGREE_ABS 1e-9
+
+START_TEST(grid_on_off_agree_on_packing)
+{
+    struct tfx *on = tfx_newf("on", packing_fmt, "on");
+    struct tfx *off = tfx_newf("off", packing_fmt, "off");
+    ck_assert_int_eq(bal_sim_run(on->sim, NULL, NULL, &on->err), BAL_OK);
+    ck_assert_int_eq(bal_sim_run(off->sim, NULL, NULL, &off->err), BAL_OK);
+    const struct bal_sim *a = on->sim, *b = off->sim;
+    ck_assert_int_eq(a->n, b->n);
+    double worst = 0;
+    for (int id = 0; id < a->n; id++) {
+        const int i = a->slot[id], j = b->slot[id];
+        worst = fmax(worst, fabs(a->x[i] - b->x[j]));
+        worst = fmax(worst, fabs(a->y[i] - b->y[j]));
+        worst = fmax(worst, fabs(a->vx[i] - b->vx[j]));
+        worst = fmax(worst, fabs(a->vy[i] - b->vy[j]));
+        worst = fmax(worst, fabs(a->w[i] - b->w[j]));
+    }
+    long ca = 0, cb = 0;
+    for (long c = 0; c < a->pp.n; c++)
+        ca += (a->pp.flags[c] & BAL_PAIR_TOUCHING) != 0;
+    for (long c = 0; c < b->pp.n; c++)
+        cb += (b->pp.flags[c] & BAL_PAIR_TOUCHING) != 0;
+    ck_assert_int_eq(ca, cb);
+    ck_assert_int_gt(ca, 5); /* the packing has disc–disc contacts */
+    for (long c = 0; c < a->pw.n; c++)
+        ca += (a->pw.flags[c] & BAL_PAIR_TOUCHING) != 0;
+    for (long c = 0; c < b->pw.n; c++)
+        cb += (b->pw.flags[c] & BAL_PAIR_TOUCHING) != 0;
+    ck_assert_int_eq(ca, cb);
+    ck_assert_int_gt(info_of(on).rebuilds, 3); /* the grid was rebuilt */
+    ck_assert_msg(worst < AGREE_ABS, "grid on/off differ by %g", worst);
+}
+END_TEST
+
+Suite *suite_grid(void)
+{
+    Suite *s = suite_create("grid");
+    TCase *tc = tcase_create("candidates");
+    tcase_add_checked_fixture(tc, NULL, tfx_teardown);
+    tcase_add_test(tc, grid_mode_selection);
+    tcase_add_test(tc, grid_candidates_match_brute_force);
+    tcase_add_test(tc, grid_candidates_sparse_scene);
+    tcase_add_test(tc, grid_rebuild_when_skin_used_up);
+    suite_add_tcase(s, tc);
+
+    tc = tcase_create("history");
+    tcase_add_checked_fixture(tc, NULL, tfx_teardown);
+    tcase_add_test(tc, grid_merge_history);
+    tcase_add_test(tc, grid_history_survives_rebuild);
+    tcase_add_test(tc, grid_on_off_agree_on_packing);
+    suite_add_tcase(s, tc);
+    return s;
+}

@@ -173,7 +173,7 @@ enum bal_probe_kind {
     BAL_PROBE_DISC_X, BAL_PROBE_DISC_Y, BAL_PROBE_DISC_VX, BAL_PROBE_DISC_VY,
     BAL_PROBE_DISC_THETA, BAL_PROBE_DISC_OMEGA,
     BAL_PROBE_ENERGY_KINETIC, BAL_PROBE_ENERGY_ELASTIC,
-    BAL_PROBE_UNBALANCED, BAL_PROBE_N_CONTACTS,
+    BAL_PROBE_UNBALANCED, BAL_PROBE_N_CONTACTS, BAL_PROBE_N_SLIDING,
     BAL_PROBE_COUNT
 };
 
@@ -284,7 +284,7 @@ void bal_output_series_header(const struct bal_sim *sim, FILE *f);
 void bal_output_series_row(const struct bal_sim *sim, FILE *f);
 /* Name of disc `id` (scene order): its [disc] name, or FILL.k. */
 void bal_output_disc_name(const struct bal_sim *sim, int id, char *buf, size_t size);
-/* Write contacts.tsv and discs.tsv of the final state into dir. */
+/* Write contacts.tsv, discs.tsv and walls.tsv of the final state into dir. */
 enum bal_status bal_output_state(const struct bal_sim *sim, const char *dir,
                                  struct bal_error *err);
 

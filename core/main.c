@@ -10,8 +10,8 @@
  * Exit codes: 0 success; 1 the run failed (unstable); 2 bad input or usage;
  * 3 input/output error; 4 out of memory; 130 interrupted.
  * A scene that fails to load or validate writes nothing.  A run that
- * starts writes run.json saying how it ended; series.tsv, discs.tsv and
- * contacts.tsv appear only when the run completed.
+ * starts writes run.json saying how it ended; series.tsv, discs.tsv,
+ * contacts.tsv and walls.tsv appear only when the run completed.
  */
 #include <errno.h>
 #include <signal.h>
@@ -166,7 +166,7 @@ static int cmd_run(const struct args *a)
         return 3;
     }
     /* Remove results of an earlier run so nothing stale is read as new. */
-    const char *names[] = {"series.tsv", "discs.tsv", "contacts.tsv", "run.json"};
+    const char *names[] = {"series.tsv", "discs.tsv", "contacts.tsv", "walls.tsv", "run.json"};
     for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
         char p[1200];
         snprintf(p, sizeof p, "%s/%s", a->out, names[k]);

@@ -99,13 +99,14 @@ double bal_measure_unbalanced(const struct bal_sim *s)
     return smax / fbig;
 }
 
-static long count_contacts(const struct bal_sim *s)
+/* Contacts whose flags include `flag` (touching, or sliding). */
+static long count_contacts(const struct bal_sim *s, uint8_t flag)
 {
     long n = 0;
     for (long c = 0; c < s->pp.n; c++)
-        n += (s->pp.flags[c] & BAL_PAIR_TOUCHING) != 0;
+        n += (s->pp.flags[c] & flag) != 0;
     for (long c = 0; c < s->pw.n; c++)
-        n += (s->pw.flags[c] & BAL_PAIR_TOUCHING) != 0;
+        n += (s->pw.flags[c] & flag) != 0;
     return n;
 }
 
@@ -158,7 +159,9 @@ double bal_measure_probe(const struct bal_sim *s, int probe)
     case BAL_PROBE_UNBALANCED:
         return bal_measure_unbalanced(s);
     case BAL_PROBE_N_CONTACTS:
-        return (double)count_contacts(s);
+        return (double)count_contacts(s, BAL_PAIR_TOUCHING);
+    case BAL_PROBE_N_SLIDING:
+        return (double)count_contacts(s, BAL_PAIR_SLIDING);
     }
     return NAN;
 }

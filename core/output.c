@@ -5,6 +5,8 @@
  *                 per [probe], in file order), one row per output interval
  *   discs.tsv     final state of every disc, in scene order
  *   contacts.tsv  every touching contact of the final state
+ *   walls.tsv     every wall of the final state: end points A, B and the
+ *                 resultant the discs exert on it (C&S Table 1)
  *   run.json      version, build, scene, overrides, how the run ended,
  *                 steps, time step and its estimate, timings, energies
  *
@@ -155,6 +157,19 @@ static void write_discs(const struct bal_sim *s, FILE *f)
     }
 }
 
+static void write_walls(const struct bal_sim *s, FILE *f)
+{
+    fputs("name\tax\tay\tbx\tby\tf1\tf2\tmoment\tecc\n", f);
+    for (int k = 0; k < s->n_walls; k++) {
+        const struct bal_wall *W = &s->walls[k];
+        const double mid = 0.5 * (W->h1 + W->h2), half = 0.5 * (W->h2 - W->h1);
+        const double ecc = W->fn_sum != 0 ? (W->fn_s_sum / W->fn_sum - mid) / half : 0;
+        fprintf(f, "%s\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\n", W->name,
+                W->p[0] + W->h1 * W->e[0], W->p[1] + W->h1 * W->e[1], W->p[0] + W->h2 * W->e[0],
+                W->p[1] + W->h2 * W->e[1], W->f[0], W->f[1], W->moment, ecc);
+    }
+}
+
 enum bal_status bal_output_state(const struct bal_sim *s, const char *dir, struct bal_error *err)
 {
     FILE *f = open_tmp(dir, "contacts.tsv", err);
@@ -167,7 +182,13 @@ enum bal_status bal_output_state(const struct bal_sim *s, const char *dir, struc
     if (!f)
         return err->code;
     write_discs(s, f);
-    return close_tmp(f, dir, "discs.tsv", err);
+    if (close_tmp(f, dir, "discs.tsv", err))
+        return err->code;
+    f = open_tmp(dir, "walls.tsv", err);
+    if (!f)
+        return err->code;
+    write_walls(s, f);
+    return close_tmp(f, dir, "walls.tsv", err);
 }
 
 static void json_string(FILE *f, const char *v)

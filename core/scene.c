@@ -261,12 +261,21 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
             return where_error(err, w, key->name,
                                "expected 'WALL v1 v2 omega' with three finite numbers, got '%s'",
                                value);
-        if (st->n_moves >= BAL_MAX_MOVES)
-            return where_error(err, w, key->name, "more than %s moves in one stage", "16");
-        for (int i = 0; i < st->n_moves; i++)
-            if (strcmp(st->moves[i].wall, wall) == 0)
+        /* In a file a wall is moved once per stage; --set (line 0) replaces
+         * the wall's motion, so a variant can change a loading speed. */
+        struct bal_move_def *m = NULL;
+        for (int i = 0; i < st->n_moves; i++) {
+            if (strcmp(st->moves[i].wall, wall) != 0)
+                continue;
+            if (w.line > 0)
                 return where_error(err, w, key->name, "wall '%s' is moved twice in this stage", wall);
-        struct bal_move_def *m = &st->moves[st->n_moves++];
+            m = &st->moves[i];
+        }
+        if (!m) {
+            if (st->n_moves >= BAL_MAX_MOVES)
+                return where_error(err, w, key->name, "more than %s moves in one stage", "16");
+            m = &st->moves[st->n_moves++];
+        }
         strcpy(m->wall, wall);
         m->line = w.line;
         m->v[0] = v[0];

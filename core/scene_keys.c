@@ -114,17 +114,17 @@ const struct bal_key bal_scene_keys[] = {
      "material of the box walls (required with box = 1)"},
 
     /* [stage NAME] */
-    {BAL_SEC_STAGE, "cycles", BAL_KEY_LONG, G(cycles), NULL, 1, 1, 1e15, NULL,
-     "number of calculation cycles in this stage"},
+    {BAL_SEC_STAGE, "cycles", BAL_KEY_LONG, G(cycles), NULL, 1, 0, 1e15, NULL,
+     "number of calculation cycles in this stage (0: the stage is skipped)"},
     {BAL_SEC_STAGE, "move", BAL_KEY_MOVE, G(moves), NULL, 0, -BIG, BIG, NULL,
      "repeatable: WALL v1 v2 omega; velocity of P and angular velocity about P (C&S p. 53); "
-     "walls not named are at rest"},
+     "walls not named are at rest; --set replaces the named wall's motion"},
 
     /* [probe NAME] */
     {BAL_SEC_PROBE, "quantity", BAL_KEY_ENUM, P(kind), NULL, 1, 0, 0,
      "contact_fn contact_fs contact_sliding wall_f1 wall_f2 wall_moment wall_ecc "
      "disc_x disc_y disc_vx disc_vy disc_theta disc_omega "
-     "energy_kinetic energy_elastic unbalanced n_contacts",
+     "energy_kinetic energy_elastic unbalanced n_contacts n_sliding",
      "what the series column holds"},
     {BAL_SEC_PROBE, "a", BAL_KEY_NAME, P(a), "", 0, 0, 0, NULL,
      "body: the disc (disc_*), the wall (wall_*), or the first body of a contact"},

@@ -14,7 +14,8 @@ from .ini import IniError, parse_file, shown
 
 CASE_KEYS = {"tier", "title", "checks", "runtime"}
 VARIANT_KEYS = {"scene", "set"}
-FIGURE_KEYS = {"title", "variants", "x", "y", "xlabel", "ylabel", "xrange", "yrange"}
+FIGURE_KEYS = {"kind", "title", "variants", "x", "y", "xlabel", "ylabel", "xrange", "yrange", "paper"}
+FIGURE_KINDS = ("series", "network")
 NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 RANGE = re.compile(rf"^\s*({NUMBER})?\s*:\s*({NUMBER})?\s*$")
 
@@ -42,6 +43,8 @@ class Figure:
     xrange: str = ""         # gnuplot range 'lo:hi' (either side may be empty); '' = automatic
     yrange: str = ""
     line: int = 0
+    kind: str = "series"     # series: columns against x; network: force network of a final state
+    paper: str = ""          # the paper's words the figure reproduces, shown beside it
 
 
 @dataclass
@@ -136,12 +139,24 @@ def _add_figure(case, section):
     section.check_keys(FIGURE_KEYS)
     if any(f.name == section.name for f in case.figures):
         raise section.error(f"figure '{section.name}' defined twice in case '{case.name}'")
+    kind = section.get("kind", "series")
+    if kind not in FIGURE_KINDS:
+        raise section.error(f"figure kind must be one of {', '.join(FIGURE_KINDS)}, not '{kind}'")
+    paper = " ".join(e.value for e in section.all("paper"))
+    if kind == "network":
+        variants = section.require("variants").split()
+        if len(variants) != 1:
+            raise section.error("a network figure shows exactly one variant")
+        case.figures.append(Figure(
+            name=section.name, title=section.get("title", section.name), variants=variants,
+            x="", y=[], xlabel="", ylabel="", line=section.line, kind=kind, paper=paper))
+        return
     case.figures.append(Figure(
         name=section.name, title=section.get("title", section.name),
         variants=section.get("variants", "").split(), x=section.require("x"),
         y=section.require("y").split(), xlabel=section.get("xlabel", section.require("x")),
         ylabel=section.get("ylabel", ""), xrange=_range(section, "xrange"),
-        yrange=_range(section, "yrange"), line=section.line))
+        yrange=_range(section, "yrange"), line=section.line, kind=kind, paper=paper))
 
 
 def _range(section, key):

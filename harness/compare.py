@@ -2,7 +2,10 @@
 
 A quantity is a Python expression evaluated without builtins in a namespace holding
 every series.tsv column (numpy array) and the functions of the spec (at, first, last,
-after, upto, between, mean, max, min, std, abs, sqrt, amp, run).  evaluate_check()
+after, upto, between, mean, max, min, std, abs, sqrt, amp, run), plus series(variant,
+column) for a column of another variant of the same case, period(arr) for the mean
+number of rows between upward crossings of the mean, and settle(col, target, tol) for
+the cycle from which a column stays within tol of target.  evaluate_check()
 turns one Check into a Verdict; anything that goes wrong (missing output, failed run,
 missing column, an expression that raises, a NaN/inf value) is a FAIL whose message
 says which, never a pass and never a skip.
@@ -87,13 +90,59 @@ def folder_locator(runs_root):
 
 # ---------------------------------------------------------------- expressions
 
-def namespace(run):
-    """Columns by header name, then the expression functions (functions win a clash)."""
+def namespace(run, sibling=None):
+    """Columns by header name, then the expression functions (functions win a clash).
+
+    sibling(variant) gives the Run of another variant of the same case, for series().
+    """
     names = dict(run.columns)
     names.update(REDUCERS)
     names.update(_selectors(run.columns["cycle"]))
+    names.update(_signal_functions(run.columns["cycle"]))
     names["run"] = _run_field(run.info)
+    names["series"] = _series_of(sibling)
     return names
+
+
+def _series_of(sibling):
+    """series(variant, column): a whole column of another variant of the same case."""
+    def series(variant, column):
+        if sibling is None:
+            raise EvalError("series(): no other variants are available here")
+        try:
+            other = sibling(variant)
+        except RunProblem as problem:
+            raise EvalError(f"series(): variant '{variant}': {problem}") from None
+        if column not in other.columns:
+            raise EvalError(f"series(): variant '{variant}' has no column '{column}'")
+        return other.columns[column]
+    return series
+
+
+def _signal_functions(cycle):
+    """period and settle: properties of a signal over the rows of a run."""
+    def period(arr):
+        """Mean number of cycles between upward crossings of the signal's mean."""
+        arr = _nonempty(arr, "period")
+        x = arr - arr.mean()
+        up = np.flatnonzero((x[:-1] < 0) & (x[1:] >= 0))
+        if up.size < 2:
+            raise EvalError("period(): fewer than two upward crossings of the mean")
+        return float(np.mean(np.diff(up)))
+
+    def settle(col, target, tol):
+        """First cycle from which |col - target| <= tol |target| holds to the end."""
+        col = np.asarray(col, dtype=float)
+        if col.shape != cycle.shape:
+            raise EvalError("settle(): first argument must be a whole series column")
+        outside = np.flatnonzero(np.abs(col - target) > tol * abs(target))
+        if outside.size == 0:
+            return float(cycle[0])
+        if outside[-1] == col.size - 1:
+            raise EvalError(f"settle(): still outside {tol:g} of {target:g} at the last row")
+        return float(cycle[outside[-1] + 1])
+
+    return {"period": period, "settle": settle}
 
 
 def _nonempty(arr, fname):
@@ -175,9 +224,9 @@ def _unknown_name(name, is_call, names):
     return f"column '{name}' missing from series.tsv (columns: {columns})"
 
 
-def evaluate(expr, run):
+def evaluate(expr, run, sibling=None):
     """The expression's value in run's outputs, as one finite float."""
-    names = namespace(run)
+    names = namespace(run, sibling)
     code = _compile(expr, names)
     try:
         with np.errstate(all="ignore"):
@@ -206,7 +255,7 @@ def quantity_in(store, case, variant, expr):
     """Evaluate expr in the outputs of case/variant; errors say which variant."""
     run = store.get(case, variant)
     try:
-        return evaluate(expr, run)
+        return evaluate(expr, run, lambda other: store.get(case, other))
     except EvalError as exc:
         raise EvalError(f"{variant}: {exc}") from None
 

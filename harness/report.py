@@ -17,6 +17,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from . import REPO_ROOT
+from . import network
 from .compare import evaluate_all
 from .gate import fmt_number, fmt_reference, read_summary, tally
 from .tables import RunProblem, read_harness_record, read_run_json
@@ -29,6 +30,7 @@ SIZE = "960,540"
 class FigureOut:
     name: str
     title: str
+    paper: str = ""
     svg: Path = None
     png: Path = None
     notes: list = field(default_factory=list)
@@ -147,7 +149,7 @@ def gnuplot_script(figure, clauses, png, svg):
 
 def render_figure(case, figure, store, figures_dir):
     """Render one [figure] into figures_dir/<case>_<figure>.png/.svg; a FigureOut with notes."""
-    out = FigureOut(figure.name, figure.title)
+    out = FigureOut(figure.name, figure.title, figure.paper)
     png, svg = (Path(figures_dir) / f"{case.name}_{figure.name}.{ext}" for ext in ("png", "svg"))
     for old in (png, svg):
         old.unlink(missing_ok=True)
@@ -155,11 +157,19 @@ def render_figure(case, figure, store, figures_dir):
         out.notes.append("gnuplot not found: figure not rendered")
         return out
     with tempfile.TemporaryDirectory(prefix="ballast-fig-") as workdir:
-        clauses, out.notes = figure_data(case, figure, store, workdir)
-        if not clauses:
-            out.notes.append("nothing to plot")
-            return out
-        error = _run_gnuplot(gnuplot_script(figure, clauses, png, svg), workdir)
+        if figure.kind == "network":
+            try:
+                text = network.script(store.locate(case.name, figure.variants[0]), figure.title, png, svg)
+            except (OSError, ValueError, KeyError) as exc:
+                out.notes.append(f"{figure.variants[0]}: no final state to draw ({exc})")
+                return out
+        else:
+            clauses, out.notes = figure_data(case, figure, store, workdir)
+            if not clauses:
+                out.notes.append("nothing to plot")
+                return out
+            text = gnuplot_script(figure, clauses, png, svg)
+        error = _run_gnuplot(text, workdir)
     if error:
         out.notes.append(f"gnuplot failed: {error}")
     out.png = png if png.is_file() and png.stat().st_size else None
@@ -241,6 +251,8 @@ def _markdown_case(r):
     for f in r.figures:
         image = f"![{_md(f.title)}](figures/{f.png.name})" if f.png else "*(no figure)*"
         lines += [f"**{_md(f.title)}**", "", image] + [f"- {_md(n)}" for n in f.notes] + [""]
+        if f.paper:
+            lines += [f"> {_md(f.paper)}", ""]
     lines += [f"Checks ({r.verdict_source}):", "",
               "| check | variant | value | reference | tolerance | kind | result | provenance | message |",
               "|---|---|---|---|---|---|---|---|---|"]
@@ -261,7 +273,7 @@ th,td{border:1px solid #ccc;padding:.25em .5em;text-align:left;vertical-align:to
 th{background:#f2f2f2} td.num{text-align:right;font-family:monospace;white-space:nowrap}
 .PASS{background:#d9f2d9;font-weight:bold} .FAIL{background:#f8d0d0;font-weight:bold}
 .bad{color:#a00} figure{margin:1em 0} figure img{max-width:100%;border:1px solid #ddd}
-figcaption{font-size:.9em;color:#444} code{background:#f4f4f4;padding:0 .2em} .meta{color:#555}
+figcaption{font-size:.9em;color:#444} blockquote{margin:.4em 0 0 1em;padding-left:.8em;border-left:3px solid #bbb;font-style:italic} code{background:#f4f4f4;padding:0 .2em} .meta{color:#555}
 """
 
 
@@ -288,7 +300,8 @@ def image_html(figure):
         src = ""
     img = f"<img alt=\"{esc(figure.title)}\" src=\"{src}\">" if src else "<p class=\"bad\">(no figure)</p>"
     notes = "".join(f"<br><span class=\"bad\">{esc(n)}</span>" for n in figure.notes)
-    return f"<figure>{img}<figcaption><b>{esc(figure.title)}</b>{notes}</figcaption></figure>"
+    paper = f"<blockquote>{esc(figure.paper)}</blockquote>" if figure.paper else ""
+    return f"<figure>{img}<figcaption><b>{esc(figure.title)}</b>{notes}{paper}</figcaption></figure>"
 
 
 def _runs_html(r):

@@ -219,3 +219,51 @@ def test_store_loads_each_run_once(tmp_path, store):
     first = store.get("spring", "soft")
     (tmp_path / "runs" / "spring" / "soft" / "series.tsv").unlink()
     assert store.get("spring", "soft") is first
+
+
+# ---------------------------------------------------------------- series, period, settle
+
+def _fake_run(columns, info=None):
+    from harness.tables import Run
+    cols = {k: np.asarray(v, dtype=float) for k, v in columns.items()}
+    return Run(folder=None, columns=cols, info=info or {"status": "ok"})
+
+
+def test_period_of_a_sampled_sine():
+    cycle = np.arange(1, 401)
+    run = _fake_run({"cycle": cycle, "time": cycle, "F": np.sin(2 * np.pi * cycle / 23.5)})
+    assert abs(evaluate("period(F)", run) - 23.5) < 0.2
+
+
+def test_period_needs_two_crossings():
+    cycle = np.arange(1, 11)
+    run = _fake_run({"cycle": cycle, "time": cycle, "F": cycle * 1.0})
+    with pytest.raises(EvalError, match="crossings"):
+        evaluate("period(F)", run)
+
+
+def test_settle_finds_the_last_excursion():
+    cycle = np.arange(1, 11)
+    f = np.array([0, 5, 12, 9, 10.5, 9.95, 10.02, 10.0, 9.99, 10.0])
+    run = _fake_run({"cycle": cycle, "time": cycle, "F": f})
+    assert evaluate("settle(F, 10, 0.01)", run) == 6.0
+    assert evaluate("settle(F, 10, 0.1)", run) == 4.0
+
+
+def test_settle_that_never_happens_is_an_error():
+    cycle = np.arange(1, 6)
+    run = _fake_run({"cycle": cycle, "time": cycle, "F": [1, 2, 3, 4, 5.0]})
+    with pytest.raises(EvalError, match="still outside"):
+        evaluate("settle(F, 10, 0.01)", run)
+
+
+def test_series_reads_another_variant():
+    cycle = np.arange(1, 4)
+    a = _fake_run({"cycle": cycle, "time": cycle, "F": [1, 2, 3.0]})
+    b = _fake_run({"cycle": cycle, "time": cycle, "F": [1, 2, 4.0]})
+    sibling = {"b": b}.__getitem__
+    assert evaluate("max(abs(F - series('b', 'F')))", a, sibling) == 1.0
+    with pytest.raises(EvalError, match="no column"):
+        evaluate("max(series('b', 'G'))", a, sibling)
+    with pytest.raises(EvalError, match="no other variants"):
+        evaluate("max(series('b', 'F'))", a)

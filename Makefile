@@ -93,7 +93,7 @@ keys: bin/ballast
 	bin/ballast keys
 
 clean:
-	rm -rf $(BUILD) bin reports/runs reports/figures reports/*.json reports/*.xml \
-	       reports/*.html reports/*.md reports/sweeps
+	rm -rf $(BUILD) bin reports/runs reports/figures reports/sweeps reports/bench \
+	       reports/*.json reports/*.xml reports/*.html reports/summary.md
 
 -include $(LIB_OBJ:.o=.d) $(SAN_OBJ:.o=.d) $(BUILD)/main.d

@@ -274,7 +274,7 @@ static const struct bad_scene bad_scenes[] = {
      "bad:3: density: -2.385 is out of range"},
     {"not an integer", HEAD "[stage s]\ncycles = 2.5\n", 'p',
      "bad:9: cycles: expected an integer, got '2.5'"},
-    {"zero cycles", HEAD "[stage s]\ncycles = 0\n", 'p', "bad:9: cycles: 0 is out of range"},
+    {"negative cycles", HEAD "[stage s]\ncycles = -1\n", 'p', "bad:9: cycles: -1 is out of range"},
     {"unknown word", "[settings]\nnormal_law = hertz\n", 'p',
      "bad:2: normal_law: expected one of {incremental power}, got 'hertz'"},
     {"empty value", "[material m]\nkn =\n", 'p', "bad:2: kn: expected a value after '='"},

@@ -17,7 +17,7 @@ CFLAGS_BASE := -std=c11 -Wall -Wextra -Wpedantic -ffp-contract=off \
                -D_POSIX_C_SOURCE=200809L $(WERROR)
 CFLAGS   ?= $(OPT) -g
 ALL_CFLAGS = $(CFLAGS_BASE) $(CFLAGS) -DBAL_BUILD_FLAGS='"$(CC) $(CFLAGS_BASE) $(CFLAGS)"'
-LDLIBS   := -lm
+LDLIBS   := $(shell pkg-config --libs gsl 2>/dev/null || echo -lgsl -lgslcblas) -lm
 CHECK_LIBS = $(shell pkg-config --libs check 2>/dev/null)
 SAN      := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 

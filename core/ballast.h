@@ -95,6 +95,11 @@ struct bal_settings {
     int grid;             /* enum bal_grid_mode (auto) */
     double skin;          /* Verlet skin, length; 0 = auto (0) */
     long output_every;    /* cycles between series rows (1) */
+    double gamma_n;       /* viscous normal damping γ_n of MLH eq. (3), mass/time (0) */
+    double psi;           /* exponent ψ of MLH eq. (3) (0) */
+    double stress_width;  /* moving-average stress cells: width, 0 = off (0) */
+    double stress_height; /* cell height (0 = the width) */
+    double stress_step;   /* horizontal step between overlapping cells (0 = the width) */
     BAL_SECTION_TAIL;
 };
 
@@ -151,6 +156,26 @@ struct bal_fill_def {
     BAL_SECTION_TAIL;
 };
 
+/* A generator: a pile of equal discs on a triangular lattice (MLH Sec. 4,
+ * Fig. 2).  Row M = 0 has L discs; row M holds L − 3M (slope 30) or L − M
+ * (slope 60).  Bottom `smooth`: row 0 rests on a floor wall NAME_floor with
+ * only its two corner stones held; `bumpy`: row 0 is held at spacing
+ * d (1 + c) and the rows above sit in its hollows (spacing max(d, d(1 + c))),
+ * each row at the lowest height where it does not overlap the row below. */
+struct bal_pile_def {
+    char name[BAL_NAME_MAX];
+    int line;
+    long L;               /* discs in row 0 (required) */
+    int slope;            /* 0: 30 degrees, 1: 60 degrees (30) */
+    double d;             /* diameter (required) */
+    double origin[2];     /* left end of the base, floor height (0 0) */
+    int bottom;           /* 0: smooth, 1: bumpy (smooth) */
+    double c;             /* spacing factor of row 0 on a bumpy bottom (0) */
+    char material[BAL_NAME_MAX];
+    char wall_material[BAL_NAME_MAX];
+    BAL_SECTION_TAIL;
+};
+
 struct bal_move_def {
     char wall[BAL_NAME_MAX];  /* wall name */
     int line;
@@ -161,7 +186,11 @@ struct bal_move_def {
 struct bal_stage_def {
     char name[BAL_NAME_MAX];
     int line;
-    long cycles;              /* number of cycles (required, > 0) */
+    long cycles;              /* number of cycles, or the most when a stop rule is set */
+    long ramp;                /* 1: gravity rises linearly from 0 over the stage (0) */
+    double stop_ke;           /* stop when E_k <= stop_ke E_el (0: off) */
+    double stop_stress;       /* ... and the stresses change by <= this (0: off) */
+    long check_every;         /* cycles between checks of the stop rule (100) */
     int n_moves;
     struct bal_move_def moves[BAL_MAX_MOVES];
     BAL_SECTION_TAIL;
@@ -174,6 +203,7 @@ enum bal_probe_kind {
     BAL_PROBE_DISC_THETA, BAL_PROBE_DISC_OMEGA,
     BAL_PROBE_ENERGY_KINETIC, BAL_PROBE_ENERGY_ELASTIC,
     BAL_PROBE_UNBALANCED, BAL_PROBE_N_CONTACTS, BAL_PROBE_N_SLIDING,
+    BAL_PROBE_HELD_FX, BAL_PROBE_HELD_FY, BAL_PROBE_WEIGHT_X, BAL_PROBE_WEIGHT_Y,
     BAL_PROBE_COUNT
 };
 
@@ -189,12 +219,13 @@ struct bal_probe_def {
 struct bal_scene {
     char path[512];                 /* file the scene came from */
     struct bal_settings settings;
-    int n_materials, n_discs, n_walls, n_fills, n_stages, n_probes;
-    int cap_materials, cap_discs, cap_walls, cap_fills, cap_stages, cap_probes;
+    int n_materials, n_discs, n_walls, n_fills, n_piles, n_stages, n_probes;
+    int cap_materials, cap_discs, cap_walls, cap_fills, cap_piles, cap_stages, cap_probes;
     struct bal_material_def *materials;
     struct bal_disc_def *discs;
     struct bal_wall_def *walls;
     struct bal_fill_def *fills;
+    struct bal_pile_def *piles;
     struct bal_stage_def *stages;
     struct bal_probe_def *probes;
 };

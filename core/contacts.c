@@ -13,6 +13,7 @@
  *   F_n  = k_n δ0 (δ/δ0)^ν, δ = R_x + R_y − D (power law)   MLH eq. (2)
  *   F_s += k_s ṡ Δt, |F_s| ≤ F_n tan φ_μ + c                 eqs (15), (17)–(19)
  *   D_n = c_n ṅ, D_s = c_s ṡ (0 while sliding)              eqs (26)–(28)
+ *   D_n += γ_n ṅ (δ/δ0)^ψ (viscous normal force)           MLH eq. (3)
  *
  * F_n + D_n and F_s + D_s act on x in the directions −e and −t (Fig. 3);
  * the moment on x and on y is (F_s + D_s) R (the text after eq. 19).
@@ -47,36 +48,31 @@
 /* Candidate lists                                                     */
 /* ------------------------------------------------------------------ */
 
+static int grow_array(void **a, size_t cap, size_t size)
+{
+    void *q = realloc(*a, cap * size);
+    if (!q)
+        return 0;
+    *a = q;
+    return 1;
+}
+
 enum bal_status bal_pairs_reserve(struct bal_pairs *p, long cap)
 {
     if (cap <= p->cap)
         return BAL_OK;
-    size_t c = (size_t)cap;
-    void *k = realloc(p->key, c * sizeof *p->key);
-    if (k)
-        p->key = k;
-    void *i = realloc(p->i, c * sizeof *p->i);
-    if (i)
-        p->i = i;
-    void *j = realloc(p->j, c * sizeof *p->j);
-    if (j)
-        p->j = j;
-    void *fn = realloc(p->fn, c * sizeof *p->fn);
-    if (fn)
-        p->fn = fn;
-    void *fs = realloc(p->fs, c * sizeof *p->fs);
-    if (fs)
-        p->fs = fs;
-    void *dn = realloc(p->dn, c * sizeof *p->dn);
-    if (dn)
-        p->dn = dn;
-    void *ds = realloc(p->ds, c * sizeof *p->ds);
-    if (ds)
-        p->ds = ds;
-    void *fl = realloc(p->flags, c * sizeof *p->flags);
-    if (fl)
-        p->flags = fl;
-    if (!k || !i || !j || !fn || !fs || !dn || !ds || !fl)
+    const size_t c = (size_t)cap;
+    int ok = grow_array((void **)&p->key, c, sizeof *p->key) &&
+             grow_array((void **)&p->i, c, sizeof *p->i) &&
+             grow_array((void **)&p->j, c, sizeof *p->j) &&
+             grow_array((void **)&p->fn, c, sizeof *p->fn) &&
+             grow_array((void **)&p->flags, c, sizeof *p->flags);
+    if (ok && p->shear)
+        ok = grow_array((void **)&p->fs, c, sizeof *p->fs) &&
+             grow_array((void **)&p->ds, c, sizeof *p->ds);
+    if (ok && p->damping)
+        ok = grow_array((void **)&p->dn, c, sizeof *p->dn);
+    if (!ok)
         return BAL_ENOMEM;
     p->cap = cap;
     return BAL_OK;
@@ -84,6 +80,7 @@ enum bal_status bal_pairs_reserve(struct bal_pairs *p, long cap)
 
 void bal_pairs_free(struct bal_pairs *p)
 {
+    const uint8_t shear = p->shear, damping = p->damping;
     free(p->key);
     free(p->i);
     free(p->j);
@@ -93,6 +90,8 @@ void bal_pairs_free(struct bal_pairs *p)
     free(p->ds);
     free(p->flags);
     memset(p, 0, sizeof *p);
+    p->shear = shear;
+    p->damping = damping;
 }
 
 /* Copy the history of every contact of `old` whose key is also in `fresh`.
@@ -105,19 +104,15 @@ void bal_pairs_merge_history(struct bal_pairs *fresh, const struct bal_pairs *ol
         uint64_t k = fresh->key[c];
         while (a < old->n && old->key[a] < k)
             a++;
-        if (a < old->n && old->key[a] == k) {
-            fresh->fn[c] = old->fn[a];
-            fresh->fs[c] = old->fs[a];
-            fresh->dn[c] = old->dn[a];
-            fresh->ds[c] = old->ds[a];
-            fresh->flags[c] = old->flags[a];
-        } else {
-            fresh->fn[c] = 0;
-            fresh->fs[c] = 0;
-            fresh->dn[c] = 0;
-            fresh->ds[c] = 0;
-            fresh->flags[c] = 0;
+        const int same = a < old->n && old->key[a] == k;
+        fresh->fn[c] = same ? old->fn[a] : 0;
+        fresh->flags[c] = same ? old->flags[a] : 0;
+        if (fresh->shear) {
+            fresh->fs[c] = same ? old->fs[a] : 0;
+            fresh->ds[c] = same ? old->ds[a] : 0;
         }
+        if (fresh->damping)
+            fresh->dn[c] = same ? old->dn[a] : 0;
     }
 }
 
@@ -134,6 +129,16 @@ static inline double power_force(double kn, double delta, double delta0, double 
     if (nu == 2.0)
         return kn * delta * (delta / delta0);
     return kn * delta0 * pow(delta / delta0, nu);
+}
+
+/* The coefficient γ_n (δ/δ0)^ψ of MLH eq. (3). */
+static inline double viscous(const struct bal_sim *s, double delta)
+{
+    if (s->gamma_n == 0)
+        return 0;
+    if (s->psi == 0)
+        return s->gamma_n;
+    return s->gamma_n * pow(delta / s->delta0, s->psi);
 }
 
 static inline __attribute__((always_inline)) void
@@ -157,10 +162,13 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
         if (d2 >= rs * rs) {
             /* Not in contact (eq. 8): history is reset. */
             p->fn[c] = 0;
-            p->fs[c] = 0;
-            p->dn[c] = 0;
-            p->ds[c] = 0;
             p->flags[c] = 0;
+            if (shear) {
+                p->fs[c] = 0;
+                p->ds[c] = 0;
+            }
+            if (damp)
+                p->dn[c] = 0;
             continue;
         }
         const struct bal_pair_law *L = &laws[mat[i] * n_mat + mat[j]];
@@ -181,7 +189,7 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
         double ftn = fn, fts = 0;
         uint8_t flags = BAL_PAIR_TOUCHING;
         if (damp) {
-            const double dn = L->cn * ndot;
+            const double dn = (L->cn + viscous(s, rs - dist)) * ndot;
             p->dn[c] = dn;
             ftn += dn;
         }
@@ -301,7 +309,7 @@ void bal_contacts_walls(struct bal_sim *s)
             fs = copysign(fmax, fs);
             flags |= BAL_PAIR_SLIDING;
         }
-        const double dn = L->cn * ndot;
+        const double dn = (L->cn + viscous(s, ri - dist)) * ndot;
         const double ds = (!shear || (flags & BAL_PAIR_SLIDING)) ? 0.0 : L->cs * sdot;
         p->fn[c] = fn;
         p->fs[c] = fs;

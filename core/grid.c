@@ -68,7 +68,7 @@ static inline void push(struct bal_pairs *p, int i, int j)
 enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
 {
     const int n = s->n;
-    struct bal_pairs *fresh = &s->scratch;
+    struct bal_pairs *fresh = &s->scratch_pp;
 
     /* --- disc–disc candidates ------------------------------------- */
     fresh->n = 0;
@@ -178,6 +178,7 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
     swap_pairs(&s->pp, fresh);
 
     /* --- disc–wall candidates ------------------------------------- */
+    fresh = &s->scratch_pw;
     fresh->n = 0;
     if (grow(fresh, s->pw.n, err))
         return err->code;

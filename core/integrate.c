@@ -8,7 +8,8 @@
  *   ω_{N+1/2} = { ω_{N−1/2} (1 − α Δt/2) + (ΣM_N/I) Δt } / (1 + α Δt/2)
  *   x_{N+1}   = x_N + v_{N+1/2} Δt,   θ_{N+1} = θ_N + ω_{N+1/2} Δt
  *
- * The body force m g is added to the force sum (text after eq. 23a); with
+ * The body force m g is added to the force sum (text after eq. 23a),
+ * scaled by the gravity ramp of the current stage; with
  * C = α m and C* = α I (eq. 34) the mass cancels.  With α = 0 the update is
  * eqs (22)–(23) exactly.  Held discs keep zero velocity.
  *
@@ -63,7 +64,7 @@ void bal_integrate_velocities(struct bal_sim *s, int keep_old)
     const double dt = s->dt;
     const double half = s->alpha * dt / 2;
     const double keep = 1 - half, scale = 1 / (1 + half);
-    const double gxdt = s->g[0] * dt, gydt = s->g[1] * dt;
+    const double gxdt = s->g[0] * s->gfac * dt, gydt = s->g[1] * s->gfac * dt;
     double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
     const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict tq = s->tq;
     const double *restrict im = s->inv_m, *restrict ii = s->inv_i;

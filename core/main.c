@@ -3,6 +3,7 @@
  * line, touches signals and maps a status to an exit code.
  *
  *   ballast run SCENE --out DIR [--set KEY=VALUE ...]
+ *   ballast exact SCENE --out DIR [--set KEY=VALUE ...]
  *   ballast info SCENE [--set KEY=VALUE ...]
  *   ballast keys          (every scene key, as Markdown tables)
  *   ballast --version
@@ -21,6 +22,7 @@
 #include <sys/stat.h>
 
 #include "ballast.h"
+#include "exact.h"
 
 static volatile sig_atomic_t stop_requested;
 
@@ -46,6 +48,7 @@ static int exit_code(enum bal_status st)
 static int usage(void)
 {
     fputs("usage: ballast run SCENE --out DIR [--set KEY=VALUE ...]\n"
+          "       ballast exact SCENE --out DIR [--set KEY=VALUE ...]\n"
           "       ballast info SCENE [--set KEY=VALUE ...]\n"
           "       ballast keys\n"
           "       ballast --version\n",
@@ -166,7 +169,8 @@ static int cmd_run(const struct args *a)
         return 3;
     }
     /* Remove results of an earlier run so nothing stale is read as new. */
-    const char *names[] = {"series.tsv", "discs.tsv", "contacts.tsv", "walls.tsv", "run.json"};
+    const char *names[] = {"series.tsv", "discs.tsv", "contacts.tsv", "walls.tsv", "stress.tsv",
+                           "stress_grid.tsv", "run.json"};
     for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
         char p[1200];
         snprintf(p, sizeof p, "%s/%s", a->out, names[k]);
@@ -211,6 +215,104 @@ static int cmd_run(const struct args *a)
     return exit_code(st != BAL_OK ? st : js);
 }
 
+/* The exact static solution of the scene's initial positions (MLH Sec. 4.2):
+ * contacts.tsv with the stiff-limit forces (and an `open` column), discs.tsv,
+ * a one-row series.tsv (iterations, open contacts, seconds, weight, support,
+ * residual) and run.json, all via temporary names. */
+static enum bal_status write_exact(const struct bal_sim *sim, const struct bal_exact *ex,
+                                   const char *dir, struct bal_error *err)
+{
+    /* discs.tsv and walls.tsv of the initial state; its contacts.tsv (no DEM
+     * forces yet) and stress.tsv (zeros) are replaced or removed below. */
+    if (bal_output_state(sim, dir, err))
+        return err->code;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/stress.tsv", dir);
+    remove(path);
+    snprintf(path, sizeof path, "%s/contacts.tsv.tmp", dir);
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return bal_error(err, BAL_EIO, "%s: cannot write: %s", path, strerror(errno));
+    fputs("a\tb\tkind\tx\ty\tnx\tny\tfn\tfs\tdn\tds\tsliding\topen\n", f);
+    char a[2 * BAL_NAME_MAX], b[2 * BAL_NAME_MAX];
+    for (long c = 0; c < ex->n_contacts; c++) {
+        const struct bal_exact_contact *k = &ex->contacts[c];
+        bal_output_disc_name(sim, bal_sim_disc_id(sim, k->i), a, sizeof a);
+        if (k->is_wall)
+            snprintf(b, sizeof b, "%s", bal_sim_wall_name(sim, k->j));
+        else
+            bal_output_disc_name(sim, bal_sim_disc_id(sim, k->j), b, sizeof b);
+        double px, py;
+        bal_sim_contact_point(sim, k->i, k->is_wall, k->j, &px, &py);
+        fprintf(f, "%s\t%s\t%s\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t0\t0\t0\t0\t%d\n", a, b,
+                k->is_wall ? "wall" : "disc", px, py, k->nx, k->ny, k->fn, k->open);
+    }
+    int bad = ferror(f);
+    bad |= fclose(f) != 0;
+    if (bad)
+        return bal_error(err, BAL_EIO, "%s: write failed", path);
+    if (bal_output_commit(dir, "contacts.tsv", err))
+        return err->code;
+    snprintf(path, sizeof path, "%s/series.tsv.tmp", dir);
+    f = fopen(path, "w");
+    if (!f)
+        return bal_error(err, BAL_EIO, "%s: cannot write: %s", path, strerror(errno));
+    fprintf(f, "cycle\ttime\titerations\tn_open\tn_contacts\tseconds\tweight_x\tweight_y\t"
+               "support_x\tsupport_y\tresidual\tbandwidth\n");
+    fprintf(f, "0\t0\t%d\t%ld\t%ld\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d\n", ex->iterations,
+            ex->n_open, ex->n_contacts, ex->seconds, ex->weight[0], ex->weight[1], ex->support[0],
+            ex->support[1], ex->residual, ex->bandwidth);
+    bad = ferror(f);
+    bad |= fclose(f) != 0;
+    if (bad)
+        return bal_error(err, BAL_EIO, "%s: write failed", path);
+    return bal_output_commit(dir, "series.tsv", err);
+}
+
+static int cmd_exact(const struct args *a)
+{
+    struct bal_scene sc;
+    struct bal_error err = {0};
+    struct bal_sim *sim = NULL;
+    if (!a->out) {
+        fputs("ballast exact: --out DIR is required\n", stderr);
+        return 2;
+    }
+    if (load(&sc, a, &err) || bal_sim_create(&sim, &sc, &err)) {
+        fprintf(stderr, "%s\n", err.msg);
+        bal_scene_free(&sc);
+        return exit_code(err.code);
+    }
+    if (make_dirs(a->out) != 0) {
+        fprintf(stderr, "ballast: %s: cannot create directory: %s\n", a->out, strerror(errno));
+        bal_sim_free(sim);
+        bal_scene_free(&sc);
+        return 3;
+    }
+    const char *names[] = {"series.tsv", "discs.tsv", "contacts.tsv", "walls.tsv", "stress.tsv",
+                           "stress_grid.tsv", "run.json"};
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
+        char p[1200];
+        snprintf(p, sizeof p, "%s/%s", a->out, names[k]);
+        remove(p);
+    }
+    struct bal_exact ex = {0};
+    enum bal_status st = bal_exact_solve(sim, &ex, &err);
+    if (st == BAL_OK)
+        st = write_exact(sim, &ex, a->out, &err);
+    struct bal_error jerr = {0};
+    enum bal_status js = bal_output_run_json(sim, a->out, sc.path, a->n_sets, a->sets, st,
+                                             st == BAL_OK ? "" : err.msg, &jerr);
+    if (st != BAL_OK)
+        fprintf(stderr, "%s\n", err.msg);
+    if (js != BAL_OK)
+        fprintf(stderr, "%s\n", jerr.msg);
+    bal_exact_free(&ex);
+    bal_sim_free(sim);
+    bal_scene_free(&sc);
+    return exit_code(st != BAL_OK ? st : js);
+}
+
 int main(int argc, char **argv)
 {
     if (argc == 2 && strcmp(argv[1], "--version") == 0) {
@@ -228,6 +330,8 @@ int main(int argc, char **argv)
         rc = usage();
     else if (strcmp(a.cmd, "run") == 0)
         rc = cmd_run(&a);
+    else if (strcmp(a.cmd, "exact") == 0)
+        rc = cmd_exact(&a);
     else if (strcmp(a.cmd, "info") == 0)
         rc = cmd_info(&a);
     else

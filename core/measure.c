@@ -13,12 +13,22 @@
  * centre to the point where the resultant normal force acts, divided by
  * half the wall length (footnote 1 of Table 1).
  *
+ * Stress (MLH Sec. 3, eq. 8): σ_αβ = (1/V) Σ_c f_α^c l_β^c.  Per disc the
+ * sum runs over its contacts, f^c the force on the disc (elastic plus
+ * dashpot), l^c from its centre to the contact point (the middle of the
+ * overlap; for a wall, halfway between the disc surface and the wall), and
+ * V = 2 sqrt(3) r², the hexagonal cell of a disc in a triangular packing of
+ * its own size.  Held discs and walls bear the reactions.  Probes held_fx,
+ * held_fy sum the contact forces on held discs; weight_x, weight_y the
+ * gravity on the free ones (with the current ramp).
+ *
  * Elastic energy: the energy stored in the contact springs.  For the
  * incremental law the springs are k_n and k_s: F_n²/(2 k_n) + F_s²/(2 k_s).
  * For the power law the normal part is ∫ k_n δ0 (δ/δ0)^ν dδ
  * = k_n δ0² (δ/δ0)^{ν+1} / (ν+1).
  */
 #include <math.h>
+#include <string.h>
 
 #include "sim.h"
 
@@ -57,7 +67,7 @@ double bal_measure_elastic(const struct bal_sim *s)
         const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + s->mat[j]];
         const double delta = s->r[i] + s->r[j] - hypot(s->x[j] - s->x[i], s->y[j] - s->y[i]);
         e += normal_energy(s, L, s->pp.fn[c], delta);
-        e += s->pp.fs[c] * s->pp.fs[c] / (2 * L->ks);
+        e += pair_fs(&s->pp, c) * pair_fs(&s->pp, c) / (2 * L->ks);
     }
     for (long c = 0; c < s->pw.n; c++) {
         if (!(s->pw.flags[c] & BAL_PAIR_TOUCHING))
@@ -75,7 +85,7 @@ double bal_measure_elastic(const struct bal_sim *s)
 
 static double contact_force(const struct bal_pairs *p, long c)
 {
-    return hypot(p->fn[c] + p->dn[c], p->fs[c] + p->ds[c]);
+    return hypot(p->fn[c] + pair_dn(p, c), pair_fs(p, c) + pair_ds(p, c));
 }
 
 double bal_measure_unbalanced(const struct bal_sim *s)
@@ -110,6 +120,59 @@ static long count_contacts(const struct bal_sim *s, uint8_t flag)
     return n;
 }
 
+double bal_measure_disc_volume(double r)
+{
+    return 2 * sqrt(3.0) * r * r;
+}
+
+/* Add f ⊗ l to the moment of disc i. */
+static void add_moment(double *m, int i, double fx, double fy, double lx, double ly)
+{
+    m[4 * i + 0] += fx * lx;
+    m[4 * i + 1] += fx * ly;
+    m[4 * i + 2] += fy * lx;
+    m[4 * i + 3] += fy * ly;
+}
+
+void bal_measure_moments(const struct bal_sim *s, double *m)
+{
+    memset(m, 0, 4 * (size_t)s->n * sizeof *m);
+    for (long c = 0; c < s->pp.n; c++) {
+        if (!(s->pp.flags[c] & BAL_PAIR_TOUCHING))
+            continue;
+        const int i = s->pp.i[c], j = s->pp.j[c];
+        const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
+        const double d = hypot(dx, dy), ex = dx / d, ey = dy / d;
+        const double delta = s->r[i] + s->r[j] - d;
+        const double ftn = s->pp.fn[c] + pair_dn(&s->pp, c);
+        const double fts = pair_fs(&s->pp, c) + pair_ds(&s->pp, c);
+        /* Force on j is ftn e + fts t, t = (ey, -ex); on i the opposite.  The
+         * contact point lies on the line of centres, in the middle of the
+         * overlap; l runs from each centre to it. */
+        const double fx = ftn * ex + fts * ey, fy = ftn * ey - fts * ex;
+        const double li = s->r[i] - delta / 2, lj = s->r[j] - delta / 2;
+        add_moment(m, i, -fx, -fy, li * ex, li * ey);
+        add_moment(m, j, fx, fy, -lj * ex, -lj * ey);
+    }
+    for (long c = 0; c < s->pw.n; c++) {
+        if (!(s->pw.flags[c] & BAL_PAIR_TOUCHING))
+            continue;
+        const int i = s->pw.i[c];
+        const struct bal_wall *W = &s->walls[s->pw.j[c]];
+        double cx, cy;
+        const double d = sqrt(bal_walls_closest(W, s->x[i], s->y[i], &cx, &cy));
+        double ex = -W->e[1], ey = W->e[0];
+        if (d > 0) {
+            ex = (cx - s->x[i]) / d;
+            ey = (cy - s->y[i]) / d;
+        }
+        const double ftn = s->pw.fn[c] + s->pw.dn[c], fts = s->pw.fs[c] + s->pw.ds[c];
+        const double fx = ftn * ex + fts * ey, fy = ftn * ey - fts * ex;
+        const double l = 0.5 * (s->r[i] + d);
+        add_moment(m, i, -fx, -fy, l * ex, l * ey);
+    }
+}
+
 double bal_measure_probe(const struct bal_sim *s, int probe)
 {
     const struct bal_probe_ref *p = &s->probes[probe];
@@ -124,7 +187,7 @@ double bal_measure_probe(const struct bal_sim *s, int probe)
         if (p->kind == BAL_PROBE_CONTACT_FN)
             return list->fn[c];
         if (p->kind == BAL_PROBE_CONTACT_FS)
-            return list->fs[c];
+            return pair_fs(list, c);
         return (list->flags[c] & BAL_PAIR_SLIDING) ? 1 : 0;
     }
     case BAL_PROBE_WALL_F1:
@@ -162,6 +225,23 @@ double bal_measure_probe(const struct bal_sim *s, int probe)
         return (double)count_contacts(s, BAL_PAIR_TOUCHING);
     case BAL_PROBE_N_SLIDING:
         return (double)count_contacts(s, BAL_PAIR_SLIDING);
+    case BAL_PROBE_HELD_FX:
+    case BAL_PROBE_HELD_FY: {
+        double f = 0;
+        const double *fc = p->kind == BAL_PROBE_HELD_FX ? s->fx : s->fy;
+        for (int i = 0; i < s->n; i++)
+            if (s->fixed[i])
+                f += fc[i];
+        return f;
+    }
+    case BAL_PROBE_WEIGHT_X:
+    case BAL_PROBE_WEIGHT_Y: {
+        double m = 0;
+        for (int i = 0; i < s->n; i++)
+            if (!s->fixed[i])
+                m += s->m[i];
+        return m * s->g[p->kind == BAL_PROBE_WEIGHT_X ? 0 : 1] * s->gfac;
+    }
     }
     return NAN;
 }

@@ -7,6 +7,10 @@
  *   contacts.tsv  every touching contact of the final state
  *   walls.tsv     every wall of the final state: end points A, B and the
  *                 resultant the discs exert on it (C&S Table 1)
+ *   stress.tsv    per disc: the stress tensor of MLH eq. (8), its principal
+ *                 values and the angle of eq. (9) (measure.c states V)
+ *   stress_grid.tsv  moving averages over overlapping cells, when the scene
+ *                 sets stress_width
  *   run.json      version, build, scene, overrides, how the run ended,
  *                 steps, time step and its estimate, timings, energies
  *
@@ -41,6 +45,14 @@ void bal_output_disc_name(const struct bal_sim *s, int id, char *buf, size_t siz
             return;
         }
         k -= sc->fills[f].n;
+    }
+    for (int p = 0; p < sc->n_piles; p++) {
+        const long n = bal_sim_pile_count(&sc->piles[p]);
+        if (k < n) {
+            snprintf(buf, size, "%s.%ld", sc->piles[p].name, k);
+            return;
+        }
+        k -= n;
     }
     snprintf(buf, size, "?%d", id);
 }
@@ -117,8 +129,8 @@ static void write_contacts(const struct bal_sim *s, FILE *f)
         body_name(s, 0, i, a, sizeof a);
         body_name(s, 0, j, b, sizeof b);
         fprintf(f, "%s\t%s\tdisc\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d\n", a,
-                b, s->x[i] + at * ex, s->y[i] + at * ey, ex, ey, s->pp.fn[c], s->pp.fs[c],
-                s->pp.dn[c], s->pp.ds[c], (s->pp.flags[c] & BAL_PAIR_SLIDING) != 0);
+                b, s->x[i] + at * ex, s->y[i] + at * ey, ex, ey, s->pp.fn[c], pair_fs(&s->pp, c),
+                pair_dn(&s->pp, c), pair_ds(&s->pp, c), (s->pp.flags[c] & BAL_PAIR_SLIDING) != 0);
     }
     for (long c = 0; c < s->pw.n; c++) {
         if (!(s->pw.flags[c] & BAL_PAIR_TOUCHING))
@@ -144,16 +156,17 @@ static void write_contacts(const struct bal_sim *s, FILE *f)
 
 static void write_discs(const struct bal_sim *s, FILE *f)
 {
-    fputs("id\tname\tx\ty\tr\ttheta\tvx\tvy\tomega\tm\tfixed\n", f);
+    fputs("id\tname\tx\ty\tr\ttheta\tvx\tvy\tomega\tm\tfixed\trow\n", f);
     char name[2 * BAL_NAME_MAX];
     for (int k = 0; k < s->n; k++) {
         const int i = s->slot[k];
         bal_output_disc_name(s, k, name, sizeof name);
-        fprintf(f, "%d\t%s\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d\n", k, name,
-                s->x[i], s->y[i], s->r[i], s->th[i] * (180 / BAL_PI),
+        fprintf(f, "%d\t%s\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d\t%d\n", k,
+                name, s->x[i], s->y[i], s->r[i], s->th[i] * (180 / BAL_PI),
                 s->have_old ? 0.5 * (s->vx[i] + s->vx_old[i]) : s->vx[i],
                 s->have_old ? 0.5 * (s->vy[i] + s->vy_old[i]) : s->vy[i],
-                s->have_old ? 0.5 * (s->w[i] + s->w_old[i]) : s->w[i], s->m[i], s->fixed[i]);
+                s->have_old ? 0.5 * (s->w[i] + s->w_old[i]) : s->w[i], s->m[i], s->fixed[i],
+                s->row[i]);
     }
 }
 
@@ -170,8 +183,95 @@ static void write_walls(const struct bal_sim *s, FILE *f)
     }
 }
 
+/* Principal values and the angle of the major axis, counter-clockwise from
+ * the horizontal in [0, 180) degrees (MLH eq. 9, closed form of the 2 x 2
+ * symmetric eigenproblem on the symmetric part of the tensor). */
+static void principal(double xx, double xz, double zx, double zz, double *smax, double *smin,
+                      double *phi)
+{
+    const double plus = 0.5 * (xx + zz), minus = 0.5 * (xx - zz), star = 0.5 * (xz + zx);
+    const double rad = hypot(minus, star);
+    *smax = plus + rad;
+    *smin = plus - rad;
+    double a = 0.5 * atan2(2 * star, xx - zz) * (180 / BAL_PI);
+    *phi = a < 0 ? a + 180 : a;
+}
+
+static void write_stress(const struct bal_sim *s, FILE *f)
+{
+    fputs("id\tname\tx\ty\trow\tfixed\tV\tsxx\tsxz\tszx\tszz\tsmax\tsmin\tphi\n", f);
+    char name[2 * BAL_NAME_MAX];
+    for (int k = 0; k < s->n; k++) {
+        const int i = s->slot[k];
+        const double v = bal_measure_disc_volume(s->r[i]);
+        const double *m = &s->moment[4 * i];
+        double smax, smin, phi;
+        principal(m[0] / v, m[1] / v, m[2] / v, m[3] / v, &smax, &smin, &phi);
+        bal_output_disc_name(s, k, name, sizeof name);
+        fprintf(f, "%d\t%s\t%.17g\t%.17g\t%d\t%d\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\n",
+                k, name, s->x[i], s->y[i], s->row[i], s->fixed[i], v, m[0] / v, m[1] / v, m[2] / v,
+                m[3] / v, smax, smin, phi);
+    }
+}
+
+/* Moving averages (MLH Sec. 3): cells of width W and height H, stepped by
+ * `step` horizontally (so they overlap when step < W) and by H vertically,
+ * over the free discs; σ_cell = Σ_{discs with centre in the cell} Σ_c f ⊗ l / (W H). */
+static void write_stress_grid(const struct bal_sim *s, FILE *f)
+{
+    const struct bal_settings *st = &s->scene->settings;
+    const double w = st->stress_width, h = st->stress_height > 0 ? st->stress_height : w;
+    const double step = st->stress_step > 0 ? st->stress_step : w;
+    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+    for (int i = 0; i < s->n; i++) {
+        x0 = fmin(x0, s->x[i]);
+        x1 = fmax(x1, s->x[i]);
+        y0 = fmin(y0, s->y[i]);
+        y1 = fmax(y1, s->y[i]);
+    }
+    fputs("xc\tyc\tn\tsxx\tsxz\tszx\tszz\tsmax\tsmin\tphi\n", f);
+    for (double yb = y0 - 0.5 * h; yb <= y1; yb += h) {
+        for (double xb = x0 - 0.5 * w; xb <= x1; xb += step) {
+            double m[4] = {0, 0, 0, 0};
+            int n = 0;
+            for (int i = 0; i < s->n; i++) {
+                if (s->fixed[i] || s->x[i] < xb || s->x[i] >= xb + w || s->y[i] < yb ||
+                    s->y[i] >= yb + h)
+                    continue;
+                for (int a = 0; a < 4; a++)
+                    m[a] += s->moment[4 * i + a];
+                n++;
+            }
+            if (n == 0)
+                continue;
+            for (int a = 0; a < 4; a++)
+                m[a] /= w * h;
+            double smax, smin, phi;
+            principal(m[0], m[1], m[2], m[3], &smax, &smin, &phi);
+            fprintf(f, "%.17g\t%.17g\t%d\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\n",
+                    xb + 0.5 * w, yb + 0.5 * h, n, m[0], m[1], m[2], m[3], smax, smin, phi);
+        }
+    }
+}
+
 enum bal_status bal_output_state(const struct bal_sim *s, const char *dir, struct bal_error *err)
 {
+    /* The stress files need the moments of the final state. */
+    bal_measure_moments(s, ((struct bal_sim *)s)->moment);
+    FILE *g = open_tmp(dir, "stress.tsv", err);
+    if (!g)
+        return err->code;
+    write_stress(s, g);
+    if (close_tmp(g, dir, "stress.tsv", err))
+        return err->code;
+    if (s->scene->settings.stress_width > 0) {
+        g = open_tmp(dir, "stress_grid.tsv", err);
+        if (!g)
+            return err->code;
+        write_stress_grid(s, g);
+        if (close_tmp(g, dir, "stress_grid.tsv", err))
+            return err->code;
+    }
     FILE *f = open_tmp(dir, "contacts.tsv", err);
     if (!f)
         return err->code;
@@ -255,12 +355,43 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
                 in.n_discs, in.n_walls, in.grid_used ? "true" : "false", in.rebuilds,
                 in.n_candidates);
         json_number(f, in.wall_seconds > 0 ? (double)in.steps * in.n_discs / in.wall_seconds : 0);
+        fprintf(f, ",\n  \"gravity\": [%.17g, %.17g]", s->g[0], s->g[1]);
         fputs(",\n  \"energy_kinetic\": ", f);
         json_number(f, bal_measure_kinetic(s));
         fputs(",\n  \"energy_elastic\": ", f);
         json_number(f, bal_measure_elastic(s));
         fputs(",\n  \"unbalanced\": ", f);
         json_number(f, bal_measure_unbalanced(s));
+        const struct bal_scene *sc = s->scene;
+        fputs(",\n  \"stages\": [", f);
+        for (int g = 0; g < sc->n_stages; g++) {
+            fprintf(f, "%s\n    {\"name\": ", g ? "," : "");
+            json_string(f, sc->stages[g].name);
+            fprintf(f, ", \"cycles\": %ld, \"max_cycles\": %ld, \"stop_rule\": %s, \"stopped\": %s, "
+                       "\"ke_over_ee\": ",
+                    s->log[g].cycles, sc->stages[g].cycles,
+                    (sc->stages[g].stop_ke > 0 || sc->stages[g].stop_stress > 0) ? "true" : "false",
+                    s->log[g].stopped ? "true" : "false");
+            json_number(f, s->log[g].ke_over_ee);
+            fputs(", \"stress_change\": ", f);
+            json_number(f, s->log[g].stress_change);
+            fputs("}", f);
+        }
+        fputs("\n  ],\n  \"piles\": [", f);
+        for (int p = 0; p < sc->n_piles; p++) {
+            const struct bal_pile_def *pd = &sc->piles[p];
+            const double s0 = pd->bottom == 1 ? pd->d * (1 + pd->c) : pd->d;
+            long rows = 0;
+            while (pd->L - (pd->slope == 0 ? 3 : 1) * rows > 0)
+                rows++;
+            fprintf(f, "%s\n    {\"name\": ", p ? "," : "");
+            json_string(f, pd->name);
+            fprintf(f, ", \"L\": %ld, \"rows\": %ld, \"discs\": %ld, \"d\": %.17g, \"x0\": %.17g, "
+                       "\"width\": %.17g}",
+                    pd->L, rows, bal_sim_pile_count(pd), pd->d, pd->origin[0],
+                    (double)(pd->L - 1) * s0 + pd->d);
+        }
+        fputs("\n  ]", f);
     }
     fputs("\n}\n", f);
     return close_tmp(f, dir, "run.json", err);

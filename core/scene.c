@@ -59,6 +59,9 @@ static struct section_array section_array(struct bal_scene *s,
     case BAL_SEC_FILL:
         a = (struct section_array){(void **)&s->fills, &s->n_fills, &s->cap_fills};
         break;
+    case BAL_SEC_PILE:
+        a = (struct section_array){(void **)&s->piles, &s->n_piles, &s->cap_piles};
+        break;
     case BAL_SEC_STAGE:
         a = (struct section_array){(void **)&s->stages, &s->n_stages, &s->cap_stages};
         break;
@@ -317,6 +320,7 @@ void bal_scene_free(struct bal_scene *s)
     free(s->discs);
     free(s->walls);
     free(s->fills);
+    free(s->piles);
     free(s->stages);
     free(s->probes);
     memset(s, 0, sizeof *s);
@@ -458,7 +462,7 @@ enum bal_status bal_scene_parse(struct bal_scene *s, const char *text,
             if (k < 0)
                 return bal_error(err, BAL_EINVAL,
                                  "%s:%d: [%s]: unknown section; expected one of settings, "
-                                 "material, disc, wall, fill, stage, probe",
+                                 "material, disc, wall, fill, pile, stage, probe",
                                  w.file, w.line, inner);
             if (bal_scene_sections[k].named && !*sec_name)
                 return bal_error(err, BAL_EINVAL, "%s:%d: [%s]: a name is required: [%s NAME]",
@@ -646,6 +650,14 @@ static int body_exists(const struct bal_scene *s, const char *name, int *is_wall
         *is_wall = 1;
         return 1;
     }
+    for (int p = 0; p < s->n_piles; p++) {
+        char nm[2 * BAL_NAME_MAX];
+        snprintf(nm, sizeof nm, "%s_floor", s->piles[p].name);
+        if (s->piles[p].bottom == 0 && strcmp(nm, name) == 0) {
+            *is_wall = 1;
+            return 1;
+        }
+    }
     static const char *const sides[] = {"_bottom", "_right", "_top", "_left"};
     for (int f = 0; f < s->n_fills; f++) {
         if (!s->fills[f].box)
@@ -669,12 +681,17 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
             return err->code;
 
     const struct bal_settings *st = &s->settings;
-    if (st->normal_law == BAL_NORMAL_POWER && st->nu != 1.0 &&
-        !(st->given & (1u << bal_scene_key_index(BAL_SEC_SETTINGS, "delta0"))))
+    const int delta0_given = (st->given & (1u << bal_scene_key_index(BAL_SEC_SETTINGS, "delta0"))) != 0;
+    if (st->normal_law == BAL_NORMAL_POWER && st->nu != 1.0 && !delta0_given)
         return bal_error(err, BAL_EINVAL,
                          "%s:%d: delta0: required with normal_law = power and nu != 1 "
                          "(the force scale k_n delta0 depends on it)",
                          s->path, st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "nu")]);
+    if (st->gamma_n > 0 && st->psi != 0 && !delta0_given)
+        return bal_error(err, BAL_EINVAL,
+                         "%s:%d: delta0: required with psi != 0 (the dashpot "
+                         "gamma_n (delta/delta0)^psi depends on it, MLH eq. 3)",
+                         s->path, st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "psi")]);
 
     for (int i = 0; i < s->n_discs; i++) {
         struct bal_disc_def *d = &s->discs[i];
@@ -704,6 +721,21 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
                 return FAIL_AT(f, BAL_SEC_FILL, "wall_material", "%s", "required with box = 1");
             if (check_material_ref(s, f, BAL_SEC_FILL, "wall_material", f->wall_material, 0, err))
                 return err->code;
+        }
+    }
+    for (int i = 0; i < s->n_piles; i++) {
+        struct bal_pile_def *p = &s->piles[i];
+        if (check_material_ref(s, p, BAL_SEC_PILE, "material", p->material, 1, err))
+            return err->code;
+        if (p->bottom == 0) {
+            if (!*p->wall_material)
+                return FAIL_AT(p, BAL_SEC_PILE, "wall_material", "%s",
+                               "required with bottom = smooth (the floor's material)");
+            if (check_material_ref(s, p, BAL_SEC_PILE, "wall_material", p->wall_material, 0, err))
+                return err->code;
+            if (p->L < 3)
+                return FAIL_AT(p, BAL_SEC_PILE, "L", "%s",
+                               "a smooth bottom needs L >= 3 (two corner stones and a free disc)");
         }
     }
     for (int i = 0; i < s->n_materials; i++) {
@@ -756,9 +788,9 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
             return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "only contact probes take a second body");
         }
     }
-    if (s->n_discs == 0 && s->n_fills == 0)
-        return bal_error(err, BAL_EINVAL, "%s: no discs: add [disc NAME] or [fill NAME] sections",
-                         s->path);
+    if (s->n_discs == 0 && s->n_fills == 0 && s->n_piles == 0)
+        return bal_error(err, BAL_EINVAL,
+                         "%s: no discs: add [disc NAME], [fill NAME] or [pile NAME] sections", s->path);
     return BAL_OK;
 }
 

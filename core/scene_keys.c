@@ -24,6 +24,7 @@
 #define W(field) offsetof(struct bal_wall_def, field)
 #define F(field) offsetof(struct bal_fill_def, field)
 #define G(field) offsetof(struct bal_stage_def, field)
+#define Q(field) offsetof(struct bal_pile_def, field)
 #define P(field) offsetof(struct bal_probe_def, field)
 
 const struct bal_key bal_scene_keys[] = {
@@ -51,6 +52,16 @@ const struct bal_key bal_scene_keys[] = {
      "Verlet skin of the cell grid, length; 0 = 0.2 x the largest radius"},
     {BAL_SEC_SETTINGS, "output_every", BAL_KEY_LONG, S(output_every), "1", 0, 1, LBIG, NULL,
      "cycles between rows of series.tsv"},
+    {BAL_SEC_SETTINGS, "gamma_n", BAL_KEY_DOUBLE, S(gamma_n), "0", 0, 0, BIG, NULL,
+     "viscous normal damping gamma_n d' (d/d0)^psi of MLH eq. 3, mass/time"},
+    {BAL_SEC_SETTINGS, "psi", BAL_KEY_DOUBLE, S(psi), "0", 0, 0, 3, NULL,
+     "exponent psi of MLH eq. 3 (0: linear dashpot)"},
+    {BAL_SEC_SETTINGS, "stress_width", BAL_KEY_DOUBLE, S(stress_width), "0", 0, 0, BIG, NULL,
+     "moving-average stress cells (MLH Sec. 3): width; 0 = no stress_grid.tsv"},
+    {BAL_SEC_SETTINGS, "stress_height", BAL_KEY_DOUBLE, S(stress_height), "0", 0, 0, BIG, NULL,
+     "height of a stress cell; 0 = the width"},
+    {BAL_SEC_SETTINGS, "stress_step", BAL_KEY_DOUBLE, S(stress_step), "0", 0, 0, BIG, NULL,
+     "horizontal step between overlapping stress cells; 0 = the width"},
 
     /* [material NAME] */
     {BAL_SEC_MATERIAL, "kn", BAL_KEY_DOUBLE, M(kn), NULL, 1, 1e-300, BIG, NULL,
@@ -113,9 +124,34 @@ const struct bal_key bal_scene_keys[] = {
     {BAL_SEC_FILL, "wall_material", BAL_KEY_NAME, F(wall_material), "", 0, 0, 0, NULL,
      "material of the box walls (required with box = 1)"},
 
+    /* [pile NAME] */
+    {BAL_SEC_PILE, "L", BAL_KEY_LONG, Q(L), NULL, 1, 1, 100000, NULL,
+     "discs in the bottom row M = 0 (MLH Fig. 2)"},
+    {BAL_SEC_PILE, "slope", BAL_KEY_ENUM, Q(slope), "30", 0, 0, 0, "30 60",
+     "30: row M holds L - 3M discs; 60: L - M"},
+    {BAL_SEC_PILE, "d", BAL_KEY_DOUBLE, Q(d), NULL, 1, 1e-300, BIG, NULL, "disc diameter d0"},
+    {BAL_SEC_PILE, "origin", BAL_KEY_VEC2, Q(origin), "0 0", 0, -BIG, BIG, NULL,
+     "left end of the base and floor height"},
+    {BAL_SEC_PILE, "bottom", BAL_KEY_ENUM, Q(bottom), "smooth", 0, 0, 0, "smooth bumpy",
+     "smooth: row 0 on a floor wall NAME_floor, corner stones held; bumpy: row 0 held"},
+    {BAL_SEC_PILE, "c", BAL_KEY_DOUBLE, Q(c), "0", 0, -0.5, 1, NULL,
+     "bumpy bottom: row 0 spacing d0 (1 + c) (MLH Sec. 4.1)"},
+    {BAL_SEC_PILE, "material", BAL_KEY_NAME, Q(material), NULL, 1, 0, 0, NULL,
+     "material of the discs"},
+    {BAL_SEC_PILE, "wall_material", BAL_KEY_NAME, Q(wall_material), "", 0, 0, 0, NULL,
+     "material of the floor (required with bottom = smooth)"},
+
     /* [stage NAME] */
     {BAL_SEC_STAGE, "cycles", BAL_KEY_LONG, G(cycles), NULL, 1, 0, 1e15, NULL,
      "number of calculation cycles in this stage (0: the stage is skipped)"},
+    {BAL_SEC_STAGE, "ramp", BAL_KEY_LONG, G(ramp), "0", 0, 0, 1, NULL,
+     "1: gravity rises linearly from zero over this stage's cycles (MLH Sec. 4)"},
+    {BAL_SEC_STAGE, "stop_ke", BAL_KEY_DOUBLE, G(stop_ke), "0", 0, 0, BIG, NULL,
+     "stop the stage once E_k <= stop_ke E_el (0: off); cycles is then the most"},
+    {BAL_SEC_STAGE, "stop_stress", BAL_KEY_DOUBLE, G(stop_stress), "0", 0, 0, BIG, NULL,
+     "... and the disc stresses change by <= this share of the largest between checks"},
+    {BAL_SEC_STAGE, "check_every", BAL_KEY_LONG, G(check_every), "100", 0, 1, 1e15, NULL,
+     "cycles between checks of the stop rule"},
     {BAL_SEC_STAGE, "move", BAL_KEY_MOVE, G(moves), NULL, 0, -BIG, BIG, NULL,
      "repeatable: WALL v1 v2 omega; velocity of P and angular velocity about P (C&S p. 53); "
      "walls not named are at rest; --set replaces the named wall's motion"},
@@ -124,7 +160,8 @@ const struct bal_key bal_scene_keys[] = {
     {BAL_SEC_PROBE, "quantity", BAL_KEY_ENUM, P(kind), NULL, 1, 0, 0,
      "contact_fn contact_fs contact_sliding wall_f1 wall_f2 wall_moment wall_ecc "
      "disc_x disc_y disc_vx disc_vy disc_theta disc_omega "
-     "energy_kinetic energy_elastic unbalanced n_contacts n_sliding",
+     "energy_kinetic energy_elastic unbalanced n_contacts n_sliding "
+     "held_fx held_fy weight_x weight_y",
      "what the series column holds"},
     {BAL_SEC_PROBE, "a", BAL_KEY_NAME, P(a), "", 0, 0, 0, NULL,
      "body: the disc (disc_*), the wall (wall_*), or the first body of a contact"},
@@ -143,6 +180,7 @@ const struct bal_section_info bal_scene_sections[BAL_SEC_COUNT] = {
     {"disc", 1, SEC(bal_disc_def), "one disc"},
     {"wall", 1, SEC(bal_wall_def), "a straight rigid wall (C&S Fig. 4)"},
     {"fill", 1, SEC(bal_fill_def), "a generator of many discs on a lattice"},
+    {"pile", 1, SEC(bal_pile_def), "a generator of a pile on a triangular lattice (MLH Fig. 2)"},
     {"stage", 1, SEC(bal_stage_def), "a stage of the loading protocol, run in file order"},
     {"probe", 1, SEC(bal_probe_def), "a column of series.tsv, in file order"},
 };

@@ -77,10 +77,15 @@ void bal_sim_free(struct bal_sim *s)
     free(s->walls);
     free(s->law);
     free(s->probes);
+    free(s->row);
+    free(s->moment);
+    free(s->moment_prev);
+    free(s->log);
     bal_grid_free(&s->grid);
     bal_pairs_free(&s->pp);
     bal_pairs_free(&s->pw);
-    bal_pairs_free(&s->scratch);
+    bal_pairs_free(&s->scratch_pp);
+    bal_pairs_free(&s->scratch_pw);
     free(s);
 }
 
@@ -174,12 +179,73 @@ static int cell_order(const double *x, const double *y, int n, double h, int32_t
     return 1;
 }
 
-/* Discs in scene order before sorting: [disc] sections, then each [fill]. */
+/* Discs in scene order before sorting: [disc] sections, then each [fill],
+ * then each [pile]. */
 struct disc_init {
     double *x, *y, *r, *vx, *vy, *th, *w;
     int32_t *mat;
     uint8_t *fixed;
+    int32_t *row;
 };
+
+/* Discs in row M of a pile (0 when the pile has no row M). */
+static long pile_row_count(const struct bal_pile_def *p, long M)
+{
+    const long n = p->L - (p->slope == 0 ? 3 : 1) * M;
+    return n > 0 ? n : 0;
+}
+
+long bal_sim_pile_count(const struct bal_pile_def *p)
+{
+    long n = 0;
+    for (long M = 0; pile_row_count(p, M) > 0; M++)
+        n += pile_row_count(p, M);
+    return n;
+}
+
+/* Lay out a pile (struct bal_pile_def documents the rules) into the arrays
+ * from index k on; returns the index after the last disc. */
+static int lay_pile(const struct bal_pile_def *p, int mat, struct disc_init *d, int k)
+{
+    const double dd = p->d, r = 0.5 * dd;
+    const double s0 = p->bottom == 1 ? dd * (1 + p->c) : dd;
+    const double s = p->bottom == 1 ? dd * fmax(1.0, 1 + p->c) : dd;
+    const double xc = p->origin[0] + r + 0.5 * (double)(p->L - 1) * s0;
+    int below = k;                   /* first disc of the previous row */
+    long n_below = 0;
+    for (long M = 0; pile_row_count(p, M) > 0; M++) {
+        const long n = pile_row_count(p, M);
+        const double spacing = M == 0 ? s0 : s;
+        double y = p->origin[1] + r;
+        if (M > 0) {
+            /* The lowest height at which no disc of this row overlaps one of
+             * the row below: touching in the hollows, exactly. */
+            y = -INFINITY;
+            for (long a = 0; a < n; a++) {
+                const double x = xc + ((double)a - 0.5 * (double)(n - 1)) * spacing;
+                for (long b = 0; b < n_below; b++) {
+                    const double dx = fabs(x - d->x[below + b]);
+                    if (dx < dd)
+                        y = fmax(y, d->y[below + b] + sqrt(dd * dd - dx * dx));
+                }
+            }
+            if (!isfinite(y))
+                y = d->y[below] + dd;
+        }
+        const int first = k;
+        for (long a = 0; a < n; a++, k++) {
+            d->x[k] = xc + ((double)a - 0.5 * (double)(n - 1)) * spacing;
+            d->y[k] = y;
+            d->r[k] = r;
+            d->mat[k] = mat;
+            d->row[k] = (int32_t)M;
+            d->fixed[k] = M == 0 && (p->bottom == 1 || a == 0 || a == n - 1);
+        }
+        below = first;
+        n_below = n;
+    }
+    return k;
+}
 
 static enum bal_status gather_discs(const struct bal_scene *sc, int n, struct disc_init *d,
                                     struct bal_error *err)
@@ -194,8 +260,11 @@ static enum bal_status gather_discs(const struct bal_scene *sc, int n, struct di
     d->w = alloc_doubles((size_t)n, &ok);
     d->mat = calloc((size_t)(n ? n : 1), sizeof *d->mat);
     d->fixed = calloc((size_t)(n ? n : 1), sizeof *d->fixed);
-    if (!ok || !d->mat || !d->fixed)
+    d->row = malloc((size_t)(n ? n : 1) * sizeof *d->row);
+    if (!ok || !d->mat || !d->fixed || !d->row)
         return bal_error(err, BAL_ENOMEM, "%s: out of memory for %d discs", sc->path, n);
+    for (int i = 0; i < n; i++)
+        d->row[i] = -1;
     int k = 0;
     for (int i = 0; i < sc->n_discs; i++, k++) {
         const struct bal_disc_def *dd = &sc->discs[i];
@@ -228,6 +297,8 @@ static enum bal_status gather_discs(const struct bal_scene *sc, int n, struct di
             d->mat[k] = m;
         }
     }
+    for (int p = 0; p < sc->n_piles; p++)
+        k = lay_pile(&sc->piles[p], bal_scene_find(sc, BAL_SEC_MATERIAL, sc->piles[p].material), d, k);
     return BAL_OK;
 }
 
@@ -242,6 +313,7 @@ static void free_init(struct disc_init *d)
     free(d->w);
     free(d->mat);
     free(d->fixed);
+    free(d->row);
 }
 
 static enum bal_status resolve_body(const struct bal_sim *s, const struct bal_scene *sc,
@@ -280,11 +352,15 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
     s->normal_law = st->normal_law;
     s->nu = st->nu;
     s->delta0 = st->delta0;
-    s->has_damping = st->beta > 0;
+    s->has_damping = st->beta > 0 || st->gamma_n > 0;
+    s->gamma_n = st->gamma_n;
+    s->psi = st->psi;
 
     long n_total = sc->n_discs;
     for (int f = 0; f < sc->n_fills; f++)
         n_total += sc->fills[f].n;
+    for (int p = 0; p < sc->n_piles; p++)
+        n_total += bal_sim_pile_count(&sc->piles[p]);
     if (n_total > 100000000L) {
         bal_sim_free(s);
         return bal_error(err, BAL_EINVAL, "%s: %ld discs; at most 100000000", sc->path, n_total);
@@ -305,6 +381,8 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
     int n_walls = sc->n_walls;
     for (int f = 0; f < sc->n_fills; f++)
         n_walls += sc->fills[f].box ? 4 : 0;
+    for (int p = 0; p < sc->n_piles; p++)
+        n_walls += sc->piles[p].bottom == 0;
     s->walls = calloc((size_t)(n_walls ? n_walls : 1), sizeof *s->walls);
     if (!s->walls) {
         bal_sim_free(s);
@@ -334,6 +412,17 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         add_wall(s, nm, ox, oy, BAL_PI / 2, 0, ht, m);
     }
 
+    for (int p = 0; p < sc->n_piles; p++) {
+        const struct bal_pile_def *pd = &sc->piles[p];
+        if (pd->bottom != 0)
+            continue;
+        /* The floor under row 0, reaching a diameter beyond the corner stones. */
+        char nm[2 * BAL_NAME_MAX];
+        snprintf(nm, sizeof nm, "%s_floor", pd->name);
+        add_wall(s, nm, pd->origin[0], pd->origin[1], 0, -pd->d, (double)(pd->L + 1) * pd->d,
+                 bal_scene_find(sc, BAL_SEC_MATERIAL, pd->wall_material));
+    }
+
     /* Discs, in cell order when the grid is used. */
     struct disc_init d = {0};
     if (gather_discs(sc, n, &d, err)) {
@@ -359,7 +448,12 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
     s->fixed = calloc((size_t)(n ? n : 1), sizeof *s->fixed);
     s->grid.cell = calloc((size_t)(n ? n : 1), sizeof *s->grid.cell);
     s->grid.list = calloc((size_t)(n ? n : 1), sizeof *s->grid.list);
-    if (!ok || !s->id || !s->slot || !s->mat || !s->fixed || !s->grid.cell || !s->grid.list) {
+    s->row = calloc((size_t)(n ? n : 1), sizeof *s->row);
+    s->moment = calloc((size_t)(4 * n + 4), sizeof *s->moment);
+    s->moment_prev = calloc((size_t)(4 * n + 4), sizeof *s->moment_prev);
+    s->log = calloc((size_t)(sc->n_stages ? sc->n_stages : 1), sizeof *s->log);
+    if (!ok || !s->id || !s->slot || !s->mat || !s->fixed || !s->grid.cell || !s->grid.list ||
+        !s->row || !s->moment || !s->moment_prev || !s->log) {
         free_init(&d);
         bal_sim_free(s);
         return bal_error(err, BAL_ENOMEM, "%s: out of memory for %d discs", sc->path, n);
@@ -386,6 +480,7 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         s->w[i] = d.w[k];
         s->mat[i] = d.mat[k];
         s->fixed[i] = d.fixed[k];
+        s->row[i] = d.row[k];
         const double density = sc->materials[d.mat[k]].density;
         s->m[i] = density * BAL_PI * d.r[k] * d.r[k];
         s->inertia[i] = 0.5 * s->m[i] * d.r[k] * d.r[k];
@@ -403,7 +498,13 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
                          s->dt);
     }
 
-    /* Law and candidates. */
+    /* Law and candidates.  Disc–disc lists carry the shear and dashpot
+     * columns only when the scene needs them; wall lists always do (walls
+     * are few, and one generic loop serves them). */
+    s->pp.shear = s->scratch_pp.shear = (uint8_t)s->has_shear;
+    s->pp.damping = s->scratch_pp.damping = (uint8_t)s->has_damping;
+    s->pw.shear = s->scratch_pw.shear = 1;
+    s->pw.damping = s->scratch_pw.damping = 1;
     s->pair_loop = bal_contacts_select(s->normal_law, s->has_shear, s->has_damping);
     if (bal_grid_rebuild(s, err)) {
         bal_sim_free(s);
@@ -431,6 +532,9 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         }
     }
     s->stage = -1;
+    s->gfac = 1;
+    for (int g = 0; g < sc->n_stages; g++)
+        s->log[g] = (struct bal_stage_log){0, 0, -1, -1};
     *out = s;
     return BAL_OK;
 }
@@ -497,6 +601,29 @@ static enum bal_status check_finite(const struct bal_sim *s, struct bal_error *e
     return BAL_OK;
 }
 
+/* The stop rule of a stage (MLH Sec. 3: "the kinetic energy has to be orders
+ * of magnitude smaller than the elastic energy ... and the stresses no longer
+ * vary with time"): record both measures and say whether the rule is met. */
+static int stop_rule_met(struct bal_sim *s, const struct bal_stage_def *g, struct bal_stage_log *log)
+{
+    const double ee = bal_measure_elastic(s);
+    log->ke_over_ee = ee > 0 ? bal_measure_kinetic(s) / ee : INFINITY;
+    int met = g->stop_ke <= 0 || log->ke_over_ee <= g->stop_ke;
+    if (g->stop_stress > 0) {
+        bal_measure_moments(s, s->moment);
+        double change = 0, size = 0;
+        for (long k = 0; k < 4L * s->n; k++) {
+            change = fmax(change, fabs(s->moment[k] - s->moment_prev[k]));
+            size = fmax(size, fabs(s->moment[k]));
+        }
+        memcpy(s->moment_prev, s->moment, 4 * (size_t)s->n * sizeof *s->moment);
+        /* The first check has nothing to compare with: not met. */
+        log->stress_change = log->stress_change < 0 ? INFINITY : (size > 0 ? change / size : 0);
+        met = met && log->stress_change <= g->stop_stress;
+    }
+    return met;
+}
+
 enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_atomic_t *stop,
                             struct bal_error *err)
 {
@@ -506,24 +633,38 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
     clock_gettime(CLOCK_MONOTONIC, &t0);
     enum bal_status status = BAL_OK;
     for (int g = 0; g < sc->n_stages && status == BAL_OK; g++) {
+        const struct bal_stage_def *stage = &sc->stages[g];
+        struct bal_stage_log *log = &s->log[g];
+        const int rule = stage->stop_ke > 0 || stage->stop_stress > 0;
         bal_sim_set_stage(s, g);
-        const long cycles = sc->stages[g].cycles;
+        const long cycles = stage->cycles;
         for (long c = 0; c < cycles; c++) {
             if (stop && *stop) {
                 status = bal_error(err, BAL_EINTR, "%s: interrupted at step %ld", sc->path,
                                    s->step);
                 break;
             }
+            if (stage->ramp)
+                s->gfac = (double)(c + 1) / (double)cycles;
+            const int check = rule && (c + 1) % stage->check_every == 0;
             const int last = g == sc->n_stages - 1 && c == cycles - 1;
             const int row = series && ((s->step + 1) % every == 0 || last);
-            if ((status = bal_sim_cycle(s, row, err)) != BAL_OK)
+            if ((status = bal_sim_cycle(s, row || check, err)) != BAL_OK)
                 break;
+            log->cycles = c + 1;
             if ((row || s->step % FINITE_CHECK_EVERY == 0) &&
                 (status = check_finite(s, err)) != BAL_OK)
                 break;
-            if (row)
+            const int done = check && stop_rule_met(s, stage, log);
+            if (row || (done && series && g == sc->n_stages - 1))
                 bal_output_series_row(s, series);
+            if (done) {
+                log->stopped = 1;
+                break;
+            }
         }
+        if (stage->ramp)
+            s->gfac = 1;
     }
     /* The periodic check may have missed the last cycles. */
     if (status == BAL_OK)
@@ -574,4 +715,32 @@ long bal_sim_find_contact(const struct bal_sim *s, int a_wall, int a, int b_wall
     const int lo = a < b ? a : b, hi = a < b ? b : a;
     *list = &s->pp;
     return find_key(&s->pp, ((uint64_t)(uint32_t)lo << 32) | (uint32_t)hi);
+}
+
+int bal_sim_disc_id(const struct bal_sim *s, int i)
+{
+    return s->id[i];
+}
+
+const char *bal_sim_wall_name(const struct bal_sim *s, int k)
+{
+    return s->walls[k].name;
+}
+
+void bal_sim_contact_point(const struct bal_sim *s, int i, int is_wall, int j, double *px,
+                           double *py)
+{
+    if (is_wall) {
+        double cx, cy;
+        const double d = sqrt(bal_walls_closest(&s->walls[j], s->x[i], s->y[i], &cx, &cy));
+        const double t = d > 0 ? 0.5 * (s->r[i] + d) / d : 0;
+        *px = s->x[i] + t * (cx - s->x[i]);
+        *py = s->y[i] + t * (cy - s->y[i]);
+        return;
+    }
+    const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
+    const double d = hypot(dx, dy), delta = s->r[i] + s->r[j] - d;
+    const double t = (s->r[i] - delta / 2) / d;
+    *px = s->x[i] + t * dx;
+    *py = s->y[i] + t * dy;
 }

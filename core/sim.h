@@ -35,15 +35,23 @@ struct bal_pair_law {
 };
 
 /* A candidate list with its contact history.  Flags: bit 0 touching,
- * bit 1 sliding (|F_s| at the Coulomb limit). */
+ * bit 1 sliding (|F_s| at the Coulomb limit).  The shear history (fs, ds)
+ * exists only when `shear` is set and the normal dashpot (dn) only when
+ * `damping` is: a frictionless, undamped scene carries neither, and its
+ * rebuilds do not copy them.  Read them through pair_fs() etc. */
 struct bal_pairs {
     long n, cap;
+    uint8_t shear, damping; /* which optional columns exist */
     uint64_t *key;         /* (lo << 32) | hi, sorted ascending */
     int32_t *i, *j;        /* disc index; j: disc index or wall index */
     double *fn, *fs;       /* F_n (history of the incremental law), F_s */
     double *dn, *ds;       /* dashpot forces D_n, D_s of the last cycle */
     uint8_t *flags;
 };
+
+static inline double pair_fs(const struct bal_pairs *p, long c) { return p->fs ? p->fs[c] : 0.0; }
+static inline double pair_ds(const struct bal_pairs *p, long c) { return p->ds ? p->ds[c] : 0.0; }
+static inline double pair_dn(const struct bal_pairs *p, long c) { return p->dn ? p->dn[c] : 0.0; }
 
 #define BAL_PAIR_TOUCHING 1u
 #define BAL_PAIR_SLIDING 2u
@@ -75,6 +83,15 @@ struct bal_grid {
 };
 
 typedef void (*bal_pair_loop_fn)(struct bal_sim *s);
+
+/* How a stage ended. */
+struct bal_stage_log {
+    long cycles;           /* cycles run */
+    int stopped;           /* 1: its stop rule was met; 0: it ran all its cycles */
+    double ke_over_ee;     /* E_k / E_el at the last check (-1: never checked) */
+    double stress_change;  /* largest change of a disc's stress moment between the
+                            * last two checks, over the largest (-1: never) */
+};
 
 /* A probe with its bodies resolved: kind, and for each body whether it is a
  * wall and its array slot (disc) or wall index. */
@@ -111,7 +128,8 @@ struct bal_sim {
 
     /* contacts and neighbours */
     struct bal_pairs pp, pw;     /* disc–disc, disc–wall candidates */
-    struct bal_pairs scratch;    /* rebuild target, swapped with pp/pw */
+    struct bal_pairs scratch_pp; /* rebuild targets, swapped with pp and pw */
+    struct bal_pairs scratch_pw;
     struct bal_grid grid;
     int use_grid;
     double skin;
@@ -125,8 +143,18 @@ struct bal_sim {
     double g[2];
     int normal_law;
     double nu, delta0;
+    double gamma_n, psi;         /* viscous normal damping of MLH eq. (3) */
     int has_shear;               /* any material pair with k_s and a non-zero cap */
     int has_damping;             /* β > 0 */
+
+    /* pile rows and stresses */
+    int32_t *row;                /* row M of a pile disc, -1 for other discs */
+    double *moment;              /* 4 per disc: Σ_c f ⊗ l (xx, xy, yx, yy), scratch */
+    double *moment_prev;         /* the same at the previous check of a stop rule */
+
+    /* stages */
+    double gfac;                 /* share of gravity applied now (the ramp) */
+    struct bal_stage_log *log;   /* one per stage of the scene */
 
     /* probes */
     int n_probes;
@@ -171,7 +199,23 @@ void bal_integrate_velocities(struct bal_sim *s, int keep_old);
 /* timestep.c */
 double bal_timestep_estimate(const struct bal_sim *s);
 
+/* measure.c */
+/* Per disc, Σ_c f^c ⊗ l^c over its contacts (MLH eq. 8 without 1/V), into
+ * m[4 i .. 4 i + 3] = xx, xz, zx, zz (z vertical). */
+void bal_measure_moments(const struct bal_sim *s, double *m);
+/* The volume V_i of MLH eq. (8) for one disc: the hexagonal cell of a disc of
+ * its size in a triangular packing, 2 sqrt(3) r^2. */
+double bal_measure_disc_volume(double r);
+
 /* sim.c */
+/* Scene-order index of the disc in slot i; name of wall k; the C&S contact
+ * point of disc i with disc or wall j (as in contacts.tsv). */
+int bal_sim_disc_id(const struct bal_sim *s, int i);
+const char *bal_sim_wall_name(const struct bal_sim *s, int k);
+void bal_sim_contact_point(const struct bal_sim *s, int i, int is_wall, int j, double *px,
+                           double *py);
+/* Number of discs a [pile] generates. */
+long bal_sim_pile_count(const struct bal_pile_def *p);
 enum bal_status bal_sim_cycle(struct bal_sim *s, int keep_old, struct bal_error *err);
 /* Candidate index of the contact between two bodies, or -1. */
 long bal_sim_find_contact(const struct bal_sim *s, int a_wall, int a, int b_wall, int b,

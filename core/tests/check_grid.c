@@ -214,6 +214,8 @@ END_TEST
 START_TEST(grid_merge_history)
 {
     struct bal_pairs old = {0}, fresh = {0};
+    /* Lists with every optional column, as a frictional, damped scene has. */
+    old.shear = old.damping = fresh.shear = fresh.damping = 1;
     int ok = bal_pairs_reserve(&old, 4) == BAL_OK && bal_pairs_reserve(&fresh, 4) == BAL_OK;
     const uint64_t ko[3] = {(0ull << 32) | 1, (0ull << 32) | 3, (2ull << 32) | 5};
     const uint64_t kf[4] = {(0ull << 32) | 1, (1ull << 32) | 2, (2ull << 32) | 5, (3ull << 32) | 4};

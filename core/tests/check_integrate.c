@@ -457,6 +457,254 @@ START_TEST(integrate_interrupted)
 }
 END_TEST
 
+/* ------------------------------------------------------------------ */
+/* Stages: gravity ramp, stop rules, skipped stages (MLH Secs 3–4)     */
+/* ------------------------------------------------------------------ */
+
+/* ramp = 1: in cycle k = 1..n of the stage gravity is scaled by k/n
+ * ("gravity is slowly increased from zero", MLH Sec. 4).  A free disc from
+ * v_{1/2} = v0 (eq. 22 with m g k/n added):
+ *   v_{k+1/2} = v0 + g Δt Σ_{i≤k} i/n = v0 + g Δt k(k+1)/(2n),
+ * so after the ramp stage v = v0 + g Δt (n+1)/2 — half the unramped gain
+ * plus half a step — and
+ *   x_n = x0 + Δt Σ_{k=0}^{n−1} v_{k+1/2} = x0 + n v0 Δt + g Δt² (n² − 1)/6.
+ * A following stage without ramp adds the full g Δt per cycle:
+ *   v = V_n + m g Δt,  x = x_n + m V_n Δt + g Δt² m(m − 1)/2. */
+START_TEST(integrate_gravity_ramp)
+{
+    const double dt = 2.7e-3, g[2] = {0.25, -9.81}, v0[2] = {0.37, 1.9};
+    const double x0[2] = {-0.35, 1.15};
+    const long n = 37, m = 11;
+    for (int with_next = 0; with_next < 2; with_next++) {
+        struct tfx *f = tfx_newf("ramp",
+                                 "[settings]\ndt = %.17g\ngravity = %.17g %.17g\n"
+                                 "[material m]\nkn = 1e4\ndensity = 2.385\n"
+                                 "[disc d]\nx = %.17g %.17g\nr = 0.3\nv = %.17g %.17g\n"
+                                 "material = m\n"
+                                 "[stage up]\ncycles = %ld\nramp = 1\n%s",
+                                 dt, g[0], g[1], x0[0], x0[1], v0[0], v0[1], n,
+                                 with_next ? "[stage on]\ncycles = 11\n" : "");
+        ck_assert_int_eq(bal_sim_run(f->sim, NULL, NULL, &f->err), BAL_OK);
+        const int i = t_slot(f, "d");
+        const struct bal_sim *s = f->sim;
+        for (int k = 0; k < 2; k++) {
+            const double vn = v0[k] + g[k] * dt * (double)(n + 1) / 2;
+            const double xn = x0[k] + (double)n * v0[k] * dt + g[k] * dt * dt * (double)(n * n - 1) / 6;
+            const double v = with_next ? vn + (double)m * g[k] * dt : vn;
+            const double x = with_next ? xn + (double)m * vn * dt + g[k] * dt * dt * (double)(m * (m - 1)) / 2
+                                       : xn;
+            ASSERT_REL(k ? s->vy[i] : s->vx[i], v);
+            ASSERT_REL(k ? s->y[i] : s->x[i], x);
+        }
+        ck_assert_double_eq(s->gfac, 1.0); /* the ramp ends with its stage */
+        ck_assert_int_eq(s->log[0].cycles, n);
+        ck_assert_int_eq(s->log[0].stopped, 0);
+        tfx_release(f);
+    }
+}
+END_TEST
+
+/* Stop rules (MLH Sec. 3: "the kinetic energy has to be orders of
+ * magnitude smaller than the elastic energy ... and the stresses no longer
+ * vary").  A scene whose measures are closed forms:
+ *   - a held disc h (R = 0.61) pressed by a floor wall moving up at
+ *     v_w = 0.0173: overlap δ_N = δ_i + N v_w Δt after cycle N (δ_i = 0.0011),
+ *     F = k_n δ (ν = 1), elastic energy E_el = k_n δ²/2;
+ *   - a free disc f (R = 0.44) coasting at u = 0.23 with no contact and no
+ *     gravity: E_k = m_f u²/2, exactly (its centred velocity is u).
+ * Checks every C = 7 cycles; at check j (cycle jC):
+ *   E_k/E_el = m_f u² / (k_n δ_j²),
+ *   the stress moment of h (measure.c): f = (0, F), l = (0, −(R − δ/2)),
+ *   μ_j = −k_n δ_j (R − δ_j/2) (the only non-zero component), and the
+ *   change recorded is |μ_j − μ_{j−1}| / |μ_j| (∞ at the first check,
+ *   which has nothing to compare with).
+ * Both measures fall monotonically with j, so a threshold is first met at
+ * the first j where the closed form is below it; the rule with both
+ * thresholds stops at the later of the two.  Thresholds are set between
+ * consecutive closed-form values, at least 2.4% from either — round-off
+ * (δ accumulates < 200 additions of 2e-5 to O(1) coordinates: < 1e-10
+ * relative) cannot move a stop. */
+#define SR_KN 3.7e4
+#define SR_R 0.61
+#define SR_RF 0.44
+#define SR_RHO 2.385
+#define SR_U 0.23
+#define SR_DI 0.0011
+#define SR_VW 0.0173
+#define SR_DT 1.3e-3
+#define SR_C 7
+/* The values recorded in the log: ratios of closed forms evaluated from
+ * positions that carry < 1e-10 relative round-off (see above). */
+#define SR_LOG_REL 1e-9
+
+static double sr_delta(long j)
+{
+    return SR_DI + (double)(j * SR_C) * SR_VW * SR_DT;
+}
+
+static double sr_ke_over_ee(long j)
+{
+    const double mf = SR_RHO * BAL_PI * SR_RF * SR_RF, d = sr_delta(j);
+    return mf * SR_U * SR_U / (SR_KN * d * d);
+}
+
+static double sr_stress_change(long j)
+{
+    const double d = sr_delta(j), dp = sr_delta(j - 1);
+    const double mu = SR_KN * d * (SR_R - d / 2), mup = SR_KN * dp * (SR_R - dp / 2);
+    return fabs(mu - mup) / mu;
+}
+
+/* First check j at which the rule (thresholds 0 = off) holds; 0 if none up
+ * to check jmax. */
+static long sr_first(double stop_ke, double stop_stress, long jmax)
+{
+    for (long j = 1; j <= jmax; j++) {
+        const int ke = stop_ke <= 0 || sr_ke_over_ee(j) <= stop_ke;
+        const int st = stop_stress <= 0 || (j >= 2 && sr_stress_change(j) <= stop_stress);
+        if (ke && st)
+            return j;
+    }
+    return 0;
+}
+
+/* `after`: the stages that follow the pressing stage. */
+#define SR_AFTER "[stage after]\ncycles = 5\n"
+
+static struct tfx *sr_scene(long cycles, double stop_ke, double stop_stress, const char *after)
+{
+    const double yh = 0.8;
+    return tfx_newf("stop",
+                    "[settings]\ndt = %.17g\nnormal_law = power\n"
+                    "[material m]\nkn = %.17g\ndensity = %.17g\n"
+                    "[wall floor]\np = -1 %.17g\nangle = 0\nh1 = 0\nh2 = 2.7\nmaterial = m\n"
+                    "[disc h]\nx = 0.35 %.17g\nr = %.17g\nfixed = 1\nmaterial = m\n"
+                    "[disc f]\nx = 0.35 5\nr = %.17g\nv = %.17g 0\nmaterial = m\n"
+                    "[stage press]\ncycles = %ld\nmove = floor 0 %.17g 0\n"
+                    "stop_ke = %.17g\nstop_stress = %.17g\ncheck_every = %d\n%s",
+                    SR_DT, SR_KN, SR_RHO, yh - SR_R + SR_DI, yh, SR_R, SR_RF, SR_U, cycles, SR_VW,
+                    stop_ke, stop_stress, SR_C, after);
+}
+
+START_TEST(integrate_stop_rule)
+{
+    static const struct {
+        double stop_ke, stop_stress;
+        long expect_j;   /* the check the closed forms stop at */
+    } cases[] = {
+        {0.35, 0, 9},        /* E_k/E_el: 0.3725 at j = 8, 0.3274 at j = 9 */
+        {0, 0.0513, 13},     /* change: 0.05254 at j = 12, 0.04991 at j = 13 */
+        {0.35, 0.0513, 13},  /* both: the later */
+        {0.2, 0.0513, 14},   /* E_k/E_el: 0.2095 at j = 13, 0.1900 at j = 14 */
+    };
+    const long max_cycles = 200;
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        const long j = sr_first(cases[k].stop_ke, cases[k].stop_stress, max_cycles / SR_C);
+        ck_assert_int_eq(j, cases[k].expect_j); /* the closed forms, as commented */
+        struct tfx *f = sr_scene(max_cycles, cases[k].stop_ke, cases[k].stop_stress, SR_AFTER);
+        ck_assert_int_eq(bal_sim_run(f->sim, NULL, NULL, &f->err), BAL_OK);
+        const struct bal_stage_log *log = f->sim->log;
+        ck_assert_int_eq(log[0].stopped, 1);
+        ck_assert_int_eq(log[0].cycles, j * SR_C);
+        ck_assert_double_eq_tol(log[0].ke_over_ee, sr_ke_over_ee(j), SR_LOG_REL * sr_ke_over_ee(j));
+        if (cases[k].stop_stress > 0)
+            ck_assert_double_eq_tol(log[0].stress_change, sr_stress_change(j),
+                                    SR_LOG_REL * sr_stress_change(j));
+        else
+            ck_assert_double_eq(log[0].stress_change, -1.0); /* never measured */
+        /* the next stage runs in full, with the wall at rest */
+        ck_assert_int_eq(log[1].cycles, 5);
+        ck_assert_int_eq(log[1].stopped, 0);
+        ck_assert_int_eq(f->sim->step, j * SR_C + 5);
+        ck_assert_double_eq_tol(f->sim->walls[0].p[1], 0.8 - SR_R + sr_delta(j), 1e-12);
+        tfx_release(f);
+    }
+}
+END_TEST
+
+/* Each stage's stress rule starts afresh: its first check has nothing to
+ * compare with, even though the previous stage left a snapshot.  After
+ * `press` stops at j = 13, `rest` holds the wall still, so every moment
+ * stays μ_13 exactly: a comparison with the previous stage's snapshot would
+ * give 0 and stop at its first check (cycle 3); the rule stops at its second
+ * check (cycle 6) with the change exactly 0 and E_k/E_el at δ_13. */
+START_TEST(integrate_stop_rule_per_stage)
+{
+    struct tfx *f = sr_scene(200, 0, 0.0513,
+                             "[stage rest]\ncycles = 100\nstop_stress = 0.0513\ncheck_every = 3\n");
+    ck_assert_int_eq(bal_sim_run(f->sim, NULL, NULL, &f->err), BAL_OK);
+    const struct bal_stage_log *log = f->sim->log;
+    ck_assert_int_eq(log[0].cycles, 13 * SR_C);
+    ck_assert_int_eq(log[1].stopped, 1);
+    ck_assert_int_eq(log[1].cycles, 6);
+    ck_assert_double_eq(log[1].stress_change, 0.0);
+    ck_assert_double_eq_tol(log[1].ke_over_ee, sr_ke_over_ee(13), SR_LOG_REL * sr_ke_over_ee(13));
+    ck_assert_int_eq(f->sim->step, 13 * SR_C + 6);
+}
+END_TEST
+
+/* A rule never met runs all its cycles and says so: thresholds below every
+ * value reached, 40 cycles (checks at 7 … 35, the last is j = 5); the log
+ * keeps the measures of that last check.  And check_every defaults to 100:
+ * a rule met at every check stops at cycle 100 of 250. */
+START_TEST(integrate_stop_rule_never_met)
+{
+    struct tfx *f = sr_scene(40, 0.01, 1e-6, SR_AFTER);
+    ck_assert_int_eq(bal_sim_run(f->sim, NULL, NULL, &f->err), BAL_OK);
+    const struct bal_stage_log *log = f->sim->log;
+    ck_assert_int_eq(log[0].stopped, 0);
+    ck_assert_int_eq(log[0].cycles, 40);
+    ck_assert_double_eq_tol(log[0].ke_over_ee, sr_ke_over_ee(5), SR_LOG_REL * sr_ke_over_ee(5));
+    ck_assert_double_eq_tol(log[0].stress_change, sr_stress_change(5),
+                            SR_LOG_REL * sr_stress_change(5));
+    ck_assert_int_eq(f->sim->step, 45);
+    tfx_release(f);
+
+    f = tfx_newf("default",
+                 "[settings]\ndt = %.17g\nnormal_law = power\n"
+                 "[material m]\nkn = %.17g\ndensity = %.17g\n"
+                 "[wall floor]\np = -1 0.1911\nangle = 0\nh1 = 0\nh2 = 2.7\nmaterial = m\n"
+                 "[disc h]\nx = 0.35 0.8\nr = %.17g\nfixed = 1\nmaterial = m\n"
+                 "[disc f]\nx = 0.35 5\nr = %.17g\nv = %.17g 0\nmaterial = m\n"
+                 "[stage s]\ncycles = 250\nstop_ke = 1e9\n",
+                 SR_DT, SR_KN, SR_RHO, SR_R, SR_RF, SR_U);
+    ck_assert_int_eq(bal_sim_run(f->sim, NULL, NULL, &f->err), BAL_OK);
+    ck_assert_int_eq(f->sim->log[0].stopped, 1);
+    ck_assert_int_eq(f->sim->log[0].cycles, 100);
+    ck_assert_int_eq(f->sim->step, 100);
+}
+END_TEST
+
+/* A stage with cycles = 0 is skipped: no cycle, no check of its stop rule,
+ * its ramp and wall motion never applied (log: 0 cycles, not stopped, the
+ * measures −1 = never checked).  The next stage then runs at full gravity
+ * with the wall at rest: v = v0 + 9 g Δt. */
+START_TEST(integrate_stage_zero_cycles_skipped)
+{
+    const double dt = 1.3e-3, gy = -9.81, vy0 = 0.41;
+    struct tfx *f = tfx_newf("skip",
+                             "[settings]\ndt = %.17g\ngravity = 0 %.17g\n"
+                             "[material m]\nkn = 1e4\ndensity = 2.385\n"
+                             "[wall w]\np = -3 -3\nangle = 0\nh1 = 0\nh2 = 1\nmaterial = m\n"
+                             "[disc d]\nx = 0.5 1.25\nr = 0.3\nv = 0 %.17g\nmaterial = m\n"
+                             "[stage none]\ncycles = 0\nramp = 1\nstop_ke = 1e9\ncheck_every = 1\n"
+                             "move = w 0.5 0.25 0\n"
+                             "[stage run]\ncycles = 9\n",
+                             dt, gy, vy0);
+    ck_assert_int_eq(bal_sim_run(f->sim, NULL, NULL, &f->err), BAL_OK);
+    const struct bal_sim *s = f->sim;
+    ck_assert_int_eq(s->log[0].cycles, 0);
+    ck_assert_int_eq(s->log[0].stopped, 0);
+    ck_assert_double_eq(s->log[0].ke_over_ee, -1.0);
+    ck_assert_double_eq(s->log[0].stress_change, -1.0);
+    ck_assert_int_eq(s->log[1].cycles, 9);
+    ck_assert_int_eq(s->step, 9);
+    ck_assert_double_eq(s->walls[0].p[0], -3.0);
+    ck_assert_double_eq(s->walls[0].p[1], -3.0);
+    ASSERT_REL(s->vy[t_slot(f, "d")], vy0 + 9 * gy * dt);
+}
+END_TEST
+
 Suite *suite_integrate(void)
 {
     Suite *s = suite_create("integrate");
@@ -484,6 +732,15 @@ Suite *suite_integrate(void)
     tcase_add_test(tc, integrate_unstable_short_run_with_series);
     tcase_add_test(tc, integrate_unstable_short_run_without_series);
     tcase_add_test(tc, integrate_interrupted);
+    suite_add_tcase(s, tc);
+
+    tc = tcase_create("stages");
+    tcase_add_checked_fixture(tc, NULL, tfx_teardown);
+    tcase_add_test(tc, integrate_gravity_ramp);
+    tcase_add_test(tc, integrate_stop_rule);
+    tcase_add_test(tc, integrate_stop_rule_per_stage);
+    tcase_add_test(tc, integrate_stop_rule_never_met);
+    tcase_add_test(tc, integrate_stage_zero_cycles_skipped);
     suite_add_tcase(s, tc);
     return s;
 }

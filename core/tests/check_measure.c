@@ -14,6 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <unistd.h>
+
 #include "check_main.h"
 
 /* A few dozen O(1) operations (see check_integrate.c). */
@@ -224,6 +226,335 @@ START_TEST(measure_series_rows)
 }
 END_TEST
 
+/* ------------------------------------------------------------------ */
+/* Stress of MLH eq. (8) and the probes of held discs and weight       */
+/* ------------------------------------------------------------------ */
+
+/* MLH eq. (8): σ_αβ = (1/V) Σ_c f_α^c l_β^c over the contacts of one disc,
+ * f^c the force on the disc, l^c from its centre to the contact point (the
+ * middle of the overlap: |l| = R − δ/2 for equal radii), V = 2√3 R²
+ * (measure.c).  A compressive contact pushes the disc along −e (e towards
+ * the neighbour) while l runs along +e, so f ⊗ l = −F l e ⊗ e: the core's
+ * tensor is tension-positive, compression negative.
+ *
+ * The scenes are static: a free centre disc at rest among held discs with
+ * set overlaps, no gravity, normal_law = power, ν = 1 (F = k_n δ); after one
+ * cycle nothing has moved (v_{1/2} = 0), so every contact force is k_n δ of
+ * the set overlap. */
+#define ST_KN 3.7e4
+#define ST_R 0.61
+#define ST_RHO 2.385
+
+/* Components of O(1) moments summed over ≤ 6 contacts, each from an overlap
+ * with ~1e-14 relative round-off (OVERLAP_REL): 1e-12 of the largest
+ * component bounds the error of every component, including those that
+ * cancel to zero. */
+#define STRESS_REL 1e-12
+/* Angles from atan2 of such components, in degrees. */
+#define ANGLE_TOL_DEG 1e-9
+
+/* Everything bal_output_state writes, to clean the temporary directory. */
+static const char *const state_files[] = {"stress.tsv", "stress_grid.tsv", "contacts.tsv",
+                                          "discs.tsv", "walls.tsv"};
+
+static void remove_state_dir(const char *dir)
+{
+    char path[1024];
+    for (size_t k = 0; k < sizeof state_files / sizeof state_files[0]; k++) {
+        snprintf(path, sizeof path, "%s/%s", dir, state_files[k]);
+        remove(path);
+    }
+    rmdir(dir);
+}
+
+/* Split a TSV line in place into at most `max` fields; returns the count. */
+static int split_tab(char *line, char **field, int max)
+{
+    int n = 0;
+    line[strcspn(line, "\r\n")] = '\0';
+    for (char *p = line; n < max;) {
+        field[n++] = p;
+        char *tab = strchr(p, '\t');
+        if (!tab)
+            break;
+        *tab = '\0';
+        p = tab + 1;
+    }
+    return n;
+}
+
+/* Read the row of `path` whose column `name` is `who`: the numbers in the
+ * columns `cols` into out[].  Returns the number of such rows (1 expected);
+ * columns missing from the header give NAN. */
+static int read_tsv_row(const char *path, const char *who, int ncols, const char *const *cols,
+                        double *out)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return -1;
+    char *line = NULL;
+    size_t cap = 0;
+    char *field[64];
+    int idx[16], name_col = -1, found = 0;
+    for (int k = 0; k < ncols; k++) {
+        idx[k] = -1;
+        out[k] = NAN;
+    }
+    if (getline(&line, &cap, f) > 0) {
+        const int n = split_tab(line, field, 64);
+        for (int a = 0; a < n; a++) {
+            if (strcmp(field[a], "name") == 0)
+                name_col = a;
+            for (int k = 0; k < ncols; k++)
+                if (strcmp(field[a], cols[k]) == 0)
+                    idx[k] = a;
+        }
+    }
+    while (name_col >= 0 && getline(&line, &cap, f) > 0) {
+        const int n = split_tab(line, field, 64);
+        if (n <= name_col || strcmp(field[name_col], who) != 0)
+            continue;
+        found++;
+        for (int k = 0; k < ncols; k++)
+            if (idx[k] >= 0 && idx[k] < n)
+                out[k] = strtod(field[idx[k]], NULL);
+    }
+    free(line);
+    fclose(f);
+    return found;
+}
+
+/* The stress.tsv row of disc `who` after bal_output_state into a fresh
+ * temporary directory (removed again before returning). */
+enum { S_V, S_XX, S_XZ, S_ZX, S_ZZ, S_MAX, S_MIN, S_PHI, S_N };
+
+static int stress_row(const struct tfx *f, const char *who, double out[S_N])
+{
+    static const char *const cols[S_N] = {"V", "sxx", "sxz", "szx", "szz", "smax", "smin", "phi"};
+    char dir[] = "/tmp/ballast_check_XXXXXX";
+    if (!mkdtemp(dir))
+        return -2;
+    struct bal_error err = {0};
+    int found = -3;
+    if (bal_output_state(f->sim, dir, &err) == BAL_OK) {
+        char path[1024];
+        snprintf(path, sizeof path, "%s/stress.tsv", dir);
+        found = read_tsv_row(path, who, S_N, cols, out);
+    }
+    remove_state_dir(dir);
+    return found;
+}
+
+/* A free centre disc c with held neighbours n0, n1, ... at the given angles
+ * (degrees) and overlaps. */
+static struct tfx *star(int n, const double *angle_deg, const double *overlap)
+{
+    char text[T_TEXT_MAX];
+    const double cx = 0.35, cy = -0.42;
+    int len = snprintf(text, sizeof text,
+                       "[settings]\ndt = 1e-5\nnormal_law = power\n"
+                       "[material m]\nkn = %.17g\ndensity = %.17g\n"
+                       "[disc c]\nx = %.17g %.17g\nr = %.17g\nmaterial = m\n"
+                       "[stage s]\ncycles = 1\n",
+                       ST_KN, ST_RHO, cx, cy, ST_R);
+    for (int k = 0; k < n; k++) {
+        const double a = angle_deg[k] * BAL_PI / 180, d = 2 * ST_R - overlap[k];
+        len += snprintf(text + len, sizeof text - (size_t)len,
+                        "[disc n%d]\nx = %.17g %.17g\nr = %.17g\nfixed = 1\nmaterial = m\n", k,
+                        cx + d * cos(a), cy + d * sin(a), ST_R);
+    }
+    ck_assert_int_lt(len, (int)sizeof text);
+    return tfx_new(text, "star");
+}
+
+/* Six equal contacts at 60° (a hexagonal cell, rotated by 17.3°), overlap
+ * δ = 0.0137: F = k_n δ, l = R − δ/2, and since Σ_c e_c ⊗ e_c = 3 I for six
+ * directions 60° apart,
+ *   σ = −(1/V) F l Σ e_c ⊗ e_c = −(3 F l / V) I,  V = 2√3 R²:
+ * isotropic, σ_xx = σ_zz = σ_max = σ_min = −3Fl/V, σ_xz = σ_zx = 0.  (The
+ * held ring discs also overlap each other — the hexagon's side equals its
+ * radius, 2R − δ — which does not enter the centre disc's sum.) */
+START_TEST(measure_stress_hexagonal_isotropic)
+{
+    const double delta = 0.0137;
+    double ang[6], ov[6];
+    for (int k = 0; k < 6; k++) {
+        ang[k] = 17.3 + 60.0 * k;
+        ov[k] = delta;
+    }
+    struct tfx *f = star(6, ang, ov);
+    t_steps(f, 1);
+    const double F = ST_KN * delta, l = ST_R - delta / 2, vol = 2 * sqrt(3.0) * ST_R * ST_R;
+    const double sigma = -3 * F * l / vol, tol = STRESS_REL * fabs(sigma);
+
+    /* the moments Σ f ⊗ l directly */
+    const struct bal_sim *s = f->sim;
+    double *m = malloc(4 * (size_t)s->n * sizeof *m);
+    ck_assert_ptr_nonnull(m);
+    bal_measure_moments(s, m);
+    const int i = t_slot(f, "c");
+    double mc[4];
+    memcpy(mc, m + 4 * i, sizeof mc);
+    free(m);
+    ck_assert_double_eq_tol(bal_measure_disc_volume(ST_R), vol, 1e-15 * vol);
+    ck_assert_double_eq_tol(mc[0] / vol, sigma, tol);
+    ck_assert_double_eq_tol(mc[1] / vol, 0.0, tol);
+    ck_assert_double_eq_tol(mc[2] / vol, 0.0, tol);
+    ck_assert_double_eq_tol(mc[3] / vol, sigma, tol);
+
+    /* the same through stress.tsv (written with %.17g: read back exactly) */
+    double row[S_N];
+    ck_assert_int_eq(stress_row(f, "c", row), 1);
+    ck_assert_double_eq_tol(row[S_V], vol, 1e-15 * vol);
+    ck_assert_double_eq_tol(row[S_XX], sigma, tol);
+    ck_assert_double_eq_tol(row[S_ZZ], sigma, tol);
+    ck_assert_double_eq_tol(row[S_XZ], 0.0, tol);
+    ck_assert_double_eq_tol(row[S_ZX], 0.0, tol);
+    ck_assert_double_eq_tol(row[S_MAX], sigma, tol);
+    ck_assert_double_eq_tol(row[S_MIN], sigma, tol);
+    ck_assert(sigma < 0); /* compression is negative */
+}
+END_TEST
+
+/* Anisotropic: two contacts along e at a = 71.3° (overlap δ1 = 0.0137) and
+ * two along t = (−sin a, cos a) (δ2 = 0.0052).  With F_k = k_n δ_k,
+ * l_k = R − δ_k/2, X_k = 2 F_k l_k / V:
+ *   σ = −X1 e ⊗ e − X2 t ⊗ t,
+ *   σ_xx = −X1 cos²a − X2 sin²a,  σ_zz = −X1 sin²a − X2 cos²a,
+ *   σ_xz = σ_zx = −(X1 − X2) sin a cos a;
+ * principal values σ_max = −X2 (axis t, at a + 90° = 161.3°) and
+ * σ_min = −X1 (axis e, at a), X1 > X2.
+ *
+ * The angle.  Eq. (9)'s first form, φ = arctan[(σ_max − σ_xx)/σ_xz], is the
+ * axis of σ_max; applied to the core's tension-positive tensor that is the
+ * least compressive axis, a + 90° — stress.tsv's phi (output.c: "the angle
+ * of the major axis", i.e. of its smax).  MLH plot stresses compression
+ * positive (Figs 3, 6, 7: S_max is the largest compression), where the
+ * same formula gives the most compressive axis a; eq. (9)'s second form,
+ * π/2 + ½ arctan[2σ_xz/(σ_xx − σ_zz)], gives a on either sign convention
+ * here.  So MLH's φ = phi − 90° (mod 180°), the conversion harness/piles.py
+ * applies; both are checked. */
+START_TEST(measure_stress_anisotropic_principal)
+{
+    const double a_deg = 71.3, d1 = 0.0137, d2 = 0.0052;
+    const double ang[4] = {a_deg, a_deg + 180, a_deg + 90, a_deg + 270};
+    const double ov[4] = {d1, d1, d2, d2};
+    struct tfx *f = star(4, ang, ov);
+    t_steps(f, 1);
+    const double vol = 2 * sqrt(3.0) * ST_R * ST_R, a = a_deg * BAL_PI / 180;
+    const double X1 = 2 * ST_KN * d1 * (ST_R - d1 / 2) / vol;
+    const double X2 = 2 * ST_KN * d2 * (ST_R - d2 / 2) / vol;
+    const double ca = cos(a), sa = sin(a);
+    const double sxx = -X1 * ca * ca - X2 * sa * sa, szz = -X1 * sa * sa - X2 * ca * ca;
+    const double sxz = -(X1 - X2) * sa * ca, tol = STRESS_REL * X1;
+    double row[S_N];
+    ck_assert_int_eq(stress_row(f, "c", row), 1);
+    ck_assert_double_eq_tol(row[S_XX], sxx, tol);
+    ck_assert_double_eq_tol(row[S_ZZ], szz, tol);
+    ck_assert_double_eq_tol(row[S_XZ], sxz, tol);
+    ck_assert_double_eq_tol(row[S_ZX], sxz, tol); /* frictionless: symmetric (MLH Sec. 3) */
+    ck_assert_double_eq_tol(row[S_MAX], -X2, tol);
+    ck_assert_double_eq_tol(row[S_MIN], -X1, tol);
+    /* the core's phi: axis of smax, a + 90° */
+    ck_assert_double_eq_tol(row[S_PHI], a_deg + 90, ANGLE_TOL_DEG);
+    /* eq. (9), first form, on the tension-positive tensor read back */
+    double phi1 = atan((row[S_MAX] - row[S_XX]) / row[S_XZ]) * 180 / BAL_PI;
+    phi1 = fmod(phi1 + 180, 180);
+    ck_assert_double_eq_tol(phi1, row[S_PHI], ANGLE_TOL_DEG);
+    /* MLH's φ (most compressive axis): a = phi − 90°, and the second form */
+    const double phi2 =
+        90 + 0.5 * atan(2 * row[S_XZ] / (row[S_XX] - row[S_ZZ])) * 180 / BAL_PI;
+    ck_assert_double_eq_tol(fmod(row[S_PHI] + 90, 180), a_deg, ANGLE_TOL_DEG);
+    ck_assert_double_eq_tol(phi2, a_deg, ANGLE_TOL_DEG);
+}
+END_TEST
+
+/* Probes held_fx, held_fy (Σ of the force sums of held discs) and weight_x,
+ * weight_y (Σ m g over free discs, times the ramp).  A free disc c
+ * (R = 0.44) rests on held a (R = 0.61, at 235° from c, overlap 0.0137) and
+ * held b (R = 0.53, at 310°, overlap 0.0089); a also presses into a floor
+ * wall by 0.0061; a and b do not touch (gap 0.077); a free disc e flies
+ * elsewhere.  Gravity (0.37, −9.81), ν = 1.  After one cycle from rest:
+ *   held_f = k_n δ_a u_a + k_n δ_b u_b + k_n δ_w (0, 1),
+ * u the unit vector from c to the held disc (c pushes it away), and
+ *   weight = (m_c + m_e) g. */
+START_TEST(measure_held_and_weight_probes)
+{
+    const double g[2] = {0.37, -9.81}, ra = 0.61, rb = 0.53, rc = 0.44, re = 0.29;
+    const double da = 0.0137, db = 0.0089, dw = 0.0061;
+    const double c[2] = {0.35, 1.6};
+    const double ua[2] = {cos(235 * BAL_PI / 180), sin(235 * BAL_PI / 180)};
+    const double ub[2] = {cos(310 * BAL_PI / 180), sin(310 * BAL_PI / 180)};
+    const double a[2] = {c[0] + (rc + ra - da) * ua[0], c[1] + (rc + ra - da) * ua[1]};
+    const double b[2] = {c[0] + (rc + rb - db) * ub[0], c[1] + (rc + rb - db) * ub[1]};
+    ck_assert(hypot(b[0] - a[0], b[1] - a[1]) > ra + rb + 0.05);
+    struct tfx *f = tfx_newf(
+        "held",
+        "[settings]\ndt = 1e-5\nnormal_law = power\ngravity = %.17g %.17g\n"
+        "[material m]\nkn = %.17g\ndensity = %.17g\n"
+        "[wall floor]\np = -1.5 %.17g\nangle = 0\nh1 = 0\nh2 = 3\nmaterial = m\n"
+        "[disc c]\nx = %.17g %.17g\nr = %.17g\nmaterial = m\n"
+        "[disc a]\nx = %.17g %.17g\nr = %.17g\nfixed = 1\nmaterial = m\n"
+        "[disc b]\nx = %.17g %.17g\nr = %.17g\nfixed = 1\nmaterial = m\n"
+        "[disc e]\nx = 3.5 4.2\nr = %.17g\nmaterial = m\n"
+        "[stage s]\ncycles = 1\n"
+        "[probe hx]\nquantity = held_fx\n[probe hy]\nquantity = held_fy\n"
+        "[probe wx]\nquantity = weight_x\n[probe wy]\nquantity = weight_y\n",
+        g[0], g[1], ST_KN, ST_RHO, a[1] - ra + dw, c[0], c[1], rc, a[0], a[1], ra, b[0], b[1], rb,
+        re);
+    t_steps(f, 1);
+    const double fa = ST_KN * da, fb = ST_KN * db, fw = ST_KN * dw;
+    const double hx = fa * ua[0] + fb * ub[0], hy = fa * ua[1] + fb * ub[1] + fw;
+    const double mfree = ST_RHO * BAL_PI * (rc * rc + re * re);
+    const double scale = fa + fb + fw;
+    ck_assert_double_eq_tol(t_probe_value(f, "hx"), hx, STRESS_REL * scale);
+    ck_assert_double_eq_tol(t_probe_value(f, "hy"), hy, STRESS_REL * scale);
+    ASSERT_REL(t_probe_value(f, "wx"), mfree * g[0]);
+    ASSERT_REL(t_probe_value(f, "wy"), mfree * g[1]);
+}
+END_TEST
+
+/* weight_y follows the gravity ramp: a stage of n = 5 cycles with ramp = 1
+ * applies the share (k + 1)/n in its cycle k (0-based), and the series row
+ * written after that cycle reads m g (k + 1)/n; the following stage applies
+ * all of it. */
+START_TEST(measure_weight_follows_ramp)
+{
+    const double gy = -9.81, r = 0.44;
+    struct tfx *f = tfx_newf("ramp",
+                             "[settings]\ndt = 1.3e-3\ngravity = 0 %.17g\n"
+                             "[material m]\nkn = 1e4\ndensity = %.17g\n"
+                             "[disc d]\nx = 0.5 1.25\nr = %.17g\nmaterial = m\n"
+                             "[stage up]\ncycles = 5\nramp = 1\n[stage on]\ncycles = 2\n"
+                             "[probe wy]\nquantity = weight_y\n",
+                             gy, ST_RHO, r);
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *out = open_memstream(&buf, &len);
+    ck_assert_ptr_nonnull(out);
+    bal_output_series_header(f->sim, out);
+    const enum bal_status st = bal_sim_run(f->sim, out, NULL, &f->err);
+    fclose(out);
+    long cycle[8] = {0};
+    double w[8] = {0};
+    int rows = 0;
+    for (char *line = strchr(buf, '\n'); line && line[1] && rows < 8; line = strchr(line + 1, '\n')) {
+        double time;
+        if (sscanf(line + 1, "%ld %lf %lf", &cycle[rows], &time, &w[rows]) != 3)
+            break;
+        rows++;
+    }
+    free(buf);
+    ck_assert_int_eq(st, BAL_OK);
+    ck_assert_int_eq(rows, 7);
+    const double mg = ST_RHO * BAL_PI * r * r * gy;
+    for (int k = 0; k < 7; k++) {
+        ck_assert_int_eq(cycle[k], k + 1);
+        ASSERT_REL(w[k], k < 5 ? mg * (k + 1) / 5.0 : mg);
+    }
+}
+END_TEST
+
 Suite *suite_measure(void)
 {
     Suite *s = suite_create("measure");
@@ -241,6 +572,14 @@ Suite *suite_measure(void)
     tcase_add_test(tc, measure_contact_count);
     tcase_add_test(tc, measure_disc_probes);
     tcase_add_test(tc, measure_series_rows);
+    suite_add_tcase(s, tc);
+
+    tc = tcase_create("stress");
+    tcase_add_checked_fixture(tc, NULL, tfx_teardown);
+    tcase_add_test(tc, measure_stress_hexagonal_isotropic);
+    tcase_add_test(tc, measure_stress_anisotropic_principal);
+    tcase_add_test(tc, measure_held_and_weight_probes);
+    tcase_add_test(tc, measure_weight_follows_ramp);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -274,6 +274,8 @@ static const struct bad_scene bad_scenes[] = {
      "bad:3: density: -2.385 is out of range"},
     {"not an integer", HEAD "[stage s]\ncycles = 2.5\n", 'p',
      "bad:9: cycles: expected an integer, got '2.5'"},
+    {"psi without delta0", "[settings]\ngamma_n = 2.5\npsi = 0.5\n" "[material g]\nkn = 1e3\ndensity = 1\n"
+     "[disc a]\nx = 0 0\nr = 1\nmaterial = g\n[stage s]\ncycles = 1\n", 'v', "bad:3: delta0: required with psi"},
     {"negative cycles", HEAD "[stage s]\ncycles = -1\n", 'p', "bad:9: cycles: -1 is out of range"},
     {"unknown word", "[settings]\nnormal_law = hertz\n", 'p',
      "bad:2: normal_law: expected one of {incremental power}, got 'hertz'"},
@@ -455,6 +457,302 @@ START_TEST(scene_long_line_refused)
 }
 END_TEST
 
+/* ------------------------------------------------------------------ */
+/* The [pile] generator (MLH Sec. 4, Fig. 2)                           */
+/* ------------------------------------------------------------------ */
+
+/* Disc counts (MLH Sec. 4): row M holds L − 3M discs (slope 30) or L − M
+ * (slope 60), so
+ *   H30 = int((L − 1)/3) + 1,  N30 = H30 (L − 3 (H30 − 1)/2),
+ *   H60 = L,                   N60 = L (L + 1)/2,
+ * e.g. L = 16 → N30 = 6 · 8.5 = 51 (the exact-solution pile of Sec. 4.2),
+ * L = 100 → N30 = 34 · 50.5 = 1717 (Sec. 4.3).  In integers,
+ * N30 = H30 (2L − 3 (H30 − 1)) / 2. */
+static long pile_n30(long L)
+{
+    const long H = (L - 1) / 3 + 1;
+    return H * (2 * L - 3 * (H - 1)) / 2;
+}
+
+START_TEST(scene_pile_counts)
+{
+    ck_assert_int_eq(pile_n30(16), 51);
+    ck_assert_int_eq(pile_n30(100), 1717);
+    for (long L = 1; L <= 101; L++) {
+        struct bal_pile_def p;
+        memset(&p, 0, sizeof p);
+        p.L = L;
+        p.d = 0.83;
+        p.slope = 0;
+        ck_assert_msg(bal_sim_pile_count(&p) == pile_n30(L), "slope 30, L = %ld: %ld discs", L,
+                      bal_sim_pile_count(&p));
+        p.slope = 1;
+        ck_assert_msg(bal_sim_pile_count(&p) == L * (L + 1) / 2, "slope 60, L = %ld: %ld discs", L,
+                      bal_sim_pile_count(&p));
+    }
+}
+END_TEST
+
+/* Lattice tolerances.  Positions are sums and square roots of O(1)–O(100)
+ * numbers, each row built from the one below: a distance of O(d) carries
+ * a few ulps of the coordinates (≤ ~1e-14 for x up to ~100 d), so 1e-12 d
+ * is a round-off bound, far below any misplaced disc. */
+#define LATTICE_REL 1e-12
+
+/* Checks shared by every pile: for each disc of row M > 0, no disc of row
+ * M − 1 is closer than d (no overlap), and its `supports` (the two nearest
+ * discs of row M − 1) lie at exactly d when `seated` (each disc in a
+ * hollow); otherwise at least one disc of the row touches the row below
+ * (each row at the lowest height where it does not overlap).  Rows are
+ * symmetric about the pile's centre xc and at one height each; row M has
+ * `per_row(M)` discs.  Returns the number of rows. */
+static int check_pile_rows(const struct bal_sim *s, double d, double xc, int seated, int slope60,
+                           long L)
+{
+    const double tol = LATTICE_REL * d;
+    int rows = 0;
+    for (int i = 0; i < s->n; i++)
+        rows = s->row[i] + 1 > rows ? s->row[i] + 1 : rows;
+    for (int M = 0; M < rows; M++) {
+        long count = 0;
+        double xsum = 0, y = NAN;
+        int touching = 0;
+        for (int i = 0; i < s->n; i++) {
+            if (s->row[i] != M)
+                continue;
+            count++;
+            xsum += s->x[i] - xc;
+            if (isnan(y))
+                y = s->y[i];
+            ck_assert_double_eq_tol(s->y[i], y, tol); /* one height per row */
+            if (M == 0)
+                continue;
+            double near1 = INFINITY, near2 = INFINITY;
+            for (int j = 0; j < s->n; j++) {
+                if (s->row[j] != M - 1)
+                    continue;
+                const double dist = hypot(s->x[j] - s->x[i], s->y[j] - s->y[i]);
+                ck_assert_msg(dist >= d - tol, "row %d: disc at x = %g overlaps the row below by %g",
+                              M, s->x[i], d - dist);
+                if (dist < near1) {
+                    near2 = near1;
+                    near1 = dist;
+                } else if (dist < near2) {
+                    near2 = dist;
+                }
+            }
+            if (seated) {
+                ck_assert_msg(fabs(near1 - d) <= tol && fabs(near2 - d) <= tol,
+                              "row %d, x = %g: supports at %.17g and %.17g, expected d = %.17g", M,
+                              s->x[i], near1, near2, d);
+            }
+            touching |= fabs(near1 - d) <= tol;
+        }
+        ck_assert_int_eq(count, L - (slope60 ? 1 : 3) * M);
+        ck_assert_double_eq_tol(xsum / (double)count, 0.0, tol); /* symmetric about xc */
+        if (M > 0)
+            ck_assert_msg(touching, "row %d floats above the row below", M);
+    }
+    return rows;
+}
+
+/* Height of row M above row 0 when every row sits in the hollows of the
+ * row below at horizontal spacing s: each step is √(d² − s²/4); for s = d
+ * the triangular lattice, √3/2 d. */
+static double seated_height(int M, double d, double s)
+{
+    return M * sqrt(d * d - s * s / 4);
+}
+
+/* Smooth bottom, slope 30, L = 16 (MLH Sec. 4.2): 51 discs named heap.k
+ * after the scene's own [disc] sections; row 0 on the floor wall heap_floor
+ * (y = origin_y, spanning the base) at spacing d, centres at
+ * origin + (R + k d, R); only the two corner stones held; the rows above
+ * on a triangular lattice (row spacing √3/2 d, supports at d). */
+START_TEST(scene_pile_smooth_lattice)
+{
+    const double d = 0.83, ox = -1.7, oy = 0.45, r = d / 2;
+    const long L = 16;
+    struct tfx *f = tfx_newf("pile",
+                             "[material g]\nkn = 1e5\ndensity = 2.385\n"
+                             "[material floor]\nkn = 2e5\n"
+                             "[disc lone]\nx = -9 9\nr = 0.3\nmaterial = g\n"
+                             "[pile heap]\nL = %ld\nd = %.17g\norigin = %.17g %.17g\n"
+                             "material = g\nwall_material = floor\n"
+                             "[stage s]\ncycles = 1\n",
+                             L, d, ox, oy);
+    const struct bal_sim *s = f->sim;
+    ck_assert_int_eq(s->n, 1 + 51);
+    /* names: [disc] sections first, then heap.0 … heap.50 */
+    char name[2 * BAL_NAME_MAX], want[2 * BAL_NAME_MAX];
+    bal_output_disc_name(s, 0, name, sizeof name);
+    ck_assert_str_eq(name, "lone");
+    for (int k = 0; k < 51; k++) {
+        bal_output_disc_name(s, 1 + k, name, sizeof name);
+        snprintf(want, sizeof want, "heap.%d", k);
+        ck_assert_str_eq(name, want);
+    }
+    /* the floor */
+    ck_assert_int_eq(s->n_walls, 1);
+    ck_assert_str_eq(s->walls[0].name, "heap_floor");
+    const struct bal_wall *w = &s->walls[0];
+    ck_assert_double_eq_tol(w->e[0], 1.0, ANGLE_ABS);
+    ck_assert_double_eq_tol(w->e[1], 0.0, ANGLE_ABS);
+    ck_assert_double_eq_tol(w->p[1], oy, LATTICE_REL);
+    ck_assert(w->p[0] + w->h1 * w->e[0] <= ox);                  /* reaches past */
+    ck_assert(w->p[0] + w->h2 * w->e[0] >= ox + (double)L * d); /* both ends */
+    /* row 0 and the held corner stones */
+    int held = 0;
+    double xmin = INFINITY, xmax = -INFINITY;
+    for (int i = 0; i < s->n; i++) {
+        if (s->row[i] != 0)
+            continue;
+        const double k = (s->x[i] - ox - r) / d;
+        ck_assert_double_eq_tol(k, round(k), LATTICE_REL * L);
+        ck_assert_double_eq_tol(s->y[i], oy + r, LATTICE_REL); /* resting on the floor */
+        xmin = fmin(xmin, s->x[i]);
+        xmax = fmax(xmax, s->x[i]);
+    }
+    ck_assert_double_eq_tol(xmin, ox + r, LATTICE_REL);
+    ck_assert_double_eq_tol(xmax, ox + r + (double)(L - 1) * d, LATTICE_REL * L);
+    for (int i = 0; i < s->n; i++) {
+        if (!s->fixed[i])
+            continue;
+        held++;
+        ck_assert_int_eq(s->row[i], 0);
+        ck_assert(s->x[i] == xmin || s->x[i] == xmax);
+    }
+    ck_assert_int_eq(held, 2);
+    ck_assert_int_eq(s->row[t_slot(f, "lone")], -1);
+    const double xc = ox + r + 0.5 * (double)(L - 1) * d;
+    ck_assert_int_eq(check_pile_rows(s, d, xc, 1, 0, L), 6);
+    for (int i = 0; i < s->n; i++)
+        if (s->row[i] > 0)
+            ck_assert_double_eq_tol(s->y[i] - (oy + r), seated_height(s->row[i], d, d),
+                                    LATTICE_REL * L);
+    /* Nothing overlaps at the start: no contact carries a force. */
+    t_steps(f, 1);
+    ck_assert_double_eq(bal_measure_elastic(s), 0.0);
+}
+END_TEST
+
+/* Bumpy bottom, slope 60 and 30: all of row 0 held at spacing d (1 + c),
+ * no floor wall.  c = 1/15 (MLH Sec. 4.1, wide): rows above at the same
+ * spacing s = d (1 + c), seated in the hollows, height steps √(d² − s²/4).
+ * c = 0: the triangular lattice.  c = −1/150 (squeezed): rows above at
+ * spacing d, row 1 no longer in symmetric hollows; it still touches row 0
+ * and overlaps nothing. */
+START_TEST(scene_pile_bumpy_lattice)
+{
+    static const struct {
+        double c;
+        int slope60, seated;
+        long L, n;
+    } cases[] = {
+        {1.0 / 15, 0, 1, 19, 70},   /* 19 16 13 10 7 4 1 */
+        {0.0, 1, 1, 7, 28},         /* MLH Fig. 2, L_0 = 7 */
+        {0.0, 0, 1, 100, 1717},     /* MLH Sec. 4.3 */
+        {-1.0 / 150, 0, 0, 19, 70},
+    };
+    const double d = 0.0015, ox = 0.0125, oy = -0.0071, r = d / 2;
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        struct tfx *f = tfx_newf("bumpy",
+                                 "[material g]\nkn = 1e5\ndensity = 2.385\n"
+                                 "[pile base]\nL = %ld\nslope = %s\nd = %.17g\n"
+                                 "origin = %.17g %.17g\nbottom = bumpy\nc = %.17g\nmaterial = g\n"
+                                 "[stage s]\ncycles = 1\n",
+                                 cases[k].L, cases[k].slope60 ? "60" : "30", d, ox, oy, cases[k].c);
+        const struct bal_sim *s = f->sim;
+        ck_assert_int_eq(s->n, cases[k].n);
+        ck_assert_int_eq(s->n_walls, 0);
+        const double s0 = d * (1 + cases[k].c);
+        int held = 0;
+        for (int i = 0; i < s->n; i++) {
+            ck_assert_int_eq(s->fixed[i], s->row[i] == 0); /* all of row 0, nothing else */
+            held += s->fixed[i];
+            if (s->row[i] == 0) {
+                const double q = (s->x[i] - ox - r) / s0;
+                ck_assert_double_eq_tol(q, round(q), LATTICE_REL * (double)cases[k].L);
+                ck_assert_double_eq_tol(s->y[i], oy + r, LATTICE_REL * d);
+            }
+        }
+        ck_assert_int_eq(held, cases[k].L);
+        const double xc = ox + r + 0.5 * (double)(cases[k].L - 1) * s0;
+        check_pile_rows(s, d, xc, cases[k].seated, cases[k].slope60, cases[k].L);
+        if (cases[k].seated) {
+            const double sp = fmax(d, s0);
+            for (int i = 0; i < s->n; i++)
+                ck_assert_double_eq_tol(s->y[i] - (oy + r), seated_height(s->row[i], d, sp),
+                                        LATTICE_REL * d * (double)cases[k].L);
+        }
+        tfx_release(f);
+    }
+}
+END_TEST
+
+/* Pile scenes the validator must refuse. */
+#define PILE_HEAD "[material g]\nkn = 1e5\ndensity = 2.385\n[material w]\nkn = 2e5\n"
+
+static const struct bad_scene bad_piles[] = {
+    {"smooth bottom without wall_material",
+     PILE_HEAD "[pile p]\nL = 5\nd = 0.83\nmaterial = g\n" STAGE, 'v',
+     "bad:6: wall_material: required with bottom = smooth"},
+    {"smooth bottom with L < 3",
+     PILE_HEAD "[pile p]\nL = 2\nd = 0.83\nmaterial = g\nwall_material = w\n" STAGE, 'v',
+     "bad:7: L: a smooth bottom needs L >= 3"},
+    {"unknown slope", PILE_HEAD "[pile p]\nL = 5\nslope = 45\n", 'p',
+     "bad:8: slope: expected one of {30 60}, got '45'"},
+    {"unknown bottom", PILE_HEAD "[pile p]\nbottom = rough\n", 'p',
+     "bad:7: bottom: expected one of {smooth bumpy}, got 'rough'"},
+    {"wall_material naming no material",
+     PILE_HEAD "[pile p]\nL = 5\nd = 0.83\nmaterial = g\nwall_material = steel\n" STAGE, 'v',
+     "bad:10: wall_material: no [material steel] in the scene"},
+    {"pile without d", PILE_HEAD "[pile p]\nL = 5\nmaterial = g\nwall_material = w\n" STAGE, 'v',
+     "bad:6: [pile p]: d: required key is missing"},
+    {"c beyond its range", PILE_HEAD "[pile p]\nc = 1.5\n", 'p', "bad:7: c: 1.5 is out of range"},
+};
+
+START_TEST(scene_pile_refused)
+{
+    const struct bad_scene *b = &bad_piles[_i];
+    struct tfx *f = tfx_parse("", "unused");
+    enum bal_status st = bal_scene_parse(&f->sc, b->text, "bad", &f->err);
+    char stage = 'p';
+    if (st == BAL_OK) {
+        stage = 'v';
+        st = bal_scene_validate(&f->sc, &f->err);
+    }
+    ck_assert_msg(st == BAL_EINVAL, "%s: status %d, message '%s'", b->what, st, f->err.msg);
+    ck_assert_msg(stage == b->refused_by, "%s: refused by %c, expected %c", b->what, stage,
+                  b->refused_by);
+    ck_assert_msg(t_contains(f->err.msg, b->expect), "%s: message '%s' lacks '%s'", b->what,
+                  f->err.msg, b->expect);
+    if (stage == 'v')
+        ck_assert_int_eq(tfx_create(f), BAL_EINVAL);
+}
+END_TEST
+
+/* The boundary cases are accepted: a smooth pile of L = 3 (two corner
+ * stones and one free disc), a bumpy pile of L = 1 without a floor. */
+START_TEST(scene_pile_smallest)
+{
+    struct tfx *f = tfx_new(PILE_HEAD "[pile p]\nL = 3\nd = 0.83\nmaterial = g\n"
+                                      "wall_material = w\n" STAGE,
+                            "small");
+    ck_assert_int_eq(f->sim->n, 3);
+    ck_assert_int_eq(f->sim->n_walls, 1);
+    int held = 0;
+    for (int i = 0; i < f->sim->n; i++)
+        held += f->sim->fixed[i];
+    ck_assert_int_eq(held, 2);
+    f = tfx_new(PILE_HEAD "[pile p]\nL = 1\nd = 0.83\nbottom = bumpy\nmaterial = g\n" STAGE,
+                "one");
+    ck_assert_int_eq(f->sim->n, 1);
+    ck_assert_int_eq(f->sim->n_walls, 0);
+    ck_assert_int_eq(f->sim->fixed[0], 1);
+}
+END_TEST
+
 Suite *suite_scene(void)
 {
     Suite *s = suite_create("scene");
@@ -480,6 +778,15 @@ Suite *suite_scene(void)
     tcase_add_test(tc, scene_long_line_refused);
     tcase_add_test(tc, scene_missing_file_is_eio);
     tcase_add_test(tc, scene_strerror_names_every_status);
+    suite_add_tcase(s, tc);
+
+    tc = tcase_create("pile");
+    tcase_add_checked_fixture(tc, NULL, tfx_teardown);
+    tcase_add_test(tc, scene_pile_counts);
+    tcase_add_test(tc, scene_pile_smooth_lattice);
+    tcase_add_test(tc, scene_pile_bumpy_lattice);
+    tcase_add_loop_test(tc, scene_pile_refused, 0, (int)(sizeof bad_piles / sizeof bad_piles[0]));
+    tcase_add_test(tc, scene_pile_smallest);
     suite_add_tcase(s, tc);
     return s;
 }

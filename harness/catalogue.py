@@ -4,7 +4,27 @@ A case.txt holds one or more [case NAME] sections; the [variant] and [figure] se
 after a [case] belong to it.  load() reads every family folder (sorted by name, cases in
 file order) and validates names, tiers and references between sections; select() picks
 cases by name or by tier.
+
+Figure kinds (`kind = ...`, default series) and their keys (FIGURE_KIND_KEYS; every kind
+takes kind, title, variants and paper; variants default to all of the case's):
+
+    series     series.tsv columns against a column:  x = COLUMN, y = COLUMN ...,
+               xlabel, ylabel, xrange, yrange
+    network    the force network of one variant's final state (C&S Fig. 5(b));
+               exactly one variant
+    profile    pile_S(component, row) against pile_X(row) per variant (MLH Figs 3, 6, 7):
+               y = COMPONENT ... (xx zz xz max min phi ratio), row = M (default 1),
+               xlabel, ylabel, xrange, yrange
+    principal  the principal axes of the stress of every free disc of one variant's final
+               state (MLH Fig. 3(d)); exactly one variant
+    points     one point per variant at (x, y), joined in the order listed and labelled
+               with the variant's name (error against cost): x = EXPR, y = EXPR (quantity
+               expressions, as in reference/*.ref), logscale = xy | x | y | (empty: none),
+               xlabel, ylabel, xrange, yrange
+
+A key that the figure's kind does not use is an error, as is an unknown kind.
 """
+import ast
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -13,9 +33,22 @@ from . import TIERS, cases_root
 from .ini import IniError, parse_file, shown
 
 CASE_KEYS = {"tier", "title", "checks", "runtime"}
-VARIANT_KEYS = {"scene", "set"}
-FIGURE_KEYS = {"kind", "title", "variants", "x", "y", "xlabel", "ylabel", "xrange", "yrange", "paper"}
-FIGURE_KINDS = ("series", "network")
+VARIANT_KEYS = {"scene", "set", "command"}
+COMMANDS = ("run", "exact")
+FIGURE_KINDS = ("series", "network", "profile", "principal", "points")
+_COMMON = {"kind", "title", "variants", "paper"}
+_AXES = {"xlabel", "ylabel", "xrange", "yrange"}
+FIGURE_KIND_KEYS = {
+    "series": _COMMON | _AXES | {"x", "y"},
+    "network": _COMMON,
+    "profile": _COMMON | _AXES | {"y", "row"},
+    "principal": _COMMON,
+    "points": _COMMON | _AXES | {"x", "y", "logscale"},
+}
+FIGURE_KEYS = set().union(*FIGURE_KIND_KEYS.values())
+LOGSCALES = {"": "", "x": "x", "y": "y", "xy": "xy", "yx": "xy"}
+PROFILE_XLABEL = "X = (x - x0) / l"
+PROFILE_YLABEL = "S (compression positive, units m g / l)"
 NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 RANGE = re.compile(rf"^\s*({NUMBER})?\s*:\s*({NUMBER})?\s*$")
 
@@ -29,6 +62,7 @@ class Variant:
     name: str
     scene: Path
     sets: list
+    command: str = "run"     # run: the DEM; exact: the exact static solver (ballast exact)
 
 
 @dataclass
@@ -43,8 +77,10 @@ class Figure:
     xrange: str = ""         # gnuplot range 'lo:hi' (either side may be empty); '' = automatic
     yrange: str = ""
     line: int = 0
-    kind: str = "series"     # series: columns against x; network: force network of a final state
+    kind: str = "series"     # one of FIGURE_KINDS (see the module docstring)
     paper: str = ""          # the paper's words the figure reproduces, shown beside it
+    row: int = 1             # profile: the pile row M of S(M)
+    logscale: str = ""       # points: '', 'x', 'y' or 'xy'
 
 
 @dataclass
@@ -132,7 +168,10 @@ def _add_variant(case, section):
         if "=" not in entry.value:
             raise section.error(f"'set' needs KEY=VALUE, got '{entry.value}'", entry.line)
     sets = [e.value for e in section.all("set")]
-    case.variants.append(Variant(section.name, case.folder / section.require("scene"), sets))
+    command = section.get("command", "run")
+    if command not in COMMANDS:
+        raise section.error(f"command must be one of {', '.join(COMMANDS)}, not '{command}'")
+    case.variants.append(Variant(section.name, case.folder / section.require("scene"), sets, command))
 
 
 def _add_figure(case, section):
@@ -142,21 +181,69 @@ def _add_figure(case, section):
     kind = section.get("kind", "series")
     if kind not in FIGURE_KINDS:
         raise section.error(f"figure kind must be one of {', '.join(FIGURE_KINDS)}, not '{kind}'")
-    paper = " ".join(e.value for e in section.all("paper"))
-    if kind == "network":
-        variants = section.require("variants").split()
-        if len(variants) != 1:
-            raise section.error("a network figure shows exactly one variant")
-        case.figures.append(Figure(
-            name=section.name, title=section.get("title", section.name), variants=variants,
-            x="", y=[], xlabel="", ylabel="", line=section.line, kind=kind, paper=paper))
-        return
-    case.figures.append(Figure(
-        name=section.name, title=section.get("title", section.name),
-        variants=section.get("variants", "").split(), x=section.require("x"),
-        y=section.require("y").split(), xlabel=section.get("xlabel", section.require("x")),
-        ylabel=section.get("ylabel", ""), xrange=_range(section, "xrange"),
-        yrange=_range(section, "yrange"), line=section.line, kind=kind, paper=paper))
+    allowed = FIGURE_KIND_KEYS[kind]
+    for e in section.entries:
+        if e.key not in allowed:
+            raise section.error(f"'{e.key}' does not apply to a {kind} figure "
+                                f"(its keys: {', '.join(sorted(allowed))})", e.line)
+    common = dict(name=section.name, title=section.get("title", section.name), line=section.line,
+                  kind=kind, paper=" ".join(e.value for e in section.all("paper")))
+    case.figures.append(FIGURE_MAKERS[kind](section, common))
+
+
+def _one_variant(section, common):
+    """network and principal: exactly one variant, no axes."""
+    variants = section.require("variants").split()
+    if len(variants) != 1:
+        raise section.error(f"a {common['kind']} figure shows exactly one variant")
+    return Figure(variants=variants, x="", y=[], xlabel="", ylabel="", **common)
+
+
+def _series(section, common):
+    return Figure(variants=section.get("variants", "").split(), x=section.require("x"),
+                  y=section.require("y").split(), xlabel=section.get("xlabel", section.require("x")),
+                  ylabel=section.get("ylabel", ""), xrange=_range(section, "xrange"),
+                  yrange=_range(section, "yrange"), **common)
+
+
+def _profile(section, common):
+    from .piles import COMPONENTS
+    components = section.require("y").split()
+    for c in components:
+        if c not in COMPONENTS:
+            raise section.error(f"profile component must be one of {', '.join(COMPONENTS)}, not '{c}'",
+                                section.entry("y").line)
+    row = section.number("row", 1.0)
+    if not row.is_integer() or row < 0:
+        raise section.error(f"'row' must be a pile row number (0, 1, 2, ...), not '{section.get('row')}'",
+                            section.entry("row").line)
+    return Figure(variants=section.get("variants", "").split(), x="", y=components,
+                  xlabel=section.get("xlabel", PROFILE_XLABEL), ylabel=section.get("ylabel", PROFILE_YLABEL),
+                  xrange=_range(section, "xrange"), yrange=_range(section, "yrange"), row=int(row), **common)
+
+
+def _expression(section, key):
+    """A quantity expression (syntax checked here, so the error names file:line)."""
+    text = section.require(key)
+    try:
+        ast.parse(text, mode="eval")
+    except SyntaxError as exc:
+        raise section.error(f"'{key}' is not an expression: {exc.msg}", section.entry(key).line) from None
+    return text
+
+
+def _points(section, common):
+    x, y = _expression(section, "x"), _expression(section, "y")
+    logscale = section.get("logscale", "")
+    if logscale not in LOGSCALES:
+        raise section.error(f"'logscale' must be xy, x, y or empty, not '{logscale}'", section.entry("logscale").line)
+    return Figure(variants=section.get("variants", "").split(), x=x, y=[y], xlabel=section.get("xlabel", x),
+                  ylabel=section.get("ylabel", y), xrange=_range(section, "xrange"),
+                  yrange=_range(section, "yrange"), logscale=LOGSCALES[logscale], **common)
+
+
+FIGURE_MAKERS = {"series": _series, "network": _one_variant, "profile": _profile,
+                 "principal": _one_variant, "points": _points}
 
 
 def _range(section, key):

@@ -5,10 +5,12 @@ every series.tsv column (numpy array) and the functions of the spec (at, first, 
 after, upto, between, mean, max, min, std, abs, sqrt, amp, run), plus series(variant,
 column) for a column of another variant of the same case, period(arr) for the mean
 number of rows between upward crossings of the mean, and settle(col, target, tol) for
-the cycle from which a column stays within tol of target.  evaluate_check()
-turns one Check into a Verdict; anything that goes wrong (missing output, failed run,
-missing column, an expression that raises, a NaN/inf value) is a FAIL whose message
-says which, never a pass and never a skip.
+the cycle from which a column stays within tol of target; and the pile functions of
+piles.py (pile_X, pile_S, middle, horizontal_contacts, contact_error, contact_mismatch,
+weight), which read the run's final state (discs.tsv, contacts.tsv, stress.tsv) when
+called.  evaluate_check() turns one Check into a Verdict; anything that goes wrong
+(missing output, failed run, missing column, an expression that raises, a NaN/inf
+value) is a FAIL whose message says which, never a pass and never a skip.
 """
 import ast
 import math
@@ -91,9 +93,11 @@ def folder_locator(runs_root):
 # ---------------------------------------------------------------- expressions
 
 def namespace(run, sibling=None):
-    """Columns by header name, then the expression functions (functions win a clash).
+    """Columns by header name, then the expression functions (functions win a clash,
+    except where the expression uses the name as a value: see _compile).
 
-    sibling(variant) gives the Run of another variant of the same case, for series().
+    sibling(variant) gives the Run of another variant of the same case, for series(),
+    contact_error() and contact_mismatch().
     """
     names = dict(run.columns)
     names.update(REDUCERS)
@@ -101,6 +105,8 @@ def namespace(run, sibling=None):
     names.update(_signal_functions(run.columns["cycle"]))
     names["run"] = _run_field(run.info)
     names["series"] = _series_of(sibling)
+    from . import piles   # here, not at the top: piles imports EvalError from this module
+    names.update(piles.functions(run, sibling))
     return names
 
 
@@ -199,8 +205,16 @@ def _run_field(info):
     return run
 
 
-def _compile(expr, names):
-    """Compile expr; refuse private attributes and names the namespace lacks."""
+SHADOWED = "column_shadowed_by_function_"
+
+
+def _compile(expr, names, columns=None):
+    """Compile expr; refuse private attributes and names the namespace lacks.
+
+    A name that is both a series column and a function (a probe called 'weight' beside
+    weight()) is the function where it is called and the column where it is used as a
+    value: those uses are renamed SHADOWED + name, and names gets that entry.
+    """
     try:
         tree = ast.parse(expr, mode="eval")
     except SyntaxError as exc:
@@ -208,6 +222,11 @@ def _compile(expr, names):
     nodes = list(ast.walk(tree))
     called = {id(n.func) for n in nodes if isinstance(n, ast.Call)}
     bound = {n.id for n in nodes if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)}
+    for node in nodes:
+        if (isinstance(node, ast.Name) and id(node) not in called and node.id not in bound
+                and columns and node.id in columns and callable(names.get(node.id))):
+            names[SHADOWED + node.id] = columns[node.id]
+            node.id = SHADOWED + node.id
     for node in nodes:
         if isinstance(node, ast.Attribute) and node.attr.startswith("_"):
             raise EvalError(f"'{node.attr}' is not allowed in an expression")
@@ -227,7 +246,7 @@ def _unknown_name(name, is_call, names):
 def evaluate(expr, run, sibling=None):
     """The expression's value in run's outputs, as one finite float."""
     names = namespace(run, sibling)
-    code = _compile(expr, names)
+    code = _compile(expr, names, run.columns)
     try:
         with np.errstate(all="ignore"):
             result = eval(code, {**names, "__builtins__": {}})  # noqa: S307 -- no builtins, vetted names

@@ -29,6 +29,7 @@ class Job:
     sets: list
     out: Path
     expected: float = 0.0   # expected seconds, for the ETA
+    command: str = "run"    # the core's command: run (DEM) or exact (static solver)
 
     @property
     def label(self):
@@ -47,13 +48,13 @@ class Outcome:
 def jobs_for(cases, runs_root):
     """One Job per variant of each case, outputs in runs_root/<case>/<variant>."""
     return [Job(c.name, v.name, v.scene, list(v.sets), Path(runs_root) / c.name / v.name,
-                c.runtime / len(c.variants))
+                c.runtime / len(c.variants), v.command)
             for c in cases for v in c.variants]
 
 
 def command(job, binary):
     """The core's command line for a job."""
-    cmd = [str(binary), "run", str(job.scene), "--out", str(job.out)]
+    cmd = [str(binary), job.command, str(job.scene), "--out", str(job.out)]
     for kv in job.sets:
         cmd += ["--set", kv]
     return cmd
@@ -206,5 +207,6 @@ def run_all(jobs, binary, workers=None, out=sys.stdout, tty=None):
 def sweep_jobs(case, variant, key, values, sweeps_root):
     """One Job per value: the variant with KEY=value appended, outputs in sweeps_root/<case>/<KEY>=<V>."""
     return [Job(case.name, f"{key}={v}", variant.scene, list(variant.sets) + [f"{key}={v}"],
-                Path(sweeps_root) / case.name / f"{key}={v}", case.runtime / len(case.variants))
+                Path(sweeps_root) / case.name / f"{key}={v}", case.runtime / len(case.variants),
+                variant.command)
             for v in values]

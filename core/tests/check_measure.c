@@ -347,16 +347,17 @@ static int stress_row(const struct tfx *f, const char *who, double out[S_N])
 
 /* A free centre disc c with held neighbours n0, n1, ... at the given angles
  * (degrees) and overlaps. */
-static struct tfx *star(int n, const double *angle_deg, const double *overlap)
+static struct tfx *star_with(int n, const double *angle_deg, const double *overlap,
+                             const char *settings)
 {
     char text[T_TEXT_MAX];
     const double cx = 0.35, cy = -0.42;
     int len = snprintf(text, sizeof text,
-                       "[settings]\ndt = 1e-5\nnormal_law = power\n"
+                       "[settings]\ndt = 1e-5\nnormal_law = power\n%s"
                        "[material m]\nkn = %.17g\ndensity = %.17g\n"
                        "[disc c]\nx = %.17g %.17g\nr = %.17g\nmaterial = m\n"
                        "[stage s]\ncycles = 1\n",
-                       ST_KN, ST_RHO, cx, cy, ST_R);
+                       settings, ST_KN, ST_RHO, cx, cy, ST_R);
     for (int k = 0; k < n; k++) {
         const double a = angle_deg[k] * BAL_PI / 180, d = 2 * ST_R - overlap[k];
         len += snprintf(text + len, sizeof text - (size_t)len,
@@ -365,6 +366,11 @@ static struct tfx *star(int n, const double *angle_deg, const double *overlap)
     }
     ck_assert_int_lt(len, (int)sizeof text);
     return tfx_new(text, "star");
+}
+
+static struct tfx *star(int n, const double *angle_deg, const double *overlap)
+{
+    return star_with(n, angle_deg, overlap, "");
 }
 
 /* Six equal contacts at 60° (a hexagonal cell, rotated by 17.3°), overlap
@@ -413,6 +419,54 @@ START_TEST(measure_stress_hexagonal_isotropic)
     ck_assert_double_eq_tol(row[S_MAX], sigma, tol);
     ck_assert_double_eq_tol(row[S_MIN], sigma, tol);
     ck_assert(sigma < 0); /* compression is negative */
+}
+END_TEST
+
+/* Moving averages (stress_grid.tsv): cells of width W = 3.1 and height
+ * H = 2.7 stepped by W contain free discs only, so in the hexagonal star
+ * exactly one cell holds a disc, the centre one, and its stress is the
+ * centre's moment over the cell area: σ = −(3 F l / (W H)) I.  Every other
+ * cell is empty and is not written. */
+START_TEST(measure_stress_grid_cell)
+{
+    const double delta = 0.0137, W = 3.1, H = 2.7;
+    double ang[6], ov[6];
+    for (int k = 0; k < 6; k++) {
+        ang[k] = 17.3 + 60.0 * k;
+        ov[k] = delta;
+    }
+    struct tfx *f = star_with(6, ang, ov,
+                              "stress_width = 3.1\nstress_height = 2.7\nstress_step = 3.1\n");
+    t_steps(f, 1);
+    const double F = ST_KN * delta, l = ST_R - delta / 2;
+    const double sigma = -3 * F * l / (W * H), tol = STRESS_REL * fabs(sigma);
+    char dir[] = "/tmp/ballast_check_XXXXXX";
+    ck_assert_ptr_nonnull(mkdtemp(dir));
+    struct bal_error err = {0};
+    ck_assert_int_eq(bal_output_state(f->sim, dir, &err), BAL_OK);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/stress_grid.tsv", dir);
+    FILE *g = fopen(path, "r");
+    ck_assert_ptr_nonnull(g);
+    char line[1024];
+    ck_assert_ptr_nonnull(fgets(line, sizeof line, g));
+    ck_assert(strncmp(line, "xc\tyc\tn\tsxx", 11) == 0);
+    int rows = 0, n = 0;
+    double v[7] = {0};
+    while (fgets(line, sizeof line, g)) {
+        rows++;
+        ck_assert_int_eq(sscanf(line, "%lf %lf %d %lf %lf %lf %lf", &v[0], &v[1], &n, &v[2],
+                                &v[3], &v[4], &v[5]),
+                         7);
+    }
+    fclose(g);
+    remove_state_dir(dir);
+    ck_assert_int_eq(rows, 1);
+    ck_assert_int_eq(n, 1);
+    ck_assert_double_eq_tol(v[2], sigma, tol); /* sxx */
+    ck_assert_double_eq_tol(v[3], 0.0, tol);   /* sxz */
+    ck_assert_double_eq_tol(v[4], 0.0, tol);   /* szx */
+    ck_assert_double_eq_tol(v[5], sigma, tol); /* szz */
 }
 END_TEST
 
@@ -577,6 +631,7 @@ Suite *suite_measure(void)
     tc = tcase_create("stress");
     tcase_add_checked_fixture(tc, NULL, tfx_teardown);
     tcase_add_test(tc, measure_stress_hexagonal_isotropic);
+    tcase_add_test(tc, measure_stress_grid_cell);
     tcase_add_test(tc, measure_stress_anisotropic_principal);
     tcase_add_test(tc, measure_held_and_weight_probes);
     tcase_add_test(tc, measure_weight_follows_ramp);

@@ -776,7 +776,7 @@ enum bal_status bal_exact_solve(const struct bal_sim *s, struct bal_exact *out,
         }
         w.free_slot[w.nf] = i;
         w.unknown[i] = 2 * w.nf++;
-        const double gx = s->m[i] * s->g[0], gy = s->m[i] * s->g[1];
+        const double gx = bal_mass(s, i) * s->g[0], gy = bal_mass(s, i) * s->g[1];
         out->weight[0] += gx;
         out->weight[1] += gy;
         wmax = fmax(wmax, hypot(gx, gy));
@@ -812,8 +812,8 @@ enum bal_status bal_exact_solve(const struct bal_sim *s, struct bal_exact *out,
         }
         for (int a = 0; a < w.nf; a++) {
             const int i = w.free_slot[a];
-            w.f[2 * a] = s->m[i] * s->g[0];
-            w.f[2 * a + 1] = s->m[i] * s->g[1];
+            w.f[2 * a] = bal_mass(s, i) * s->g[0];
+            w.f[2 * a + 1] = bal_mass(s, i) * s->g[1];
         }
         st = iterate(s, &w, FORCE_TOL * wsum, &out->iterations, err);
         if (st)

@@ -16,8 +16,15 @@
  * (i << 32 | j) without a global sort; the history of the old list is then
  * carried over by one linear merge (contacts.c).
  *
- * Memory: lists grow by doubling, and only here, in a rebuild; the step
- * itself never allocates.
+ * Memory: a rebuild writes the new list into a scratch of keys and pair
+ * indices and carries the history over one column at a time, so it needs
+ * about 29 bytes a candidate beside the list itself.  Lists grow by a
+ * quarter, and only here, in a rebuild; the contact loops never allocate.
+ *
+ * Every BAL_REORDER_EVERY rebuilds the discs are re-sorted into the cell
+ * order of their current positions (bal_grid_reorder), because flow
+ * scatters neighbours across memory.  The rebuild that follows finds each
+ * pair's history through the permutation.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -38,47 +45,166 @@ void bal_grid_free(struct bal_grid *g)
     memset(g, 0, sizeof *g);
 }
 
+/* Room for `need` pairs in list p (its own columns) — grown by a quarter,
+ * so that a growing packing does not double its memory. */
 static enum bal_status grow(struct bal_pairs *p, long need, struct bal_error *err)
 {
     if (need <= p->cap)
         return BAL_OK;
-    long cap = p->cap ? p->cap : 64;
-    while (cap < need)
-        cap *= 2;
+    long cap = p->cap + p->cap / 4 + 64;
+    if (cap < need)
+        cap = need + need / 8 + 64;
     if (bal_pairs_reserve(p, cap))
         return bal_error(err, BAL_ENOMEM, "neighbour list: out of memory for %ld pairs", cap);
     return BAL_OK;
 }
 
-static void swap_pairs(struct bal_pairs *a, struct bal_pairs *b)
+static enum bal_status grow_scratch(struct bal_rebuild_scratch *rs, long need,
+                                    struct bal_error *err)
 {
-    struct bal_pairs t = *a;
-    *a = *b;
-    *b = t;
+    if (need <= rs->cap)
+        return BAL_OK;
+    long cap = rs->cap + rs->cap / 4 + 64;
+    if (cap < need)
+        cap = need + need / 8 + 64;
+    void *k = realloc(rs->key, (size_t)cap * sizeof *rs->key);
+    if (k)
+        rs->key = k;
+    void *i = realloc(rs->i, (size_t)cap * sizeof *rs->i);
+    if (i)
+        rs->i = i;
+    void *j = realloc(rs->j, (size_t)cap * sizeof *rs->j);
+    if (j)
+        rs->j = j;
+    void *m = realloc(rs->map, (size_t)cap * sizeof *rs->map);
+    if (m)
+        rs->map = m;
+    void *c = realloc(rs->col, (size_t)cap * sizeof *rs->col);
+    if (c)
+        rs->col = c;
+    void *b = realloc(rs->bytes, (size_t)cap * sizeof *rs->bytes);
+    if (b)
+        rs->bytes = b;
+    if (!k || !i || !j || !m || !c || !b)
+        return bal_error(err, BAL_ENOMEM, "neighbour list: out of memory for %ld pairs", cap);
+    rs->cap = cap;
+    return BAL_OK;
 }
 
-static inline void push(struct bal_pairs *p, int i, int j)
+void bal_grid_scratch_free(struct bal_rebuild_scratch *rs)
 {
-    long c = p->n++;
-    p->key[c] = ((uint64_t)(uint32_t)i << 32) | (uint32_t)j;
-    p->i[c] = i;
-    p->j[c] = j;
+    free(rs->key);
+    free(rs->i);
+    free(rs->j);
+    free(rs->map);
+    free(rs->col);
+    free(rs->bytes);
+    memset(rs, 0, sizeof *rs);
+}
+
+static inline enum bal_status push(struct bal_rebuild_scratch *rs, long *n, int i, int j,
+                                   struct bal_error *err)
+{
+    if (*n + 1 > rs->cap && grow_scratch(rs, *n + 1, err))
+        return err->code;
+    rs->key[*n] = ((uint64_t)(uint32_t)i << 32) | (uint32_t)j;
+    rs->i[*n] = i;
+    rs->j[*n] = j;
+    (*n)++;
+    return BAL_OK;
+}
+
+static long find_key(const struct bal_pairs *p, uint64_t key)
+{
+    long lo = 0, hi = p->n;
+    while (lo < hi) {
+        const long mid = lo + (hi - lo) / 2;
+        if (p->key[mid] < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < p->n && p->key[lo] == key ? lo : -1;
+}
+
+/* Where each new pair sat in the old list.  Normally both lists number the
+ * discs alike and one linear pass matches them; right after a re-sort the
+ * old list still uses the old numbers, so each new pair is translated back
+ * through the permutation and looked up by binary search. */
+static void match_old(const struct bal_sim *s, const struct bal_pairs *old,
+                      struct bal_rebuild_scratch *rs, long n, int walls)
+{
+    if (!s->reordered) {
+        long a = 0;
+        for (long c = 0; c < n; c++) {
+            const uint64_t k = rs->key[c];
+            while (a < old->n && old->key[a] < k)
+                a++;
+            rs->map[c] = (int32_t)(a < old->n && old->key[a] == k ? a : -1);
+        }
+        return;
+    }
+    for (long c = 0; c < n; c++) {
+        int i = s->new2old[rs->i[c]], j = walls ? rs->j[c] : s->new2old[rs->j[c]];
+        if (!walls && j < i) {
+            const int t = i;
+            i = j;
+            j = t;
+        }
+        rs->map[c] = (int32_t)find_key(old, ((uint64_t)(uint32_t)i << 32) | (uint32_t)j);
+    }
+}
+
+static void gather(double *column, struct bal_rebuild_scratch *rs, long n)
+{
+    for (long c = 0; c < n; c++)
+        rs->col[c] = rs->map[c] >= 0 ? column[rs->map[c]] : 0.0;
+    memcpy(column, rs->col, (size_t)n * sizeof *column);
+}
+
+/* Replace list p by the n new pairs in rs, carrying the history over. */
+static enum bal_status install(const struct bal_sim *s, struct bal_pairs *p,
+                               struct bal_rebuild_scratch *rs, long n, int walls,
+                               struct bal_error *err)
+{
+    if (n == 0) {
+        p->n = 0;
+        return BAL_OK;
+    }
+    match_old(s, p, rs, n, walls);
+    if (grow(p, n, err))
+        return err->code;
+    gather(p->fn, rs, n);
+    if (p->shear) {
+        gather(p->fs, rs, n);
+        gather(p->ds, rs, n);
+    }
+    if (p->damping)
+        gather(p->dn, rs, n);
+    for (long c = 0; c < n; c++)
+        rs->bytes[c] = rs->map[c] >= 0 ? p->flags[rs->map[c]] : 0;
+    memcpy(p->flags, rs->bytes, (size_t)n * sizeof *p->flags);
+    memcpy(p->key, rs->key, (size_t)n * sizeof *p->key);
+    memcpy(p->i, rs->i, (size_t)n * sizeof *p->i);
+    memcpy(p->j, rs->j, (size_t)n * sizeof *p->j);
+    p->n = n;
+    return BAL_OK;
 }
 
 enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
 {
     const int n = s->n;
-    struct bal_pairs *fresh = &s->scratch_pp;
+    struct bal_rebuild_scratch *rs = &s->rs;
+    long count = 0;
 
     /* --- disc–disc candidates ------------------------------------- */
-    fresh->n = 0;
     if (!s->use_grid) {
-        long need = (long)n * (n - 1) / 2;
-        if (grow(fresh, need, err))
+        if (grow_scratch(rs, (long)n * (n - 1) / 2, err))
             return err->code;
         for (int i = 0; i < n; i++)
             for (int j = i + 1; j < n; j++)
-                push(fresh, i, j);
+                if (!(s->fixed[i] && s->fixed[j]) && push(rs, &count, i, j, err))
+                    return err->code;
     } else {
         struct bal_grid *g = &s->grid;
         double x0 = s->x[0], x1 = s->x[0], y0 = s->y[0], y1 = s->y[0];
@@ -123,7 +249,6 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
         }
         for (long c = 0; c < nc; c++)
             g->start[c + 1] += g->start[c];
-        /* Fill cells; `list` positions taken from a running copy. */
         for (int i = 0; i < n; i++)
             g->list[g->start[g->cell[i]]++] = i;
         for (long c = nc; c > 0; c--)
@@ -143,7 +268,9 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
                     const int c = yy * nx + xx;
                     for (int a = g->start[c]; a < g->start[c + 1]; a++) {
                         const int j = g->list[a];
-                        if (j <= i)
+                        /* Two held discs never move: their contact is no
+                         * part of the dynamics. */
+                        if (j <= i || (s->fixed[i] && s->fixed[j]))
                             continue;
                         const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
                         const double reach = s->r[i] + s->r[j] + s->skin;
@@ -168,20 +295,16 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
                 }
                 nb[b + 1] = v;
             }
-            if (fresh->n + k > fresh->cap && grow(fresh, fresh->n + k, err))
-                return err->code;
             for (int a = 0; a < k; a++)
-                push(fresh, i, nb[a]);
+                if (push(rs, &count, i, nb[a], err))
+                    return err->code;
         }
     }
-    bal_pairs_merge_history(fresh, &s->pp);
-    swap_pairs(&s->pp, fresh);
+    if (install(s, &s->pp, rs, count, 0, err))
+        return err->code;
 
     /* --- disc–wall candidates ------------------------------------- */
-    fresh = &s->scratch_pw;
-    fresh->n = 0;
-    if (grow(fresh, s->pw.n, err))
-        return err->code;
+    count = 0;
     for (int i = 0; i < n; i++) {
         for (int k = 0; k < s->n_walls; k++) {
             if (s->use_grid) {
@@ -191,13 +314,13 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
                 if (d2 >= reach * reach)
                     continue;
             }
-            if (fresh->n + 1 > fresh->cap && grow(fresh, fresh->n + 1, err))
+            if (push(rs, &count, i, k, err))
                 return err->code;
-            push(fresh, i, k);
         }
     }
-    bal_pairs_merge_history(fresh, &s->pw);
-    swap_pairs(&s->pw, fresh);
+    if (install(s, &s->pw, rs, count, 1, err))
+        return err->code;
+    s->reordered = 0;
 
     if (s->use_grid) {
         memcpy(s->x_ref, s->x, (size_t)n * sizeof *s->x);
@@ -208,4 +331,99 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
     s->need_rebuild = 0;
     s->rebuilds++;
     return BAL_OK;
+}
+
+/* ------------------------------------------------------------------ */
+/* Re-sorting discs into cell order                                     */
+/* ------------------------------------------------------------------ */
+
+static int cell_key_cmp(const void *a, const void *b)
+{
+    const struct bal_cell_key *p = a, *q = b;
+    if (p->cell != q->cell)
+        return p->cell < q->cell ? -1 : 1;
+    return (p->slot > q->slot) - (p->slot < q->slot);
+}
+
+/* a[new] = a[new2old[new]]; the rebuild scratch column is the buffer. */
+static void permute_doubles(struct bal_sim *s, double *a, int stride)
+{
+    double *t = s->rs.col;
+    for (int i = 0; i < s->n; i++)
+        for (int k = 0; k < stride; k++)
+            t[(long)stride * i + k] = a[(long)stride * s->new2old[i] + k];
+    memcpy(a, t, (size_t)s->n * (size_t)stride * sizeof *a);
+}
+
+static void permute_int32(struct bal_sim *s, int32_t *a)
+{
+    int32_t *t = (int32_t *)s->rs.col;
+    for (int i = 0; i < s->n; i++)
+        t[i] = a[s->new2old[i]];
+    memcpy(a, t, (size_t)s->n * sizeof *a);
+}
+
+static void permute_uint8(struct bal_sim *s, uint8_t *a)
+{
+    uint8_t *t = (uint8_t *)s->rs.col;
+    for (int i = 0; i < s->n; i++)
+        t[i] = a[s->new2old[i]];
+    memcpy(a, t, (size_t)s->n * sizeof *a);
+}
+
+enum bal_status bal_grid_reorder(struct bal_sim *s, struct bal_error *err)
+{
+    const int n = s->n;
+    if (n >= 2) {
+        double x0 = s->x[0], y0 = s->y[0], x1 = s->x[0];
+        for (int i = 1; i < n; i++) {
+            x0 = fmin(x0, s->x[i]);
+            y0 = fmin(y0, s->y[i]);
+            x1 = fmax(x1, s->x[i]);
+        }
+        const double h = 2 * s->r_max + s->skin;
+        const long nx = (long)((x1 - x0) / h) + 1;
+        /* The sort keys (16 bytes a disc) and the permutation buffers live in
+         * the rebuild scratch column; stress moments need 4 doubles a disc. */
+        if (grow_scratch(&s->rs, 4L * n, err))
+            return err->code;
+        struct bal_cell_key *order = (struct bal_cell_key *)s->rs.col;
+        for (int i = 0; i < n; i++)
+            order[i] = (struct bal_cell_key){(long)((s->y[i] - y0) / h) * nx +
+                                                 (long)((s->x[i] - x0) / h), i};
+        qsort(order, (size_t)n, sizeof *order, cell_key_cmp);
+        for (int i = 0; i < n; i++)
+            s->new2old[i] = order[i].slot;
+
+        double *columns[] = {s->x, s->y, s->th, s->vx, s->vy, s->w, s->r, s->inv_m,
+                             s->inv_i, s->fx, s->fy, s->tq};
+        for (size_t k = 0; k < sizeof columns / sizeof columns[0]; k++)
+            permute_doubles(s, columns[k], 1);
+        if (s->moment_prev)
+            permute_doubles(s, s->moment_prev, 4);
+        permute_int32(s, s->id);
+        permute_int32(s, s->mat);
+        if (s->row)
+            permute_int32(s, s->row);
+        permute_uint8(s, s->fixed);
+        for (int i = 0; i < n; i++)
+            s->slot[s->id[i]] = i;
+        for (int k = 0; k < s->n_probes; k++) {
+            struct bal_probe_ref *p = &s->probes[k];
+            const int disc_a = !p->a_wall && (p->kind <= BAL_PROBE_CONTACT_SLIDING ||
+                                              (p->kind >= BAL_PROBE_DISC_X &&
+                                               p->kind <= BAL_PROBE_DISC_OMEGA));
+            const int disc_b = !p->b_wall && p->kind <= BAL_PROBE_CONTACT_SLIDING;
+            const int old_a = p->a, old_b = p->b;
+            for (int i = 0; i < n && (disc_a || disc_b); i++) {
+                if (disc_a && s->new2old[i] == old_a)
+                    p->a = i;
+                if (disc_b && s->new2old[i] == old_b)
+                    p->b = i;
+            }
+        }
+        s->reordered = 1;
+        s->reorders++;
+    }
+    return bal_grid_rebuild(s, err);
 }

@@ -15,6 +15,11 @@
  *
  * The position update also tracks how far any disc has moved since the
  * neighbour list was built, which decides when it is rebuilt (grid.c).
+ *
+ * Measurements want velocities at t_N, (v_{N-1/2} + v_{N+1/2})/2 (eq. 31);
+ * rather than keep a copy of v_{N-1/2} (24 bytes a disc),
+ * bal_integrate_previous() recovers it from v_{N+1/2} and the force sums,
+ * which stay in place until the next cycle.
  */
 #include <math.h>
 #include <string.h>
@@ -53,14 +58,30 @@ void bal_integrate_positions(struct bal_sim *s)
         s->need_rebuild = 1;
 }
 
-void bal_integrate_velocities(struct bal_sim *s, int keep_old)
+void bal_integrate_previous(const struct bal_sim *s, int i, double *vx, double *vy, double *w)
+{
+    if (s->fixed[i]) {
+        *vx = *vy = *w = 0;
+        return;
+    }
+    const double dt = s->dt, half = s->alpha * dt / 2;
+    const double ax = s->fx[i] * s->inv_m[i] * dt + s->g[0] * s->gfac * dt;
+    const double ay = s->fy[i] * s->inv_m[i] * dt + s->g[1] * s->gfac * dt;
+    const double aw = s->tq[i] * s->inv_i[i] * dt;
+    if (half == 0) {
+        *vx = s->vx[i] - ax;
+        *vy = s->vy[i] - ay;
+        *w = s->w[i] - aw;
+        return;
+    }
+    *vx = (s->vx[i] * (1 + half) - ax) / (1 - half);
+    *vy = (s->vy[i] * (1 + half) - ay) / (1 - half);
+    *w = (s->w[i] * (1 + half) - aw) / (1 - half);
+}
+
+void bal_integrate_velocities(struct bal_sim *s)
 {
     const int n = s->n;
-    if (keep_old) {
-        memcpy(s->vx_old, s->vx, (size_t)n * sizeof *s->vx);
-        memcpy(s->vy_old, s->vy, (size_t)n * sizeof *s->vy);
-        memcpy(s->w_old, s->w, (size_t)n * sizeof *s->w);
-    }
     const double dt = s->dt;
     const double half = s->alpha * dt / 2;
     const double keep = 1 - half, scale = 1 / (1 + half);

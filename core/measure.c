@@ -32,19 +32,30 @@
 
 #include "sim.h"
 
-static double centred(const struct bal_sim *s, const double *now, const double *old, int i)
+/* Velocities of disc i at t_N: the mean of v_{N-1/2} and v_{N+1/2} (eq. 31);
+ * before the first cycle, the initial ones. */
+void bal_measure_velocity(const struct bal_sim *s, int i, double *vx, double *vy, double *w)
 {
-    return s->have_old ? 0.5 * (now[i] + old[i]) : now[i];
+    if (!s->have_old) {
+        *vx = s->vx[i];
+        *vy = s->vy[i];
+        *w = s->w[i];
+        return;
+    }
+    double ox, oy, ow;
+    bal_integrate_previous(s, i, &ox, &oy, &ow);
+    *vx = 0.5 * (s->vx[i] + ox);
+    *vy = 0.5 * (s->vy[i] + oy);
+    *w = 0.5 * (s->w[i] + ow);
 }
 
 double bal_measure_kinetic(const struct bal_sim *s)
 {
     double e = 0;
     for (int i = 0; i < s->n; i++) {
-        const double vx = centred(s, s->vx, s->vx_old, i);
-        const double vy = centred(s, s->vy, s->vy_old, i);
-        const double w = centred(s, s->w, s->w_old, i);
-        e += 0.5 * s->m[i] * (vx * vx + vy * vy) + 0.5 * s->inertia[i] * w * w;
+        double vx, vy, w;
+        bal_measure_velocity(s, i, &vx, &vy, &w);
+        e += 0.5 * bal_mass(s, i) * (vx * vx + vy * vy) + 0.5 * bal_inertia(s, i) * w * w;
     }
     return e;
 }
@@ -103,7 +114,8 @@ double bal_measure_unbalanced(const struct bal_sim *s)
     for (int i = 0; i < s->n; i++) {
         if (s->fixed[i])
             continue;
-        const double sx = s->fx[i] + s->m[i] * s->g[0], sy = s->fy[i] + s->m[i] * s->g[1];
+        const double m = bal_mass(s, i);
+        const double sx = s->fx[i] + m * s->g[0], sy = s->fy[i] + m * s->g[1];
         smax = fmax(smax, hypot(sx, sy));
     }
     return smax / fbig;
@@ -208,13 +220,14 @@ double bal_measure_probe(const struct bal_sim *s, int probe)
     case BAL_PROBE_DISC_Y:
         return s->y[p->a];
     case BAL_PROBE_DISC_VX:
-        return centred(s, s->vx, s->vx_old, p->a);
     case BAL_PROBE_DISC_VY:
-        return centred(s, s->vy, s->vy_old, p->a);
+    case BAL_PROBE_DISC_OMEGA: {
+        double vx, vy, w;
+        bal_measure_velocity(s, p->a, &vx, &vy, &w);
+        return p->kind == BAL_PROBE_DISC_VX ? vx : p->kind == BAL_PROBE_DISC_VY ? vy : w;
+    }
     case BAL_PROBE_DISC_THETA:
         return s->th[p->a] * (180 / BAL_PI);
-    case BAL_PROBE_DISC_OMEGA:
-        return centred(s, s->w, s->w_old, p->a);
     case BAL_PROBE_ENERGY_KINETIC:
         return bal_measure_kinetic(s);
     case BAL_PROBE_ENERGY_ELASTIC:
@@ -239,7 +252,7 @@ double bal_measure_probe(const struct bal_sim *s, int probe)
         double m = 0;
         for (int i = 0; i < s->n; i++)
             if (!s->fixed[i])
-                m += s->m[i];
+                m += bal_mass(s, i);
         return m * s->g[p->kind == BAL_PROBE_WEIGHT_X ? 0 : 1] * s->gfac;
     }
     }

@@ -22,6 +22,7 @@
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "scene.h"
@@ -160,13 +161,12 @@ static void write_discs(const struct bal_sim *s, FILE *f)
     char name[2 * BAL_NAME_MAX];
     for (int k = 0; k < s->n; k++) {
         const int i = s->slot[k];
+        double vx, vy, w;
+        bal_measure_velocity(s, i, &vx, &vy, &w);
         bal_output_disc_name(s, k, name, sizeof name);
         fprintf(f, "%d\t%s\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d\t%d\n", k,
-                name, s->x[i], s->y[i], s->r[i], s->th[i] * (180 / BAL_PI),
-                s->have_old ? 0.5 * (s->vx[i] + s->vx_old[i]) : s->vx[i],
-                s->have_old ? 0.5 * (s->vy[i] + s->vy_old[i]) : s->vy[i],
-                s->have_old ? 0.5 * (s->w[i] + s->w_old[i]) : s->w[i], s->m[i], s->fixed[i],
-                s->row[i]);
+                name, s->x[i], s->y[i], s->r[i], s->th[i] * (180 / BAL_PI), vx, vy, w,
+                bal_mass(s, i), s->fixed[i], s->row ? s->row[i] : -1);
     }
 }
 
@@ -197,19 +197,20 @@ static void principal(double xx, double xz, double zx, double zz, double *smax, 
     *phi = a < 0 ? a + 180 : a;
 }
 
-static void write_stress(const struct bal_sim *s, FILE *f)
+static void write_stress(const struct bal_sim *s, const double *moment, FILE *f)
 {
     fputs("id\tname\tx\ty\trow\tfixed\tV\tsxx\tsxz\tszx\tszz\tsmax\tsmin\tphi\n", f);
     char name[2 * BAL_NAME_MAX];
     for (int k = 0; k < s->n; k++) {
         const int i = s->slot[k];
         const double v = bal_measure_disc_volume(s->r[i]);
-        const double *m = &s->moment[4 * i];
+        const double *m = &moment[4 * i];
         double smax, smin, phi;
         principal(m[0] / v, m[1] / v, m[2] / v, m[3] / v, &smax, &smin, &phi);
         bal_output_disc_name(s, k, name, sizeof name);
         fprintf(f, "%d\t%s\t%.17g\t%.17g\t%d\t%d\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\n",
-                k, name, s->x[i], s->y[i], s->row[i], s->fixed[i], v, m[0] / v, m[1] / v, m[2] / v,
+                k, name, s->x[i], s->y[i], s->row ? s->row[i] : -1, s->fixed[i], v, m[0] / v,
+                m[1] / v, m[2] / v,
                 m[3] / v, smax, smin, phi);
     }
 }
@@ -217,7 +218,7 @@ static void write_stress(const struct bal_sim *s, FILE *f)
 /* Moving averages (MLH Sec. 3): cells of width W and height H, stepped by
  * `step` horizontally (so they overlap when step < W) and by H vertically,
  * over the free discs; σ_cell = Σ_{discs with centre in the cell} Σ_c f ⊗ l / (W H). */
-static void write_stress_grid(const struct bal_sim *s, FILE *f)
+static void write_stress_grid(const struct bal_sim *s, const double *moment, FILE *f)
 {
     const struct bal_settings *st = &s->scene->settings;
     const double w = st->stress_width, h = st->stress_height > 0 ? st->stress_height : w;
@@ -239,7 +240,7 @@ static void write_stress_grid(const struct bal_sim *s, FILE *f)
                     s->y[i] >= yb + h)
                     continue;
                 for (int a = 0; a < 4; a++)
-                    m[a] += s->moment[4 * i + a];
+                    m[a] += moment[4 * i + a];
                 n++;
             }
             if (n == 0)
@@ -256,22 +257,29 @@ static void write_stress_grid(const struct bal_sim *s, FILE *f)
 
 enum bal_status bal_output_state(const struct bal_sim *s, const char *dir, struct bal_error *err)
 {
-    /* The stress files need the moments of the final state. */
-    bal_measure_moments(s, ((struct bal_sim *)s)->moment);
+    /* The stress files need the moments of the final state (output runs
+     * outside the step loop, so it may allocate). */
+    double *moment = malloc((size_t)(4 * s->n + 4) * sizeof *moment);
+    if (!moment)
+        return bal_error(err, BAL_ENOMEM, "%s: out of memory for the stresses", dir);
+    bal_measure_moments(s, moment);
     FILE *g = open_tmp(dir, "stress.tsv", err);
-    if (!g)
-        return err->code;
-    write_stress(s, g);
-    if (close_tmp(g, dir, "stress.tsv", err))
-        return err->code;
-    if (s->scene->settings.stress_width > 0) {
-        g = open_tmp(dir, "stress_grid.tsv", err);
-        if (!g)
-            return err->code;
-        write_stress_grid(s, g);
-        if (close_tmp(g, dir, "stress_grid.tsv", err))
-            return err->code;
+    enum bal_status st = g ? BAL_OK : err->code;
+    if (st == BAL_OK) {
+        write_stress(s, moment, g);
+        st = close_tmp(g, dir, "stress.tsv", err);
     }
+    if (st == BAL_OK && s->scene->settings.stress_width > 0) {
+        g = open_tmp(dir, "stress_grid.tsv", err);
+        st = g ? BAL_OK : err->code;
+        if (st == BAL_OK) {
+            write_stress_grid(s, moment, g);
+            st = close_tmp(g, dir, "stress_grid.tsv", err);
+        }
+    }
+    free(moment);
+    if (st != BAL_OK)
+        return st;
     FILE *f = open_tmp(dir, "contacts.tsv", err);
     if (!f)
         return err->code;
@@ -356,6 +364,10 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
                 in.n_candidates);
         json_number(f, in.wall_seconds > 0 ? (double)in.steps * in.n_discs / in.wall_seconds : 0);
         fprintf(f, ",\n  \"gravity\": [%.17g, %.17g]", s->g[0], s->g[1]);
+        fprintf(f, ",\n  \"timers\": {\"positions\": %.6g, \"neighbours\": %.6g, \"contacts\": %.6g, "
+                   "\"walls\": %.6g, \"velocities\": %.6g}, \"reorders\": %ld",
+                s->timers.positions, s->timers.neighbours, s->timers.contacts, s->timers.walls,
+                s->timers.velocities, s->reorders);
         fputs(",\n  \"energy_kinetic\": ", f);
         json_number(f, bal_measure_kinetic(s));
         fputs(",\n  \"energy_elastic\": ", f);

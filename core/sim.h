@@ -84,6 +84,25 @@ struct bal_grid {
 
 typedef void (*bal_pair_loop_fn)(struct bal_sim *s);
 
+/* A disc's cell and its array slot, for sorting discs into cell order. */
+struct bal_cell_key {
+    long cell;
+    int32_t slot;
+};
+
+/* Scratch of a rebuild: the new candidate list (keys and pair indices),
+ * where each new pair sat in the old list, and one history column at a time
+ * while it is carried over.  About 29 bytes per candidate, instead of a
+ * second copy of the whole list. */
+struct bal_rebuild_scratch {
+    long cap;
+    uint64_t *key;
+    int32_t *i, *j;
+    int32_t *map;          /* position of the same pair in the old list, or -1 */
+    double *col;           /* one double column being gathered */
+    uint8_t *bytes;        /* the flags column being gathered */
+};
+
 /* How a stage ended. */
 struct bal_stage_log {
     long cycles;           /* cycles run */
@@ -110,9 +129,8 @@ struct bal_sim {
     int32_t *slot;               /* array slot of scene-order index */
     double *x, *y, *th;          /* position, rotation */
     double *vx, *vy, *w;         /* velocities at t_{N-1/2} (t_{N+1/2} after a step) */
-    double *r, *m, *inv_m, *inertia, *inv_i;
+    double *r, *inv_m, *inv_i;   /* radius, 1/m, 1/I (m and I: bal_mass, bal_inertia) */
     double *fx, *fy, *tq;        /* force and moment sums of the last cycle */
-    double *vx_old, *vy_old, *w_old; /* velocities before the last update (for t_N averages) */
     double *x_ref, *y_ref;       /* positions at the last rebuild */
     int32_t *mat;
     uint8_t *fixed;
@@ -123,13 +141,13 @@ struct bal_sim {
     struct bal_wall *walls;
 
     /* materials */
+    double *density;             /* per material: mass per area */
     int n_mat;
     struct bal_pair_law *law;    /* n_mat × n_mat */
 
     /* contacts and neighbours */
     struct bal_pairs pp, pw;     /* disc–disc, disc–wall candidates */
-    struct bal_pairs scratch_pp; /* rebuild targets, swapped with pp and pw */
-    struct bal_pairs scratch_pw;
+    struct bal_rebuild_scratch rs; /* the new list of a rebuild, one column at a time */
     struct bal_grid grid;
     int use_grid;
     double skin;
@@ -148,8 +166,9 @@ struct bal_sim {
     int has_damping;             /* β > 0 */
 
     /* pile rows and stresses */
-    int32_t *row;                /* row M of a pile disc, -1 for other discs */
-    double *moment;              /* 4 per disc: Σ_c f ⊗ l (xx, xy, yx, yy), scratch */
+    int32_t *row;                /* row M of a pile disc, -1 otherwise; NULL without piles */
+    double *moment;              /* 4 per disc: Σ_c f ⊗ l (xx, xy, yx, yy); only with a
+                                  * stress stop rule (output allocates its own) */
     double *moment_prev;         /* the same at the previous check of a stop rule */
 
     /* stages */
@@ -159,7 +178,15 @@ struct bal_sim {
     /* probes */
     int n_probes;
     struct bal_probe_ref *probes;
-    int have_old;                /* vx_old etc. hold v_{N-1/2} of the last step */
+    int have_old;                /* a cycle has run: v_{N-1/2} can be recovered */
+
+    /* where the time goes (wall-clock seconds per phase of the cycle) */
+    struct bal_timers {
+        double positions, neighbours, contacts, walls, velocities;
+    } timers;
+    long reorders;               /* times the discs were re-sorted into cell order */
+    int32_t *new2old;            /* n entries: the permutation of the last re-sort */
+    int reordered;               /* 1: the lists still number discs as before the re-sort */
 
     /* progress */
     long step;
@@ -167,6 +194,19 @@ struct bal_sim {
     int stage;
     double wall_seconds;
 };
+
+/* Mass and moment of inertia of disc i: the same expressions as at creation
+ * (m = density π r², I = m r²/2), so they are bitwise the stored values of
+ * old; storing them would cost 16 bytes a disc. */
+static inline double bal_mass(const struct bal_sim *s, int i)
+{
+    return s->density[s->mat[i]] * BAL_PI * s->r[i] * s->r[i];
+}
+
+static inline double bal_inertia(const struct bal_sim *s, int i)
+{
+    return 0.5 * bal_mass(s, i) * s->r[i] * s->r[i];
+}
 
 /* contacts.c */
 enum bal_status bal_pairs_reserve(struct bal_pairs *p, long cap);
@@ -178,6 +218,14 @@ void bal_contacts_walls(struct bal_sim *s);
 
 /* grid.c */
 enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err);
+/* Re-sort the discs into cell order of their current positions, carrying
+ * every per-disc array and the probes along, then rebuild the lists (their
+ * history found through the permutation). */
+enum bal_status bal_grid_reorder(struct bal_sim *s, struct bal_error *err);
+void bal_grid_scratch_free(struct bal_rebuild_scratch *rs);
+/* Rebuilds between two re-sorts: the order decays only as discs flow, and a
+ * re-sort costs about as much as a few rebuilds. */
+#define BAL_REORDER_EVERY 20
 void bal_grid_free(struct bal_grid *g);
 /* With fewer discs than this, `grid = auto` uses all pairs.  Measured with
  * `build/bench --grid cases/bench/dense.scene` (README, "Neighbour search"):
@@ -194,12 +242,17 @@ double bal_walls_closest(const struct bal_wall *w, double x, double y,
 
 /* integrate.c */
 void bal_integrate_positions(struct bal_sim *s);
-void bal_integrate_velocities(struct bal_sim *s, int keep_old);
+void bal_integrate_velocities(struct bal_sim *s);
+/* The velocities v_{N-1/2} of disc i before the last update, recovered from
+ * v_{N+1/2} and the force sums by inverting eqs (35)-(36). */
+void bal_integrate_previous(const struct bal_sim *s, int i, double *vx, double *vy, double *w);
 
 /* timestep.c */
 double bal_timestep_estimate(const struct bal_sim *s);
 
 /* measure.c */
+/* Velocities of disc i at t_N (eq. 31), recovered after a cycle. */
+void bal_measure_velocity(const struct bal_sim *s, int i, double *vx, double *vy, double *w);
 /* Per disc, Σ_c f^c ⊗ l^c over its contacts (MLH eq. 8 without 1/V), into
  * m[4 i .. 4 i + 3] = xx, xz, zx, zz (z vertical). */
 void bal_measure_moments(const struct bal_sim *s, double *m);

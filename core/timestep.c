@@ -32,11 +32,11 @@ double bal_timestep_estimate(const struct bal_sim *s)
         }
         if (s->normal_law == BAL_NORMAL_POWER)
             kn *= s->nu;
-        const double m = s->m[i];
+        const double m = bal_mass(s, i);
         double t = 2 * sqrt(m / kn);
         if (ks > 0) {
             t = fmin(t, 2 * sqrt(m / ks));
-            t = fmin(t, 2 * sqrt(s->inertia[i] / (ks * s->r[i] * s->r[i])));
+            t = fmin(t, 2 * sqrt(bal_inertia(s, i) / (ks * s->r[i] * s->r[i])));
         }
         best = fmin(best, t);
     }

@@ -21,6 +21,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -155,6 +156,20 @@ static int run_one(const char *path, long n, FILE *csv, struct options *o)
     if (csv)
         fprintf(csv, "%ld,%d,%ld,%.6g,%.6g,%.6g,%.4f,%ld\n", (long)time(NULL), sim->n, steps,
                 rate[REPEATS / 2], rate[0], rate[REPEATS - 1], z, sim->rebuilds);
+    if (!o->quiet) {
+        struct rusage ru;
+        getrusage(RUSAGE_SELF, &ru);
+        long contacts = 0;
+        for (long c = 0; c < sim->pp.n; c++)
+            contacts += (sim->pp.flags[c] & BAL_PAIR_TOUCHING) != 0;
+        const double rss = 1024.0 * (double)ru.ru_maxrss;
+        printf("# N=%d memory: peak RSS %.1f MB = %.0f bytes/disc; %ld candidate pairs "
+               "(%.2f per disc), %ld contacts; timers: positions %.2f neighbours %.2f contacts "
+               "%.2f walls %.2f velocities %.2f s; %ld re-sorts\n",
+               sim->n, rss / 1e6, rss / sim->n, sim->pp.n, (double)sim->pp.n / sim->n, contacts,
+               sim->timers.positions, sim->timers.neighbours, sim->timers.contacts,
+               sim->timers.walls, sim->timers.velocities, sim->reorders);
+    }
     bal_sim_free(sim);
     bal_scene_free(&sc);
     return 0;

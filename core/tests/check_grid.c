@@ -372,6 +372,56 @@ START_TEST(grid_on_off_agree_on_packing)
 }
 END_TEST
 
+/* Re-sorting the discs into cell order (bal_grid_reorder) renumbers every
+ * array and the contact lists but is no physics: a frictional packing
+ * settling under gravity, re-sorted every 7 cycles, keeps each disc (by its
+ * scene id) where the un-sorted run has it, its contact count and its shear
+ * history.  Only the order in which forces are summed changes, so the two
+ * runs agree to round-off (REORDER_REL of the box size), not bitwise. */
+#define REORDER_REL 1e-9
+START_TEST(grid_reorder_is_no_physics)
+{
+    static const char *const text =
+        "[settings]\ndt_fraction = 0.2\ngravity = 0 -9.81\nbeta = 0.001\ngrid = on\n"
+        "[material g]\nkn = 1e5\nfriction = 0.5\ndensity = 1\n"
+        "[material b]\nkn = 1e5\nfriction = 0.5\n"
+        "[fill pack]\nn = 300\ncolumns = 24\nrmin = 0.5\nrmax = 0.75\nseed = 7\nbox = 1\n"
+        "vmax = 2\nmaterial = g\nwall_material = b\n[stage s]\ncycles = 1\n";
+    struct tfx *a = tfx_new(text, "plain"), *b = tfx_new(text, "sorted");
+    for (int k = 0; k < 700; k++) {
+        t_steps(a, 1);
+        if (k % 7 == 6)
+            ck_assert_int_eq(bal_grid_reorder(b->sim, &b->err), BAL_OK);
+        t_steps(b, 1);
+    }
+    const struct bal_sim *sa = a->sim, *sb = b->sim;
+    ck_assert_int_ge(sb->reorders, 20);
+    int moved = 0;
+    for (int id = 0; id < sa->n; id++) {
+        const int i = sa->slot[id], j = sb->slot[id];
+        ck_assert_double_eq_tol(sa->x[i], sb->x[j], REORDER_REL * 40);
+        ck_assert_double_eq_tol(sa->y[i], sb->y[j], REORDER_REL * 40);
+        moved += i != j;
+    }
+    ck_assert_int_gt(moved, 0); /* the re-sort did renumber discs */
+    long ca = 0, cb = 0;
+    double fa = 0, fb = 0;
+    for (long c = 0; c < sa->pp.n; c++)
+        if (sa->pp.flags[c] & BAL_PAIR_TOUCHING) {
+            ca++;
+            fa += fabs(pair_fs(&sa->pp, c));
+        }
+    for (long c = 0; c < sb->pp.n; c++)
+        if (sb->pp.flags[c] & BAL_PAIR_TOUCHING) {
+            cb++;
+            fb += fabs(pair_fs(&sb->pp, c));
+        }
+    ck_assert_int_eq(ca, cb);
+    ck_assert_int_gt(ca, 20); /* contacts with shear history exist */
+    ck_assert_double_eq_tol(fa, fb, 1e-6 * fa);
+}
+END_TEST
+
 Suite *suite_grid(void)
 {
     Suite *s = suite_create("grid");
@@ -388,6 +438,7 @@ Suite *suite_grid(void)
     tcase_add_test(tc, grid_merge_history);
     tcase_add_test(tc, grid_history_survives_rebuild);
     tcase_add_test(tc, grid_on_off_agree_on_packing);
+    tcase_add_test(tc, grid_reorder_is_no_physics);
     suite_add_tcase(s, tc);
     return s;
 }

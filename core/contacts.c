@@ -68,10 +68,10 @@ enum bal_status bal_pairs_reserve(struct bal_pairs *p, long cap)
              grow_array((void **)&p->fn, c, sizeof *p->fn) &&
              grow_array((void **)&p->flags, c, sizeof *p->flags);
     if (ok && p->shear)
-        ok = grow_array((void **)&p->fs, c, sizeof *p->fs) &&
-             grow_array((void **)&p->ds, c, sizeof *p->ds);
+        ok = grow_array((void **)&p->fs, c, sizeof *p->fs);
     if (ok && p->damping)
-        ok = grow_array((void **)&p->dn, c, sizeof *p->dn);
+        ok = grow_array((void **)&p->dn, c, sizeof *p->dn) &&
+             grow_array((void **)&p->ds, c, sizeof *p->ds);
     if (!ok)
         return BAL_ENOMEM;
     p->cap = cap;
@@ -107,12 +107,12 @@ void bal_pairs_merge_history(struct bal_pairs *fresh, const struct bal_pairs *ol
         const int same = a < old->n && old->key[a] == k;
         fresh->fn[c] = same ? old->fn[a] : 0;
         fresh->flags[c] = same ? old->flags[a] : 0;
-        if (fresh->shear) {
+        if (fresh->shear)
             fresh->fs[c] = same ? old->fs[a] : 0;
+        if (fresh->damping) {
+            fresh->dn[c] = same ? old->dn[a] : 0;
             fresh->ds[c] = same ? old->ds[a] : 0;
         }
-        if (fresh->damping)
-            fresh->dn[c] = same ? old->dn[a] : 0;
     }
 }
 
@@ -163,12 +163,8 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
             /* Not in contact (eq. 8): history is reset. */
             p->fn[c] = 0;
             p->flags[c] = 0;
-            if (shear) {
+            if (shear)
                 p->fs[c] = 0;
-                p->ds[c] = 0;
-            }
-            if (damp)
-                p->dn[c] = 0;
             continue;
         }
         const struct bal_pair_law *L = &laws[mat[i] * n_mat + mat[j]];
@@ -188,11 +184,8 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
         p->fn[c] = fn;
         double ftn = fn, fts = 0;
         uint8_t flags = BAL_PAIR_TOUCHING;
-        if (damp) {
-            const double dn = (L->cn + viscous(s, rs - dist)) * ndot;
-            p->dn[c] = dn;
-            ftn += dn;
-        }
+        if (damp)
+            ftn += (L->cn + viscous(s, rs - dist)) * ndot;
         if (shear && L->shear) {
             const double tx = ey, ty = -ex;
             const double sdot = rvx * tx + rvy * ty - (w[i] * r[i] + w[j] * r[j]);
@@ -204,11 +197,8 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
             }
             p->fs[c] = fs;
             fts = fs;
-            if (damp) {
-                const double ds = (flags & BAL_PAIR_SLIDING) ? 0.0 : L->cs * sdot;
-                p->ds[c] = ds;
-                fts += ds;
-            }
+            if (damp && !(flags & BAL_PAIR_SLIDING))
+                fts += L->cs * sdot;
         }
         p->flags[c] = flags;
 
@@ -329,5 +319,34 @@ void bal_contacts_walls(struct bal_sim *s)
         const double along = (cx - W->p[0]) * W->e[0] + (cy - W->p[1]) * W->e[1];
         W->fn_sum += ftn;
         W->fn_s_sum += ftn * along;
+    }
+}
+
+void bal_contact_dashpots(const struct bal_sim *s, const struct bal_pairs *p, long c,
+                          double *dn, double *ds)
+{
+    *dn = *ds = 0;
+    if (!(p->flags[c] & BAL_PAIR_TOUCHING))
+        return;
+    if (p != &s->pp) {
+        *dn = p->dn ? p->dn[c] : 0;
+        *ds = p->ds ? p->ds[c] : 0;
+        return;
+    }
+    if (!s->has_damping)
+        return;
+    const int i = p->i[c], j = p->j[c];
+    const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + s->mat[j]];
+    const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
+    const double dist = sqrt(dx * dx + dy * dy), ex = dx / dist, ey = dy / dist;
+    double vxi, vyi, wi, vxj, vyj, wj;
+    bal_integrate_previous(s, i, &vxi, &vyi, &wi);
+    bal_integrate_previous(s, j, &vxj, &vyj, &wj);
+    const double rvx = vxi - vxj, rvy = vyi - vyj;
+    const double ndot = rvx * ex + rvy * ey;
+    *dn = (L->cn + viscous(s, s->r[i] + s->r[j] - dist)) * ndot;
+    if (s->has_shear && L->shear && !(p->flags[c] & BAL_PAIR_SLIDING)) {
+        const double sdot = rvx * ey - rvy * ex - (wi * s->r[i] + wj * s->r[j]);
+        *ds = L->cs * sdot;
     }
 }

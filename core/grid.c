@@ -18,7 +18,7 @@
  *
  * Memory: a rebuild writes the new list into a scratch of keys and pair
  * indices and carries the history over one column at a time, so it needs
- * about 29 bytes a candidate beside the list itself.  Lists grow by a
+ * about 21 bytes a candidate beside the list itself.  Lists grow by a
  * quarter, and only here, in a rebuild; the contact loops never allocate.
  *
  * Every BAL_REORDER_EVERY rebuilds the discs are re-sorted into the cell
@@ -70,22 +70,21 @@ static enum bal_status grow_scratch(struct bal_rebuild_scratch *rs, long need,
     void *k = realloc(rs->key, (size_t)cap * sizeof *rs->key);
     if (k)
         rs->key = k;
-    void *i = realloc(rs->i, (size_t)cap * sizeof *rs->i);
-    if (i)
-        rs->i = i;
-    void *j = realloc(rs->j, (size_t)cap * sizeof *rs->j);
-    if (j)
-        rs->j = j;
     void *m = realloc(rs->map, (size_t)cap * sizeof *rs->map);
     if (m)
         rs->map = m;
-    void *c = realloc(rs->col, (size_t)cap * sizeof *rs->col);
-    if (c)
-        rs->col = c;
+    void *c = rs->col;
+    if (cap > rs->col_cap) {
+        c = realloc(rs->col, (size_t)cap * sizeof *rs->col);
+        if (c) {
+            rs->col = c;
+            rs->col_cap = cap;
+        }
+    }
     void *b = realloc(rs->bytes, (size_t)cap * sizeof *rs->bytes);
     if (b)
         rs->bytes = b;
-    if (!k || !i || !j || !m || !c || !b)
+    if (!k || !m || !c || !b)
         return bal_error(err, BAL_ENOMEM, "neighbour list: out of memory for %ld pairs", cap);
     rs->cap = cap;
     return BAL_OK;
@@ -94,8 +93,6 @@ static enum bal_status grow_scratch(struct bal_rebuild_scratch *rs, long need,
 void bal_grid_scratch_free(struct bal_rebuild_scratch *rs)
 {
     free(rs->key);
-    free(rs->i);
-    free(rs->j);
     free(rs->map);
     free(rs->col);
     free(rs->bytes);
@@ -108,8 +105,6 @@ static inline enum bal_status push(struct bal_rebuild_scratch *rs, long *n, int 
     if (*n + 1 > rs->cap && grow_scratch(rs, *n + 1, err))
         return err->code;
     rs->key[*n] = ((uint64_t)(uint32_t)i << 32) | (uint32_t)j;
-    rs->i[*n] = i;
-    rs->j[*n] = j;
     (*n)++;
     return BAL_OK;
 }
@@ -145,7 +140,8 @@ static void match_old(const struct bal_sim *s, const struct bal_pairs *old,
         return;
     }
     for (long c = 0; c < n; c++) {
-        int i = s->new2old[rs->i[c]], j = walls ? rs->j[c] : s->new2old[rs->j[c]];
+        const int ni = (int)(rs->key[c] >> 32), nj = (int)(rs->key[c] & 0xffffffffu);
+        int i = s->new2old[ni], j = walls ? nj : s->new2old[nj];
         if (!walls && j < i) {
             const int t = i;
             i = j;
@@ -167,7 +163,7 @@ static enum bal_status install(const struct bal_sim *s, struct bal_pairs *p,
                                struct bal_rebuild_scratch *rs, long n, int walls,
                                struct bal_error *err)
 {
-    if (n == 0) {
+    if (n <= 0) {
         p->n = 0;
         return BAL_OK;
     }
@@ -175,18 +171,20 @@ static enum bal_status install(const struct bal_sim *s, struct bal_pairs *p,
     if (grow(p, n, err))
         return err->code;
     gather(p->fn, rs, n);
-    if (p->shear) {
+    if (p->shear)
         gather(p->fs, rs, n);
+    if (p->damping) {
+        gather(p->dn, rs, n);
         gather(p->ds, rs, n);
     }
-    if (p->damping)
-        gather(p->dn, rs, n);
     for (long c = 0; c < n; c++)
         rs->bytes[c] = rs->map[c] >= 0 ? p->flags[rs->map[c]] : 0;
     memcpy(p->flags, rs->bytes, (size_t)n * sizeof *p->flags);
     memcpy(p->key, rs->key, (size_t)n * sizeof *p->key);
-    memcpy(p->i, rs->i, (size_t)n * sizeof *p->i);
-    memcpy(p->j, rs->j, (size_t)n * sizeof *p->j);
+    for (long c = 0; c < n; c++) {
+        p->i[c] = (int32_t)(rs->key[c] >> 32);
+        p->j[c] = (int32_t)(rs->key[c] & 0xffffffffu);
+    }
     p->n = n;
     return BAL_OK;
 }
@@ -385,8 +383,15 @@ enum bal_status bal_grid_reorder(struct bal_sim *s, struct bal_error *err)
         const long nx = (long)((x1 - x0) / h) + 1;
         /* The sort keys (16 bytes a disc) and the permutation buffers live in
          * the rebuild scratch column; stress moments need 4 doubles a disc. */
-        if (grow_scratch(&s->rs, 4L * n, err))
-            return err->code;
+        /* Sort keys take 2 doubles a disc, stress moments 4. */
+        const long need = (s->moment_prev ? 4L : 2L) * n;
+        if (need > s->rs.col_cap) {
+            double *c = realloc(s->rs.col, (size_t)need * sizeof *c);
+            if (!c)
+                return bal_error(err, BAL_ENOMEM, "re-sort: out of memory for %d discs", n);
+            s->rs.col = c;
+            s->rs.col_cap = need;
+        }
         struct bal_cell_key *order = (struct bal_cell_key *)s->rs.col;
         for (int i = 0; i < n; i++)
             order[i] = (struct bal_cell_key){(long)((s->y[i] - y0) / h) * nx +

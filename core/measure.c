@@ -94,9 +94,11 @@ double bal_measure_elastic(const struct bal_sim *s)
     return e;
 }
 
-static double contact_force(const struct bal_pairs *p, long c)
+static double contact_force(const struct bal_sim *s, const struct bal_pairs *p, long c)
 {
-    return hypot(p->fn[c] + pair_dn(p, c), pair_fs(p, c) + pair_ds(p, c));
+    double dn, ds;
+    bal_contact_dashpots(s, p, c, &dn, &ds);
+    return hypot(p->fn[c] + dn, pair_fs(p, c) + ds);
 }
 
 double bal_measure_unbalanced(const struct bal_sim *s)
@@ -104,10 +106,10 @@ double bal_measure_unbalanced(const struct bal_sim *s)
     double fbig = 0;
     for (long c = 0; c < s->pp.n; c++)
         if (s->pp.flags[c] & BAL_PAIR_TOUCHING)
-            fbig = fmax(fbig, contact_force(&s->pp, c));
+            fbig = fmax(fbig, contact_force(s, &s->pp, c));
     for (long c = 0; c < s->pw.n; c++)
         if (s->pw.flags[c] & BAL_PAIR_TOUCHING)
-            fbig = fmax(fbig, contact_force(&s->pw, c));
+            fbig = fmax(fbig, contact_force(s, &s->pw, c));
     if (fbig == 0)
         return 0;
     double smax = 0;
@@ -156,8 +158,10 @@ void bal_measure_moments(const struct bal_sim *s, double *m)
         const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
         const double d = hypot(dx, dy), ex = dx / d, ey = dy / d;
         const double delta = s->r[i] + s->r[j] - d;
-        const double ftn = s->pp.fn[c] + pair_dn(&s->pp, c);
-        const double fts = pair_fs(&s->pp, c) + pair_ds(&s->pp, c);
+        double dn, ds;
+        bal_contact_dashpots(s, &s->pp, c, &dn, &ds);
+        const double ftn = s->pp.fn[c] + dn;
+        const double fts = pair_fs(&s->pp, c) + ds;
         /* Force on j is ftn e + fts t, t = (ey, -ex); on i the opposite.  The
          * contact point lies on the line of centres, in the middle of the
          * overlap; l runs from each centre to it. */

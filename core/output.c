@@ -129,9 +129,11 @@ static void write_contacts(const struct bal_sim *s, FILE *f)
         const double ex = dx / d, ey = dy / d, at = s->r[i] - delta / 2;
         body_name(s, 0, i, a, sizeof a);
         body_name(s, 0, j, b, sizeof b);
+        double dn, ds;
+        bal_contact_dashpots(s, &s->pp, c, &dn, &ds);
         fprintf(f, "%s\t%s\tdisc\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d\n", a,
                 b, s->x[i] + at * ex, s->y[i] + at * ey, ex, ey, s->pp.fn[c], pair_fs(&s->pp, c),
-                pair_dn(&s->pp, c), pair_ds(&s->pp, c), (s->pp.flags[c] & BAL_PAIR_SLIDING) != 0);
+                dn, ds, (s->pp.flags[c] & BAL_PAIR_SLIDING) != 0);
     }
     for (long c = 0; c < s->pw.n; c++) {
         if (!(s->pw.flags[c] & BAL_PAIR_TOUCHING))

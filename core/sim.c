@@ -507,7 +507,7 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
      * columns only when the scene needs them; wall lists always do (walls
      * are few, and one generic loop serves them). */
     s->pp.shear = (uint8_t)s->has_shear;
-    s->pp.damping = (uint8_t)s->has_damping;
+    s->pp.damping = 0; /* disc-pair dashpots are recomputed for reports */
     s->pw.shear = 1;
     s->pw.damping = 1;
     s->pair_loop = bal_contacts_select(s->normal_law, s->has_shear, s->has_damping);
@@ -771,4 +771,34 @@ void bal_sim_contact_point(const struct bal_sim *s, int i, int is_wall, int j, d
     const double t = (s->r[i] - delta / 2) / d;
     *px = s->x[i] + t * dx;
     *py = s->y[i] + t * dy;
+}
+
+static double list_bytes(const struct bal_pairs *p)
+{
+    double per = sizeof *p->key + sizeof *p->i + sizeof *p->j + sizeof *p->fn + sizeof *p->flags;
+    if (p->shear)
+        per += sizeof *p->fs;
+    if (p->damping)
+        per += sizeof *p->dn + sizeof *p->ds;
+    return per * (double)p->cap;
+}
+
+void bal_sim_memory(const struct bal_sim *s, double *disc_bytes, double *pair_bytes)
+{
+    const double n = s->n;
+    /* 14 double columns, id, slot, mat, fixed, grid cell and list, new2old */
+    double d = n * (14 * sizeof(double) + 3 * sizeof(int32_t) + 1 + 3 * sizeof(int32_t));
+    if (s->row)
+        d += n * sizeof *s->row;
+    if (s->moment)
+        d += 4 * n * sizeof *s->moment;
+    if (s->moment_prev)
+        d += 4 * n * sizeof *s->moment_prev;
+    d += (double)s->grid.cells_cap * sizeof *s->grid.start;
+    const struct bal_rebuild_scratch *rs = &s->rs;
+    double p = list_bytes(&s->pp) + list_bytes(&s->pw);
+    p += (double)rs->cap * (sizeof *rs->key + sizeof *rs->map + sizeof *rs->bytes) +
+         (double)rs->col_cap * sizeof *rs->col;
+    *disc_bytes = d;
+    *pair_bytes = p;
 }

@@ -38,7 +38,9 @@ struct bal_pair_law {
  * bit 1 sliding (|F_s| at the Coulomb limit).  The shear history (fs, ds)
  * exists only when `shear` is set and the normal dashpot (dn) only when
  * `damping` is: a frictionless, undamped scene carries neither, and its
- * rebuilds do not copy them.  Read them through pair_fs() etc. */
+ * rebuilds do not copy them.  The disc–disc list never stores its dashpot
+ * forces (they are recomputed for reports: bal_contact_dashpots); the wall
+ * list does.  Read F_s through pair_fs(). */
 struct bal_pairs {
     long n, cap;
     uint8_t shear, damping; /* which optional columns exist */
@@ -50,8 +52,6 @@ struct bal_pairs {
 };
 
 static inline double pair_fs(const struct bal_pairs *p, long c) { return p->fs ? p->fs[c] : 0.0; }
-static inline double pair_ds(const struct bal_pairs *p, long c) { return p->ds ? p->ds[c] : 0.0; }
-static inline double pair_dn(const struct bal_pairs *p, long c) { return p->dn ? p->dn[c] : 0.0; }
 
 #define BAL_PAIR_TOUCHING 1u
 #define BAL_PAIR_SLIDING 2u
@@ -90,14 +90,14 @@ struct bal_cell_key {
     int32_t slot;
 };
 
-/* Scratch of a rebuild: the new candidate list (keys and pair indices),
- * where each new pair sat in the old list, and one history column at a time
- * while it is carried over.  About 29 bytes per candidate, instead of a
- * second copy of the whole list. */
+/* Scratch of a rebuild: the new candidate list (its keys), where each new
+ * pair sat in the old list, and one history column at a time while it is
+ * carried over.  About 21 bytes per candidate, instead of a second copy of
+ * the whole list. */
 struct bal_rebuild_scratch {
     long cap;
-    uint64_t *key;
-    int32_t *i, *j;
+    long col_cap;          /* `col` may be longer: the re-sort uses it as its buffer */
+    uint64_t *key;         /* (i << 32) | j of each new pair */
     int32_t *map;          /* position of the same pair in the old list, or -1 */
     double *col;           /* one double column being gathered */
     uint8_t *bytes;        /* the flags column being gathered */
@@ -215,6 +215,12 @@ void bal_pairs_sort(struct bal_pairs *p);
 void bal_pairs_merge_history(struct bal_pairs *fresh, const struct bal_pairs *old);
 bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping);
 void bal_contacts_walls(struct bal_sim *s);
+/* The dashpot forces D_n, D_s of contact c of list p in the last cycle:
+ * stored for walls, recomputed for disc pairs from the geometry at t_N and
+ * the velocities v_{N-1/2} (recovered), exactly as the cycle computed them.
+ * Zero for a contact that is not touching. */
+void bal_contact_dashpots(const struct bal_sim *s, const struct bal_pairs *p, long c,
+                          double *dn, double *ds);
 
 /* grid.c */
 enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err);
@@ -267,6 +273,9 @@ int bal_sim_disc_id(const struct bal_sim *s, int i);
 const char *bal_sim_wall_name(const struct bal_sim *s, int k);
 void bal_sim_contact_point(const struct bal_sim *s, int i, int is_wall, int j, double *px,
                            double *py);
+/* Bytes the simulation holds while it steps (every array at its allocated
+ * capacity), split into what scales with discs and with candidate pairs. */
+void bal_sim_memory(const struct bal_sim *s, double *disc_bytes, double *pair_bytes);
 /* Number of discs a [pile] generates. */
 long bal_sim_pile_count(const struct bal_pile_def *p);
 enum bal_status bal_sim_cycle(struct bal_sim *s, int keep_old, struct bal_error *err);

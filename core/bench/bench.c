@@ -163,10 +163,17 @@ static int run_one(const char *path, long n, FILE *csv, struct options *o)
         for (long c = 0; c < sim->pp.n; c++)
             contacts += (sim->pp.flags[c] & BAL_PAIR_TOUCHING) != 0;
         const double rss = 1024.0 * (double)ru.ru_maxrss;
-        printf("# N=%d memory: peak RSS %.1f MB = %.0f bytes/disc; %ld candidate pairs "
+        double disc_bytes, pair_bytes;
+        bal_sim_memory(sim, &disc_bytes, &pair_bytes);
+        printf("# N=%d memory: held while stepping %.0f bytes/disc (%.0f per disc + %.0f for its "
+               "pairs, %.1f bytes per contact); peak RSS %.1f MB = %.0f bytes/disc\n",
+               sim->n, (disc_bytes + pair_bytes) / sim->n, disc_bytes / sim->n,
+               pair_bytes / sim->n, pair_bytes / (double)(contacts > 0 ? contacts : 1), rss / 1e6,
+               rss / sim->n);
+        printf("# N=%d %ld candidate pairs "
                "(%.2f per disc), %ld contacts; timers: positions %.2f neighbours %.2f contacts "
                "%.2f walls %.2f velocities %.2f s; %ld re-sorts\n",
-               sim->n, rss / 1e6, rss / sim->n, sim->pp.n, (double)sim->pp.n / sim->n, contacts,
+               sim->n, sim->pp.n, (double)sim->pp.n / sim->n, contacts,
                sim->timers.positions, sim->timers.neighbours, sim->timers.contacts,
                sim->timers.walls, sim->timers.velocities, sim->reorders);
     }

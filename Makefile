@@ -27,7 +27,8 @@ LIB_OBJ  := $(LIB_SRC:core/%.c=$(BUILD)/%.o)
 TEST_SRC := $(wildcard core/tests/check_*.c)
 BENCH_SRC := core/bench/bench.c
 
-.PHONY: all deps test test-c test-prefix test-py test-sanitize validate bench clean keys
+.PHONY: all deps test test-c test-prefix test-py test-sanitize validate bench bench-scaling \
+        bench-peer clean keys
 
 all: deps bin/ballast
 
@@ -88,6 +89,12 @@ $(BUILD)/bench: $(BENCH_SRC) $(BUILD)/libballast.a
 
 bench: deps $(BUILD)/bench
 	$(BUILD)/bench cases/bench/dense.scene
+	$(BUILD)/bench --settling cases/bench/dense.scene 20000
+	$(BUILD)/bench --pile cases/piles/pile30_bumpy.scene
+
+# Particle-steps per second from 1 000 to 1 000 000 discs (about 40 minutes).
+bench-scaling: deps $(BUILD)/bench
+	$(BUILD)/bench cases/bench/dense.scene 1000 5000 20000 80000 320000 1000000
 
 keys: bin/ballast
 	bin/ballast keys

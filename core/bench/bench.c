@@ -16,6 +16,8 @@
  * usage: bench SCENE [N ...]      (default N: 5000 20000 80000)
  *        bench --grid SCENE       (all pairs against the cell grid, small N:
  *                                  where BAL_GRID_CROSSOVER comes from)
+ *        bench --settling SCENE [N]  (the packing timed while it falls)
+ *        bench --pile PILE_SCENE  (the L0 = 100 pile relaxed, 5 whole runs)
  */
 #include <math.h>
 #include <stdio.h>
@@ -62,6 +64,7 @@ static double timed_steps(struct bal_sim *sim, long steps, struct bal_error *err
 struct options {
     const char *extra;
     const char *extra2;
+    int flowing;            /* time the fall itself: no settling first */
     double seconds;
     int quiet;
     double median;
@@ -107,7 +110,7 @@ static int run_one(const char *path, long n, FILE *csv, struct options *o)
      * blocks of the first stage's length until it is (or give up and say
      * so in the output). */
     long extra = 0;
-    while (bal_measure_kinetic(sim) > SETTLED_EK_OVER_EE * bal_measure_elastic(sim) &&
+    while (!o->flowing && bal_measure_kinetic(sim) > SETTLED_EK_OVER_EE * bal_measure_elastic(sim) &&
            extra < MAX_SETTLE_BLOCKS * sc.stages[0].cycles) {
         for (long c = 0; c < sc.stages[0].cycles; c++, extra++)
             if (bal_sim_cycle(sim, 1, &err)) {
@@ -149,9 +152,10 @@ static int run_one(const char *path, long n, FILE *csv, struct options *o)
         printf("# N=%d settled for %ld cycles: E_k/E_el = %.2g, %ld rebuilds so far\n", sim->n,
                sc.stages[0].cycles + extra, ek_ee, sim->rebuilds);
     if (!o->quiet)
-        printf("bench dense N=%d steps=%ld particle_steps_per_s=%.4g min=%.4g max=%.4g "
+        printf("bench %s N=%d steps=%ld particle_steps_per_s=%.4g min=%.4g max=%.4g "
            "contacts_per_disc=%.3f\n",
-           sim->n, steps, rate[REPEATS / 2], rate[0], rate[REPEATS - 1], z);
+           o->flowing ? "settling" : "dense", sim->n, steps, rate[REPEATS / 2], rate[0],
+           rate[REPEATS - 1], z);
     fflush(stdout);
     if (csv)
         fprintf(csv, "%ld,%d,%ld,%.6g,%.6g,%.6g,%.4f,%ld\n", (long)time(NULL), sim->n, steps,
@@ -213,8 +217,8 @@ static int grid_crossover(const char *path)
                REPEATS);
         printf("%6s %12s %12s %8s\n", "N", "all_pairs", "grid", "grid/all");
         for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
-            struct options off = {"settings.grid=off", phase[p], 0.2, 1, 0};
-            struct options on = {"settings.grid=on", phase[p], 0.2, 1, 0};
+            struct options off = {"settings.grid=off", phase[p], 0, 0.2, 1, 0};
+            struct options on = {"settings.grid=on", phase[p], 0, 0.2, 1, 0};
             if (run_one(path, sizes[k], NULL, &off) || run_one(path, sizes[k], NULL, &on))
                 return 1;
             printf("%6ld %12.4g %12.4g %8.3f\n", sizes[k], off.median, on.median,
@@ -222,6 +226,38 @@ static int grid_crossover(const char *path)
             fflush(stdout);
         }
     }
+    return 0;
+}
+
+/* The pile of MLH Sec. 4.3 (cases/piles/pile30_bumpy.scene with L = 100,
+ * 1717 discs, frictionless), relaxed from the lattice under a gravity ramp
+ * until its stop rule holds: each repeat is a whole run from scratch. */
+static int pile_bench(const char *path)
+{
+    double rate[REPEATS];
+    long steps = 0;
+    int n = 0;
+    for (int k = 0; k < REPEATS; k++) {
+        struct bal_scene sc;
+        struct bal_error err = {0};
+        struct bal_sim *sim = NULL;
+        bal_scene_default(&sc);
+        if (bal_scene_load(&sc, path, &err) || bal_scene_set(&sc, "pile.p.L=100", &err) ||
+            bal_sim_create(&sim, &sc, &err) || bal_sim_run(sim, NULL, NULL, &err)) {
+            fprintf(stderr, "bench: %s\n", err.msg);
+            bal_sim_free(sim);
+            bal_scene_free(&sc);
+            return 1;
+        }
+        rate[k] = (double)sim->step * sim->n / sim->wall_seconds;
+        steps = sim->step;
+        n = sim->n;
+        bal_sim_free(sim);
+        bal_scene_free(&sc);
+    }
+    qsort(rate, REPEATS, sizeof rate[0], cmp_double);
+    printf("bench pile N=%d steps=%ld particle_steps_per_s=%.4g min=%.4g max=%.4g\n", n, steps,
+           rate[REPEATS / 2], rate[0], rate[REPEATS - 1]);
     return 0;
 }
 
@@ -233,6 +269,15 @@ int main(int argc, char **argv)
     }
     if (strcmp(argv[1], "--grid") == 0 && argc == 3)
         return grid_crossover(argv[2]);
+    if (strcmp(argv[1], "--pile") == 0 && argc == 3)
+        return pile_bench(argv[2]);
+    if (strcmp(argv[1], "--settling") == 0 && argc >= 3) {
+        /* The same packing timed while it falls from the lattice (settle
+         * stage cut to one cycle): flow, frequent rebuilds and re-sorts. */
+        const long n = argc > 3 ? atol(argv[3]) : 20000;
+        struct options o = {"stage.settle.cycles=1", NULL, 1, TARGET_SECONDS, 0, 0};
+        return run_one(argv[2], n, NULL, &o);
+    }
     long sizes[16] = {5000, 20000, 80000};
     int n_sizes = 3;
     if (argc > 2) {
@@ -243,7 +288,7 @@ int main(int argc, char **argv)
     FILE *csv = open_csv();
     int rc = 0;
     for (int k = 0; k < n_sizes && rc == 0; k++)
-        rc = run_one(argv[1], sizes[k], csv, &(struct options){NULL, NULL, TARGET_SECONDS, 0, 0});
+        rc = run_one(argv[1], sizes[k], csv, &(struct options){NULL, NULL, 0, TARGET_SECONDS, 0, 0});
     if (csv)
         fclose(csv);
     return rc;

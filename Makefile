@@ -92,6 +92,11 @@ bench: deps $(BUILD)/bench
 	$(BUILD)/bench --settling cases/bench/dense.scene 20000
 	$(BUILD)/bench --pile cases/piles/pile30_bumpy.scene
 
+# ballast against LAMMPS on the same scenes (installs Debian's lammps if missing;
+# LAMMPS is not a build or test dependency).
+bench-peer: all
+	$(PYTHON) bench/peer/race.py
+
 # Particle-steps per second from 1 000 to 1 000 000 discs (about 40 minutes).
 bench-scaling: deps $(BUILD)/bench
 	$(BUILD)/bench cases/bench/dense.scene 1000 5000 20000 80000 320000 1000000

@@ -4,6 +4,7 @@
 #   make test         C unit tests (Check), symbol-prefix check, harness tests (pytest)
 #   make test-sanitize  C unit tests under AddressSanitizer + UndefinedBehaviorSanitizer
 #   make bench        dense-packing benchmark (median and spread of 5 repeats)
+#   make bench-peer   ballast against LAMMPS on the same physics (cross-check, then the race)
 #   make clean
 
 # ---- settings -------------------------------------------------------------
@@ -92,9 +93,10 @@ bench: deps $(BUILD)/bench
 	$(BUILD)/bench --settling cases/bench/dense.scene 20000
 	$(BUILD)/bench --pile cases/piles/pile30_bumpy.scene
 
-# ballast against LAMMPS on the same scenes (installs Debian's lammps if missing;
-# LAMMPS is not a build or test dependency).
-bench-peer: all
+# ballast against LAMMPS (installed with apt-get when missing; not a build or test
+# dependency): a cross-check of the same physics, then 5 alternating repeats per
+# scene (bench/peer/race.py).
+bench-peer: deps bin/ballast
 	$(PYTHON) bench/peer/race.py
 
 # Particle-steps per second from 1 000 to 1 000 000 discs (about 40 minutes).

@@ -34,7 +34,7 @@ from .ini import IniError, parse_file, shown
 
 CASE_KEYS = {"tier", "title", "checks", "runtime"}
 VARIANT_KEYS = {"scene", "set", "command"}
-COMMANDS = ("run", "exact")
+COMMANDS = ("run", "exact", "peer")
 FIGURE_KINDS = ("series", "network", "profile", "principal", "points")
 _COMMON = {"kind", "title", "variants", "paper"}
 _AXES = {"xlabel", "ylabel", "xrange", "yrange"}
@@ -62,7 +62,8 @@ class Variant:
     name: str
     scene: Path
     sets: list
-    command: str = "run"     # run: the DEM; exact: the exact static solver (ballast exact)
+    command: str = "run"     # run: the DEM; exact: the exact static solver (ballast exact);
+                             # peer: the cross-check against LAMMPS (bench/peer/race.py)
 
 
 @dataclass

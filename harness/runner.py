@@ -54,6 +54,10 @@ def jobs_for(cases, runs_root):
 
 def command(job, binary):
     """The core's command line for a job."""
+    if job.command == "peer":
+        # The cross-code check against LAMMPS: a Python script, not the core.
+        race = Path(__file__).resolve().parent.parent / "bench" / "peer" / "race.py"
+        return ["/usr/bin/python3", str(race), "--check-only", "--out", str(job.out)]
     cmd = [str(binary), job.command, str(job.scene), "--out", str(job.out)]
     for kv in job.sets:
         cmd += ["--set", kv]

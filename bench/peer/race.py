@@ -687,6 +687,8 @@ def cross_check(work, template, steps=CHECK_STEPS):
     ok2 = check_verdict(half, TOL_FRICTION) and rx <= TOL_RATIO and rf <= TOL_RATIO
     print(check_line(half, ok2, f"friction={MU:g},dt/2",
                      f" ratio_dx={rx:.3g} ratio_dF={rf:.3g}"), flush=True)
+    cross_check.results = {"friction0": exact, "friction": full, "half_dt": half,
+                           "ratio_dx": rx, "ratio_dF": rf}
     if not (ok0 and ok1 and ok2):
         print(f"peer: FAIL: limits: friction=0 {TOL_EXACT['max_dx']:g} for every figure; "
               f"friction: {', '.join(f'{k} {v:g}' for k, v in TOL_FRICTION.items())}; "
@@ -784,11 +786,54 @@ def sweep(race, steps, quick, host_dir, stamp):
     return best[0], tried
 
 
+def check_outputs(results, ok):
+    """The cross-check as a run's outputs (series.tsv, run.json), for the
+    catalogue's full-tier case `peer_check`: one row, one column per figure of
+    each of the three runs, and the two convergence ratios."""
+    names, values = ["cycle", "time"], [0.0, 0.0]
+    for run in ("friction0", "friction", "half_dt"):
+        for k in FIGURES:
+            names.append(f"{run}_{k}")
+            values.append(float(results[run][k]))
+    names += ["ratio_dx", "ratio_dF"]
+    values += [float(results["ratio_dx"]), float(results["ratio_dF"])]
+    series = "\t".join(names) + "\n" + "\t".join(repr(v) for v in values) + "\n"
+    info = {"status": "ok" if ok else "failed", "message": "" if ok else "cross-check failed",
+            "steps": int(results["friction"]["step"]), "n_discs": int(results["friction"]["n"])}
+    return series, info
+
+
+def check_only(out, template):
+    """`--check-only --out DIR`: the cross-check alone, written like a run."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    global BALLAST_RUN
+    BALLAST_RUN = out / "ballast"
+    shutil.copy2(BALLAST, BALLAST_RUN)
+    ok, _ = cross_check(out / "work", template)
+    series, info = check_outputs(cross_check.results, ok)
+    for name, text in (("series.tsv", series), ("run.json", json.dumps(info, indent=1) + "\n")):
+        tmp = out / (name + ".tmp")
+        tmp.write_text(text)
+        tmp.rename(out / name)
+    return 0 if ok else 1
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true",
                     help="small N, 2 repeats of short runs: a test of the machinery, not a benchmark")
+    ap.add_argument("--check-only", action="store_true",
+                    help="only the cross-check, written as a run into --out (the peer_check case)")
+    ap.add_argument("--out", help="folder for --check-only")
     a = ap.parse_args(argv)
+    if a.check_only:
+        if not a.out:
+            sys.exit("peer: --check-only needs --out DIR")
+        if not BALLAST.exists():
+            sys.exit("peer: build the core first (make bin/ballast)")
+        ensure_lammps()
+        return check_only(a.out, TEMPLATE.read_text())
     if not BALLAST.exists():
         sys.exit("peer: build the core first (make bin/ballast)")
     ensure_lammps()

@@ -512,3 +512,19 @@ def test_sweep_never_keeps_settings_with_dangerous_builds(tmp_path, capsys):
     fake = FakeRace(lambda s: 1.0 / s["skin"])                    # the smaller the faster ...
     best, _ = race.sweep(fake, 100, True, tmp_path, 1)
     assert best["skin"] >= 0.05                                    # ... but below 0.05 dangerous
+
+
+def test_check_outputs_one_row_per_figure():
+    """--check-only writes the cross-check as a run: one series row, a column per figure
+    of each run, the ratios, and run.json saying whether it passed."""
+    fig = {k: 0.5 * (i + 1) for i, k in enumerate(race.FIGURES)}
+    res = {"friction0": dict(fig, n=300, step=400), "friction": dict(fig, n=300, step=400),
+           "half_dt": dict(fig, n=300, step=800), "ratio_dx": 0.455, "ratio_dF": 0.404}
+    series, info = race.check_outputs(res, True)
+    head, row = series.splitlines()
+    names, values = head.split("\t"), [float(v) for v in row.split("\t")]
+    assert names[:2] == ["cycle", "time"] and len(names) == len(values)
+    assert values[names.index("friction_max_dx")] == fig["max_dx"]
+    assert values[names.index("ratio_dF")] == 0.404
+    assert info["status"] == "ok" and info["steps"] == 400
+    assert race.check_outputs(res, False)[1]["status"] == "failed"

@@ -148,27 +148,30 @@ static int cmd_info(const struct args *a)
     return 0;
 }
 
-static int cmd_run(const struct args *a)
+/* What `run` and `exact` share: the scene loaded and validated, the
+ * simulation created, the output folder made and emptied of an earlier
+ * run's results (so nothing stale is read as new).  Returns -1 when ready,
+ * else the exit code, having said why and freed what it made. */
+static int prepare(const struct args *a, const char *cmd, struct bal_scene *sc,
+                   struct bal_sim **sim)
 {
-    struct bal_scene sc;
     struct bal_error err = {0};
-    struct bal_sim *sim = NULL;
+    *sim = NULL;
     if (!a->out) {
-        fputs("ballast run: --out DIR is required\n", stderr);
+        fprintf(stderr, "ballast %s: --out DIR is required\n", cmd);
         return 2;
     }
-    if (load(&sc, a, &err) || bal_sim_create(&sim, &sc, &err)) {
+    if (load(sc, a, &err) || bal_sim_create(sim, sc, &err)) {
         fprintf(stderr, "%s\n", err.msg);
-        bal_scene_free(&sc);
+        bal_scene_free(sc);
         return exit_code(err.code);
     }
     if (make_dirs(a->out) != 0) {
         fprintf(stderr, "ballast: %s: cannot create directory: %s\n", a->out, strerror(errno));
-        bal_sim_free(sim);
-        bal_scene_free(&sc);
+        bal_sim_free(*sim);
+        bal_scene_free(sc);
         return 3;
     }
-    /* Remove results of an earlier run so nothing stale is read as new. */
     const char *names[] = {"series.tsv", "discs.tsv", "contacts.tsv", "walls.tsv", "stress.tsv",
                            "stress_grid.tsv", "run.json"};
     for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
@@ -176,6 +179,17 @@ static int cmd_run(const struct args *a)
         snprintf(p, sizeof p, "%s/%s", a->out, names[k]);
         remove(p);
     }
+    return -1;
+}
+
+static int cmd_run(const struct args *a)
+{
+    struct bal_scene sc;
+    struct bal_error err = {0};
+    struct bal_sim *sim = NULL;
+    const int early = prepare(a, "run", &sc, &sim);
+    if (early >= 0)
+        return early;
 
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
@@ -274,28 +288,9 @@ static int cmd_exact(const struct args *a)
     struct bal_scene sc;
     struct bal_error err = {0};
     struct bal_sim *sim = NULL;
-    if (!a->out) {
-        fputs("ballast exact: --out DIR is required\n", stderr);
-        return 2;
-    }
-    if (load(&sc, a, &err) || bal_sim_create(&sim, &sc, &err)) {
-        fprintf(stderr, "%s\n", err.msg);
-        bal_scene_free(&sc);
-        return exit_code(err.code);
-    }
-    if (make_dirs(a->out) != 0) {
-        fprintf(stderr, "ballast: %s: cannot create directory: %s\n", a->out, strerror(errno));
-        bal_sim_free(sim);
-        bal_scene_free(&sc);
-        return 3;
-    }
-    const char *names[] = {"series.tsv", "discs.tsv", "contacts.tsv", "walls.tsv", "stress.tsv",
-                           "stress_grid.tsv", "run.json"};
-    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
-        char p[1200];
-        snprintf(p, sizeof p, "%s/%s", a->out, names[k]);
-        remove(p);
-    }
+    const int early = prepare(a, "exact", &sc, &sim);
+    if (early >= 0)
+        return early;
     struct bal_exact ex = {0};
     enum bal_status st = bal_exact_solve(sim, &ex, &err);
     if (st == BAL_OK)

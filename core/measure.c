@@ -175,13 +175,8 @@ void bal_measure_moments(const struct bal_sim *s, double *m)
             continue;
         const int i = s->pw.i[c];
         const struct bal_wall *W = &s->walls[s->pw.j[c]];
-        double cx, cy;
-        const double d = sqrt(bal_walls_closest(W, s->x[i], s->y[i], &cx, &cy));
-        double ex = -W->e[1], ey = W->e[0];
-        if (d > 0) {
-            ex = (cx - s->x[i]) / d;
-            ey = (cy - s->y[i]) / d;
-        }
+        double ex, ey;
+        const double d = bal_walls_normal(W, s->x[i], s->y[i], &ex, &ey);
         const double ftn = s->pw.fn[c] + s->pw.dn[c], fts = s->pw.fs[c] + s->pw.ds[c];
         const double fx = ftn * ex + fts * ey, fy = ftn * ey - fts * ex;
         const double l = 0.5 * (s->r[i] + d);

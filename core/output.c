@@ -140,13 +140,8 @@ static void write_contacts(const struct bal_sim *s, FILE *f)
             continue;
         const int i = s->pw.i[c];
         const struct bal_wall *W = &s->walls[s->pw.j[c]];
-        double cx, cy;
-        const double d = sqrt(bal_walls_closest(W, s->x[i], s->y[i], &cx, &cy));
-        double ex = -W->e[1], ey = W->e[0];
-        if (d > 0) {
-            ex = (cx - s->x[i]) / d;
-            ey = (cy - s->y[i]) / d;
-        }
+        double ex, ey;
+        const double d = bal_walls_normal(W, s->x[i], s->y[i], &ex, &ey);
         /* Halfway between the disc's surface point and the wall point
          * (C&S p. 49, contact A of Fig. 1). */
         const double at = 0.5 * (s->r[i] + d);

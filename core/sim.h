@@ -245,6 +245,9 @@ void bal_walls_move(struct bal_sim *s);
 /* Closest point of wall w to (x, y); returns squared distance. */
 double bal_walls_closest(const struct bal_wall *w, double x, double y,
                          double *cx, double *cy);
+/* Unit normal from (x, y) to the closest point of wall w (the wall's own
+ * normal when the point lies on it); returns the distance. */
+double bal_walls_normal(const struct bal_wall *w, double x, double y, double *ex, double *ey);
 
 /* integrate.c */
 void bal_integrate_positions(struct bal_sim *s);

@@ -52,3 +52,18 @@ void bal_walls_move(struct bal_sim *s)
         w->disp += hypot(w->v[0], w->v[1]) * dt + fabs(w->omega) * hmax * dt;
     }
 }
+
+double bal_walls_normal(const struct bal_wall *w, double x, double y, double *ex, double *ey)
+{
+    double cx, cy;
+    const double d = sqrt(bal_walls_closest(w, x, y, &cx, &cy));
+    if (d > 0) {
+        *ex = (cx - x) / d;
+        *ey = (cy - y) / d;
+    } else {
+        /* Centre exactly on the wall: along the wall's normal. */
+        *ex = -w->e[1];
+        *ey = w->e[0];
+    }
+    return d;
+}

@@ -94,6 +94,19 @@ void bal_pairs_free(struct bal_pairs *p)
     p->damping = damping;
 }
 
+long bal_pairs_find(const struct bal_pairs *p, uint64_t key)
+{
+    long lo = 0, hi = p->n;
+    while (lo < hi) {
+        const long mid = lo + (hi - lo) / 2;
+        if (p->key[mid] < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < p->n && p->key[lo] == key ? lo : -1;
+}
+
 /* Copy the history of every contact of `old` whose key is also in `fresh`.
  * Both lists are sorted by key, so one linear pass suffices.  Contacts of
  * `fresh` that are new start with zero history. */

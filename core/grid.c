@@ -109,19 +109,6 @@ static inline enum bal_status push(struct bal_rebuild_scratch *rs, long *n, int 
     return BAL_OK;
 }
 
-static long find_key(const struct bal_pairs *p, uint64_t key)
-{
-    long lo = 0, hi = p->n;
-    while (lo < hi) {
-        const long mid = lo + (hi - lo) / 2;
-        if (p->key[mid] < key)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < p->n && p->key[lo] == key ? lo : -1;
-}
-
 /* Where each new pair sat in the old list.  Normally both lists number the
  * discs alike and one linear pass matches them; right after a re-sort the
  * old list still uses the old numbers, so each new pair is translated back
@@ -147,7 +134,7 @@ static void match_old(const struct bal_sim *s, const struct bal_pairs *old,
             i = j;
             j = t;
         }
-        rs->map[c] = (int32_t)find_key(old, ((uint64_t)(uint32_t)i << 32) | (uint32_t)j);
+        rs->map[c] = (int32_t)bal_pairs_find(old, ((uint64_t)(uint32_t)i << 32) | (uint32_t)j);
     }
 }
 
@@ -343,6 +330,23 @@ static int cell_key_cmp(const void *a, const void *b)
     return (p->slot > q->slot) - (p->slot < q->slot);
 }
 
+void bal_grid_cell_order(const double *x, const double *y, int n, double h,
+                         struct bal_cell_key *keys, int32_t *order)
+{
+    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY;
+    for (int i = 0; i < n; i++) {
+        x0 = fmin(x0, x[i]);
+        y0 = fmin(y0, y[i]);
+        x1 = fmax(x1, x[i]);
+    }
+    const long nx = (long)((x1 - x0) / h) + 1;
+    for (int i = 0; i < n; i++)
+        keys[i] = (struct bal_cell_key){(long)((y[i] - y0) / h) * nx + (long)((x[i] - x0) / h), i};
+    qsort(keys, (size_t)n, sizeof *keys, cell_key_cmp);
+    for (int i = 0; i < n; i++)
+        order[i] = keys[i].slot;
+}
+
 /* a[new] = a[new2old[new]]; the rebuild scratch column is the buffer. */
 static void permute_doubles(struct bal_sim *s, double *a, int stride)
 {
@@ -373,17 +377,8 @@ enum bal_status bal_grid_reorder(struct bal_sim *s, struct bal_error *err)
 {
     const int n = s->n;
     if (n >= 2) {
-        double x0 = s->x[0], y0 = s->y[0], x1 = s->x[0];
-        for (int i = 1; i < n; i++) {
-            x0 = fmin(x0, s->x[i]);
-            y0 = fmin(y0, s->y[i]);
-            x1 = fmax(x1, s->x[i]);
-        }
-        const double h = 2 * s->r_max + s->skin;
-        const long nx = (long)((x1 - x0) / h) + 1;
-        /* The sort keys (16 bytes a disc) and the permutation buffers live in
-         * the rebuild scratch column; stress moments need 4 doubles a disc. */
-        /* Sort keys take 2 doubles a disc, stress moments 4. */
+        /* The sort keys (2 doubles a disc) and the permutation buffer live
+         * in the rebuild scratch column; stress moments need 4 a disc. */
         const long need = (s->moment_prev ? 4L : 2L) * n;
         if (need > s->rs.col_cap) {
             double *c = realloc(s->rs.col, (size_t)need * sizeof *c);
@@ -392,13 +387,8 @@ enum bal_status bal_grid_reorder(struct bal_sim *s, struct bal_error *err)
             s->rs.col = c;
             s->rs.col_cap = need;
         }
-        struct bal_cell_key *order = (struct bal_cell_key *)s->rs.col;
-        for (int i = 0; i < n; i++)
-            order[i] = (struct bal_cell_key){(long)((s->y[i] - y0) / h) * nx +
-                                                 (long)((s->x[i] - x0) / h), i};
-        qsort(order, (size_t)n, sizeof *order, cell_key_cmp);
-        for (int i = 0; i < n; i++)
-            s->new2old[i] = order[i].slot;
+        bal_grid_cell_order(s->x, s->y, n, 2 * s->r_max + s->skin,
+                            (struct bal_cell_key *)s->rs.col, s->new2old);
 
         double *columns[] = {s->x, s->y, s->th, s->vx, s->vy, s->w, s->r, s->inv_m,
                              s->inv_i, s->fx, s->fy, s->tq};

@@ -390,9 +390,7 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
         for (int p = 0; p < sc->n_piles; p++) {
             const struct bal_pile_def *pd = &sc->piles[p];
             const double s0 = pd->bottom == 1 ? pd->d * (1 + pd->c) : pd->d;
-            long rows = 0;
-            while (pd->L - (pd->slope == 0 ? 3 : 1) * rows > 0)
-                rows++;
+            const long rows = bal_sim_pile_rows(pd);
             fprintf(f, "%s\n    {\"name\": ", p ? "," : "");
             json_string(f, pd->name);
             fprintf(f, ", \"L\": %ld, \"rows\": %ld, \"discs\": %ld, \"d\": %.17g, \"x0\": %.17g, "

@@ -141,44 +141,6 @@ static void build_laws(struct bal_sim *s, const struct bal_scene *sc)
     }
 }
 
-/* A disc's cell and its scene-order index, for sorting into cell order. */
-struct cell_key {
-    long cell;
-    int id;
-};
-
-static int cell_key_cmp(const void *a, const void *b)
-{
-    const struct cell_key *p = a, *q = b;
-    if (p->cell != q->cell)
-        return p->cell < q->cell ? -1 : 1;
-    return (p->id > q->id) - (p->id < q->id);
-}
-
-/* The permutation that puts discs in row-major cell order, so that
- * neighbours in space are neighbours in memory.  Ties keep scene order, so
- * the order is deterministic. */
-static int cell_order(const double *x, const double *y, int n, double h, int32_t *order)
-{
-    struct cell_key *keys = malloc((size_t)(n ? n : 1) * sizeof *keys);
-    if (!keys)
-        return 0;
-    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY;
-    for (int i = 0; i < n; i++) {
-        x0 = fmin(x0, x[i]);
-        y0 = fmin(y0, y[i]);
-        x1 = fmax(x1, x[i]);
-    }
-    const long nx = (long)((x1 - x0) / h) + 1;
-    for (int i = 0; i < n; i++)
-        keys[i] = (struct cell_key){(long)((y[i] - y0) / h) * nx + (long)((x[i] - x0) / h), i};
-    qsort(keys, (size_t)n, sizeof *keys, cell_key_cmp);
-    for (int i = 0; i < n; i++)
-        order[i] = keys[i].id;
-    free(keys);
-    return 1;
-}
-
 /* Discs in scene order before sorting: [disc] sections, then each [fill],
  * then each [pile]. */
 struct disc_init {
@@ -193,6 +155,14 @@ static long pile_row_count(const struct bal_pile_def *p, long M)
 {
     const long n = p->L - (p->slope == 0 ? 3 : 1) * M;
     return n > 0 ? n : 0;
+}
+
+long bal_sim_pile_rows(const struct bal_pile_def *p)
+{
+    long rows = 0;
+    while (pile_row_count(p, rows) > 0)
+        rows++;
+    return rows;
 }
 
 long bal_sim_pile_count(const struct bal_pile_def *p)
@@ -466,11 +436,14 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         return bal_error(err, BAL_ENOMEM, "%s: out of memory for %d discs", sc->path, n);
     }
     if (s->use_grid) {
-        if (!cell_order(d.x, d.y, n, 2 * s->r_max + s->skin, s->id)) {
+        struct bal_cell_key *keys = malloc((size_t)n * sizeof *keys);
+        if (!keys) {
             free_init(&d);
             bal_sim_free(s);
             return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
         }
+        bal_grid_cell_order(d.x, d.y, n, 2 * s->r_max + s->skin, keys, s->id);
+        free(keys);
     } else {
         for (int i = 0; i < n; i++)
             s->id[i] = i;
@@ -569,7 +542,7 @@ static double seconds_now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-enum bal_status bal_sim_cycle(struct bal_sim *s, int keep_old, struct bal_error *err)
+enum bal_status bal_sim_cycle(struct bal_sim *s, struct bal_error *err)
 {
     /* Each phase is timed (five clock reads a cycle, ~0.1 us: negligible
      * beside a cycle of any scene worth timing). */
@@ -597,7 +570,6 @@ enum bal_status bal_sim_cycle(struct bal_sim *s, int keep_old, struct bal_error 
     t0 = seconds_now();
     s->timers.walls += t0 - t1;
     /* 4. motion: v_{N+1/2} */
-    (void)keep_old; /* v_{N-1/2} is recovered on demand (bal_integrate_previous) */
     bal_integrate_velocities(s);
     s->timers.velocities += seconds_now() - t0;
     s->have_old = 1;
@@ -610,7 +582,7 @@ enum bal_status bal_sim_step(struct bal_sim *s, struct bal_error *err)
 {
     if (s->stage < 0 && s->scene->n_stages > 0)
         bal_sim_set_stage(s, 0);
-    return bal_sim_cycle(s, 1, err);
+    return bal_sim_cycle(s, err);
 }
 
 /* Is every position and velocity finite?  Names the first disc that is not. */
@@ -677,7 +649,7 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
             const int check = rule && (c + 1) % stage->check_every == 0;
             const int last = g == sc->n_stages - 1 && c == cycles - 1;
             const int row = series && ((s->step + 1) % every == 0 || last);
-            if ((status = bal_sim_cycle(s, row || check, err)) != BAL_OK)
+            if ((status = bal_sim_cycle(s, err)) != BAL_OK)
                 break;
             log->cycles = c + 1;
             if ((row || s->step % FINITE_CHECK_EVERY == 0) &&
@@ -717,19 +689,6 @@ void bal_sim_info(const struct bal_sim *s, struct bal_run_info *info)
     info->n_candidates = s->pp.n;
 }
 
-static long find_key(const struct bal_pairs *p, uint64_t key)
-{
-    long lo = 0, hi = p->n;
-    while (lo < hi) {
-        long mid = lo + (hi - lo) / 2;
-        if (p->key[mid] < key)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < p->n && p->key[lo] == key ? lo : -1;
-}
-
 long bal_sim_find_contact(const struct bal_sim *s, int a_wall, int a, int b_wall, int b,
                           const struct bal_pairs **list)
 {
@@ -738,11 +697,11 @@ long bal_sim_find_contact(const struct bal_sim *s, int a_wall, int a, int b_wall
     if (a_wall || b_wall) {
         const int disc = a_wall ? b : a, wall = a_wall ? a : b;
         *list = &s->pw;
-        return find_key(&s->pw, ((uint64_t)(uint32_t)disc << 32) | (uint32_t)wall);
+        return bal_pairs_find(&s->pw, ((uint64_t)(uint32_t)disc << 32) | (uint32_t)wall);
     }
     const int lo = a < b ? a : b, hi = a < b ? b : a;
     *list = &s->pp;
-    return find_key(&s->pp, ((uint64_t)(uint32_t)lo << 32) | (uint32_t)hi);
+    return bal_pairs_find(&s->pp, ((uint64_t)(uint32_t)lo << 32) | (uint32_t)hi);
 }
 
 int bal_sim_disc_id(const struct bal_sim *s, int i)

@@ -213,6 +213,8 @@ enum bal_status bal_pairs_reserve(struct bal_pairs *p, long cap);
 void bal_pairs_free(struct bal_pairs *p);
 void bal_pairs_sort(struct bal_pairs *p);
 void bal_pairs_merge_history(struct bal_pairs *fresh, const struct bal_pairs *old);
+/* Position of `key` in the sorted list p, or -1 (binary search). */
+long bal_pairs_find(const struct bal_pairs *p, uint64_t key);
 bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping);
 void bal_contacts_walls(struct bal_sim *s);
 /* The dashpot forces D_n, D_s of contact c of list p in the last cycle:
@@ -229,6 +231,11 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err);
  * history found through the permutation). */
 enum bal_status bal_grid_reorder(struct bal_sim *s, struct bal_error *err);
 void bal_grid_scratch_free(struct bal_rebuild_scratch *rs);
+/* The permutation that puts discs in row-major order of cells of side h
+ * (order[new] = old); ties keep their order, so it is deterministic.
+ * `keys` is scratch of n entries. */
+void bal_grid_cell_order(const double *x, const double *y, int n, double h,
+                         struct bal_cell_key *keys, int32_t *order);
 /* Rebuilds between two re-sorts: the order decays only as discs flow, and a
  * re-sort costs about as much as a few rebuilds. */
 #define BAL_REORDER_EVERY 20
@@ -279,9 +286,10 @@ void bal_sim_contact_point(const struct bal_sim *s, int i, int is_wall, int j, d
 /* Bytes the simulation holds while it steps (every array at its allocated
  * capacity), split into what scales with discs and with candidate pairs. */
 void bal_sim_memory(const struct bal_sim *s, double *disc_bytes, double *pair_bytes);
-/* Number of discs a [pile] generates. */
+/* Number of rows and of discs a [pile] generates. */
+long bal_sim_pile_rows(const struct bal_pile_def *p);
 long bal_sim_pile_count(const struct bal_pile_def *p);
-enum bal_status bal_sim_cycle(struct bal_sim *s, int keep_old, struct bal_error *err);
+enum bal_status bal_sim_cycle(struct bal_sim *s, struct bal_error *err);
 /* Candidate index of the contact between two bodies, or -1. */
 long bal_sim_find_contact(const struct bal_sim *s, int a_wall, int a, int b_wall, int b,
                           const struct bal_pairs **list);

@@ -55,7 +55,7 @@ static double timed_steps(struct bal_sim *sim, long steps, struct bal_error *err
 {
     const double t0 = now();
     for (long k = 0; k < steps; k++)
-        if (bal_sim_cycle(sim, 0, err))
+        if (bal_sim_cycle(sim, err))
             return -1;
     return now() - t0;
 }
@@ -98,7 +98,7 @@ static int run_one(const char *path, long n, FILE *csv, struct options *o)
     for (int g = 0; g + 1 < sc.n_stages; g++) {
         bal_sim_set_stage(sim, g);
         for (long c = 0; c < sc.stages[g].cycles; c++)
-            if (bal_sim_cycle(sim, 0, &err)) {
+            if (bal_sim_cycle(sim, &err)) {
                 fprintf(stderr, "bench: settling: %s\n", err.msg);
                 bal_sim_free(sim);
                 bal_scene_free(&sc);
@@ -113,7 +113,7 @@ static int run_one(const char *path, long n, FILE *csv, struct options *o)
     while (!o->flowing && bal_measure_kinetic(sim) > SETTLED_EK_OVER_EE * bal_measure_elastic(sim) &&
            extra < MAX_SETTLE_BLOCKS * sc.stages[0].cycles) {
         for (long c = 0; c < sc.stages[0].cycles; c++, extra++)
-            if (bal_sim_cycle(sim, 1, &err)) {
+            if (bal_sim_cycle(sim, &err)) {
                 fprintf(stderr, "bench: settling: %s\n", err.msg);
                 bal_sim_free(sim);
                 bal_scene_free(&sc);

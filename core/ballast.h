@@ -100,6 +100,8 @@ struct bal_settings {
     double stress_width;  /* moving-average stress cells: width, 0 = off (0) */
     double stress_height; /* cell height (0 = the width) */
     double stress_step;   /* horizontal step between overlapping cells (0 = the width) */
+    double overlap_budget; /* stop when an overlap exceeds this share of the smaller radius (0.5; 0 = off) */
+    double energy_guard;  /* stop when the run creates this share of its energy throughput (1; 0 = off) */
     BAL_SECTION_TAIL;
 };
 
@@ -202,6 +204,8 @@ enum bal_probe_kind {
     BAL_PROBE_DISC_X, BAL_PROBE_DISC_Y, BAL_PROBE_DISC_VX, BAL_PROBE_DISC_VY,
     BAL_PROBE_DISC_THETA, BAL_PROBE_DISC_OMEGA,
     BAL_PROBE_ENERGY_KINETIC, BAL_PROBE_ENERGY_ELASTIC,
+    BAL_PROBE_WORK_WALLS, BAL_PROBE_WORK_GRAVITY, BAL_PROBE_DISSIPATED_DASHPOT,
+    BAL_PROBE_DISSIPATED_FRICTION, BAL_PROBE_DISSIPATED_GLOBAL, BAL_PROBE_ENERGY_IMBALANCE,
     BAL_PROBE_UNBALANCED, BAL_PROBE_N_CONTACTS, BAL_PROBE_N_SLIDING,
     BAL_PROBE_HELD_FX, BAL_PROBE_HELD_FY, BAL_PROBE_WEIGHT_X, BAL_PROBE_WEIGHT_Y,
     BAL_PROBE_COUNT
@@ -277,6 +281,24 @@ struct bal_run_info {
     int n_discs, n_walls;
     long n_candidates;        /* candidate disc–disc pairs (last rebuild) */
 };
+
+/* The energy audit of a run, from the first cycle (energy.c):
+ * work_walls + work_gravity = (kinetic - kinetic0) + (elastic - elastic0)
+ *                             + dissipated_* + imbalance. */
+struct bal_energy {
+    int started;                  /* 0 before the first cycle: all zero */
+    long from_step;               /* step of the baseline */
+    double kinetic0, elastic0;    /* E_k, E_el at the baseline */
+    double kinetic, elastic;      /* now */
+    double work_walls, work_gravity;
+    double dissipated_dashpot, dissipated_friction, dissipated_global;
+    double imbalance;             /* > 0: energy lost unaccounted; < 0: created */
+    double throughput;            /* kinetic0 + elastic0 + |work_walls| + |work_gravity| */
+    double relative;              /* |imbalance| / throughput */
+};
+
+/* The audit now. */
+void bal_energy_report(const struct bal_sim *sim, struct bal_energy *e);
 
 /* Advance one cycle (C&S calculation cycle): move discs and walls to t_N,
  * find contacts, apply the force–displacement law at t_N, update the

@@ -166,6 +166,9 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
     const double dt = s->dt, nu = s->nu, delta0 = s->delta0;
     const int n_mat = s->n_mat;
     const struct bal_pair_law *restrict laws = s->law;
+    const double budget = s->overlap_budget;
+    double lost_dash = 0, lost_fric = 0; /* energy audit (energy.c) */
+    int over = 0;
 
     for (long c = 0; c < p->n; c++) {
         const int i = p->i[c], j = p->j[c];
@@ -185,6 +188,8 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
         const double ex = dx / dist, ey = dy / dist;
         const double rvx = vx[i] - vx[j], rvy = vy[i] - vy[j];
         const double ndot = rvx * ex + rvy * ey;
+        const double delta = rs - dist;
+        over |= delta > budget * fmin(r[i], r[j]);
 
         double fn;
         if (law == BAL_NORMAL_INCREMENTAL) {
@@ -192,26 +197,33 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
             if (fn < 0)
                 fn = 0;
         } else {
-            fn = power_force(L->kn, rs - dist, delta0, nu);
+            fn = power_force(L->kn, delta, delta0, nu);
         }
         p->fn[c] = fn;
         double ftn = fn, fts = 0;
         uint8_t flags = BAL_PAIR_TOUCHING;
-        if (damp)
-            ftn += (L->cn + viscous(s, rs - dist)) * ndot;
+        if (damp) {
+            const double dn = (L->cn + viscous(s, delta)) * ndot;
+            ftn += dn;
+            lost_dash += dn * ndot;
+        }
         if (shear && L->shear) {
             const double tx = ey, ty = -ex;
             const double sdot = rvx * tx + rvy * ty - (w[i] * r[i] + w[j] * r[j]);
             double fs = p->fs[c] + L->ks * sdot * dt;
             const double fmax = fn * L->tan_phi + L->cohesion;
             if (fabs(fs) > fmax) {
+                /* The spring gives up (|F_s| - F_max)/k_s of slip against F_max. */
+                lost_fric += fmax * (fabs(fs) - fmax) / L->ks;
                 fs = copysign(fmax, fs);
                 flags |= BAL_PAIR_SLIDING;
             }
             p->fs[c] = fs;
             fts = fs;
-            if (damp && !(flags & BAL_PAIR_SLIDING))
+            if (damp && !(flags & BAL_PAIR_SLIDING)) {
                 fts += L->cs * sdot;
+                lost_dash += L->cs * sdot * sdot;
+            }
         }
         p->flags[c] = flags;
 
@@ -227,6 +239,11 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
             tq[j] += fts * r[j];
         }
     }
+    if (damp)
+        s->audit.d_dashpot += lost_dash * dt;
+    if (shear)
+        s->audit.d_friction += lost_fric;
+    s->over_budget |= over;
 }
 
 #define PAIR_VARIANT(name, law, shear, damp) \
@@ -265,6 +282,7 @@ void bal_contacts_walls(struct bal_sim *s)
         struct bal_wall *W = &s->walls[k];
         W->f[0] = W->f[1] = W->moment = W->fn_sum = W->fn_s_sum = 0;
     }
+    double lost_dash = 0, lost_fric = 0;
     for (long c = 0; c < p->n; c++) {
         const int i = p->i[c];
         struct bal_wall *W = &s->walls[p->j[c]];
@@ -294,6 +312,8 @@ void bal_contacts_walls(struct bal_sim *s)
         const double ndot = rvx * ex + rvy * ey;
         const double sdot = rvx * tx + rvy * ty - s->w[i] * ri;
 
+        if (ri - dist > s->overlap_budget * ri)
+            s->over_budget = 1;
         double fn;
         if (s->normal_law == BAL_NORMAL_INCREMENTAL) {
             fn = p->fn[c] + L->kn * ndot * dt;
@@ -309,11 +329,13 @@ void bal_contacts_walls(struct bal_sim *s)
         double fs = shear ? p->fs[c] + L->ks * sdot * dt : 0.0;
         uint8_t flags = BAL_PAIR_TOUCHING;
         if (shear && fabs(fs) > fmax) {
+            lost_fric += fmax * (fabs(fs) - fmax) / L->ks;
             fs = copysign(fmax, fs);
             flags |= BAL_PAIR_SLIDING;
         }
         const double dn = (L->cn + viscous(s, ri - dist)) * ndot;
         const double ds = (!shear || (flags & BAL_PAIR_SLIDING)) ? 0.0 : L->cs * sdot;
+        lost_dash += dn * ndot + ds * sdot;
         p->fn[c] = fn;
         p->fs[c] = fs;
         p->dn[c] = dn;
@@ -333,6 +355,8 @@ void bal_contacts_walls(struct bal_sim *s)
         W->fn_sum += ftn;
         W->fn_s_sum += ftn * along;
     }
+    s->audit.d_dashpot += lost_dash * dt;
+    s->audit.d_friction += lost_fric;
 }
 
 void bal_contact_dashpots(const struct bal_sim *s, const struct bal_pairs *p, long c,

@@ -68,6 +68,12 @@ static double normal_energy(const struct bal_sim *s, const struct bal_pair_law *
     return L->kn * s->delta0 * s->delta0 * pow(delta / s->delta0, s->nu + 1) / (s->nu + 1);
 }
 
+/* ½ F_s²/k_s; a pair with k_s = 0 never carries a shear force. */
+static double shear_energy(const struct bal_pair_law *L, double fs)
+{
+    return L->ks > 0 ? fs * fs / (2 * L->ks) : 0;
+}
+
 double bal_measure_elastic(const struct bal_sim *s)
 {
     double e = 0;
@@ -78,7 +84,7 @@ double bal_measure_elastic(const struct bal_sim *s)
         const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + s->mat[j]];
         const double delta = s->r[i] + s->r[j] - hypot(s->x[j] - s->x[i], s->y[j] - s->y[i]);
         e += normal_energy(s, L, s->pp.fn[c], delta);
-        e += pair_fs(&s->pp, c) * pair_fs(&s->pp, c) / (2 * L->ks);
+        e += shear_energy(L, pair_fs(&s->pp, c));
     }
     for (long c = 0; c < s->pw.n; c++) {
         if (!(s->pw.flags[c] & BAL_PAIR_TOUCHING))
@@ -89,7 +95,7 @@ double bal_measure_elastic(const struct bal_sim *s)
         double cx, cy;
         const double delta = s->r[i] - sqrt(bal_walls_closest(W, s->x[i], s->y[i], &cx, &cy));
         e += normal_energy(s, L, s->pw.fn[c], delta);
-        e += s->pw.fs[c] * s->pw.fs[c] / (2 * L->ks);
+        e += shear_energy(L, s->pw.fs[c]);
     }
     return e;
 }
@@ -231,6 +237,23 @@ double bal_measure_probe(const struct bal_sim *s, int probe)
         return bal_measure_kinetic(s);
     case BAL_PROBE_ENERGY_ELASTIC:
         return bal_measure_elastic(s);
+    case BAL_PROBE_WORK_WALLS:
+    case BAL_PROBE_WORK_GRAVITY:
+    case BAL_PROBE_DISSIPATED_DASHPOT:
+    case BAL_PROBE_DISSIPATED_FRICTION:
+    case BAL_PROBE_DISSIPATED_GLOBAL:
+    case BAL_PROBE_ENERGY_IMBALANCE: {
+        struct bal_energy e;
+        bal_energy_report(s, &e);
+        switch (p->kind) {
+        case BAL_PROBE_WORK_WALLS: return e.work_walls;
+        case BAL_PROBE_WORK_GRAVITY: return e.work_gravity;
+        case BAL_PROBE_DISSIPATED_DASHPOT: return e.dissipated_dashpot;
+        case BAL_PROBE_DISSIPATED_FRICTION: return e.dissipated_friction;
+        case BAL_PROBE_DISSIPATED_GLOBAL: return e.dissipated_global;
+        default: return e.imbalance;
+        }
+    }
     case BAL_PROBE_UNBALANCED:
         return bal_measure_unbalanced(s);
     case BAL_PROBE_N_CONTACTS:

@@ -369,6 +369,21 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
         json_number(f, bal_measure_kinetic(s));
         fputs(",\n  \"energy_elastic\": ", f);
         json_number(f, bal_measure_elastic(s));
+        struct bal_energy en;
+        bal_energy_report(s, &en);
+        fprintf(f, ",\n  \"energy\": {\"from_step\": %ld", en.from_step);
+        const struct { const char *name; double v; } terms[] = {
+            {"kinetic0", en.kinetic0}, {"elastic0", en.elastic0}, {"kinetic", en.kinetic},
+            {"elastic", en.elastic}, {"work_walls", en.work_walls},
+            {"work_gravity", en.work_gravity}, {"dissipated_dashpot", en.dissipated_dashpot},
+            {"dissipated_friction", en.dissipated_friction},
+            {"dissipated_global", en.dissipated_global}, {"imbalance", en.imbalance},
+            {"throughput", en.throughput}, {"relative_imbalance", en.relative}};
+        for (size_t k = 0; k < sizeof terms / sizeof terms[0]; k++) {
+            fprintf(f, ", \"%s\": ", terms[k].name);
+            json_number(f, terms[k].v);
+        }
+        fputs("}", f);
         fputs(",\n  \"unbalanced\": ", f);
         json_number(f, bal_measure_unbalanced(s));
         const struct bal_scene *sc = s->scene;

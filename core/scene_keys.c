@@ -62,6 +62,10 @@ const struct bal_key bal_scene_keys[] = {
      "height of a stress cell; 0 = the width"},
     {BAL_SEC_SETTINGS, "stress_step", BAL_KEY_DOUBLE, S(stress_step), "0", 0, 0, BIG, NULL,
      "horizontal step between overlapping stress cells; 0 = the width"},
+    {BAL_SEC_SETTINGS, "overlap_budget", BAL_KEY_DOUBLE, S(overlap_budget), "0.5", 0, 0, BIG, NULL,
+     "stop the run when an overlap exceeds this share of the smaller radius of the pair; 0 = off"},
+    {BAL_SEC_SETTINGS, "energy_guard", BAL_KEY_DOUBLE, S(energy_guard), "1", 0, 0, BIG, NULL,
+     "stop the run when it has created this share of the energy that went through it; 0 = off"},
 
     /* [material NAME] */
     {BAL_SEC_MATERIAL, "kn", BAL_KEY_DOUBLE, M(kn), NULL, 1, 1e-300, BIG, NULL,
@@ -160,7 +164,8 @@ const struct bal_key bal_scene_keys[] = {
     {BAL_SEC_PROBE, "quantity", BAL_KEY_ENUM, P(kind), NULL, 1, 0, 0,
      "contact_fn contact_fs contact_sliding wall_f1 wall_f2 wall_moment wall_ecc "
      "disc_x disc_y disc_vx disc_vy disc_theta disc_omega "
-     "energy_kinetic energy_elastic unbalanced n_contacts n_sliding "
+     "energy_kinetic energy_elastic work_walls work_gravity dissipated_dashpot "
+     "dissipated_friction dissipated_global energy_imbalance unbalanced n_contacts n_sliding "
      "held_fx held_fy weight_x weight_y",
      "what the series column holds"},
     {BAL_SEC_PROBE, "a", BAL_KEY_NAME, P(a), "", 0, 0, 0, NULL,

@@ -33,6 +33,9 @@
 /* How often (in cycles) the run checks that the state is finite between
  * output rows.  A blown-up run is caught within this many cycles. */
 #define FINITE_CHECK_EVERY 256
+/* Cycles between checks of the energy guard: E_k and E_el cost about one
+ * cycle, so the guard costs < 0.1 %. */
+#define ENERGY_CHECK_EVERY 1024
 
 /* Default Verlet skin as a share of the largest radius: a wider skin means
  * fewer rebuilds but more candidate pairs to test every cycle. */
@@ -323,6 +326,7 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
     s->nu = st->nu;
     s->delta0 = st->delta0;
     s->has_damping = st->beta > 0 || st->gamma_n > 0;
+    s->overlap_budget = st->overlap_budget > 0 ? st->overlap_budget : INFINITY;
     s->gamma_n = st->gamma_n;
     s->psi = st->psi;
 
@@ -567,6 +571,7 @@ enum bal_status bal_sim_cycle(struct bal_sim *s, struct bal_error *err)
     t1 = seconds_now();
     s->timers.contacts += t1 - t0;
     bal_contacts_walls(s);
+    bal_energy_walls(s);
     t0 = seconds_now();
     s->timers.walls += t0 - t1;
     /* 4. motion: v_{N+1/2} */
@@ -575,6 +580,16 @@ enum bal_status bal_sim_cycle(struct bal_sim *s, struct bal_error *err)
     s->have_old = 1;
     s->step++;
     s->time += s->dt;
+    /* 5. the energy audit starts at the first cycle, the first time forces
+     * exist; the guards stop a run at once (energy.c) */
+    if (!s->audit.started) {
+        bal_energy_begin(s);
+    } else {
+        bal_energy_global(s);
+        bal_energy_gravity(s);
+    }
+    if (s->over_budget)
+        return bal_energy_overlap(s, err);
     return BAL_OK;
 }
 
@@ -655,6 +670,8 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
             if ((row || s->step % FINITE_CHECK_EVERY == 0) &&
                 (status = check_finite(s, err)) != BAL_OK)
                 break;
+            if (s->step % ENERGY_CHECK_EVERY == 0 && (status = bal_energy_guard(s, err)) != BAL_OK)
+                break;
             const int done = check && stop_rule_met(s, stage, log);
             if (row || (done && series && g == sc->n_stages - 1))
                 bal_output_series_row(s, series);
@@ -669,6 +686,8 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
     /* The periodic check may have missed the last cycles. */
     if (status == BAL_OK)
         status = check_finite(s, err);
+    if (status == BAL_OK)
+        status = bal_energy_guard(s, err);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     s->wall_seconds += (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
     return status;

@@ -71,6 +71,7 @@ struct bal_wall {
     double fn_sum;         /* Σ F_n over its contacts */
     double fn_s_sum;       /* Σ F_n s, s = position of the contact along e from P */
     double disp;           /* largest displacement of any of its points since rebuild */
+    double f_prev[2], moment_prev; /* f and moment of the cycle before (energy audit) */
 };
 
 struct bal_grid {
@@ -110,6 +111,22 @@ struct bal_stage_log {
     double ke_over_ee;     /* E_k / E_el at the last check (-1: never checked) */
     double stress_change;  /* largest change of a disc's stress moment between the
                             * last two checks, over the largest (-1: never) */
+};
+
+/* Running sums of the energy audit (energy.c), from the first cycle. */
+struct bal_audit {
+    int started;           /* the baseline has been taken */
+    int gravity;           /* the scene has gravity */
+    long start_step;       /* step of the baseline */
+    double ek0, ee0;       /* E_k and E_el at the baseline */
+    double w_walls;        /* work of the walls on the discs */
+    double w_gravity;      /* work of gravity up to the last change of g_fac */
+    double g_last;         /* Σ m g·x of the free discs at the last change of g_fac */
+    double gfac_last;      /* g_fac since then */
+    double d_dashpot;      /* dissipated by contact dashpots (disc pairs and walls) */
+    double d_friction;     /* dissipated by sliding at the Coulomb limit */
+    double d_global;       /* dissipated by global damping */
+    double d_global_last;  /* ... in the latest cycle */
 };
 
 /* A probe with its bodies resolved: kind, and for each body whether it is a
@@ -188,6 +205,11 @@ struct bal_sim {
     int32_t *new2old;            /* n entries: the permutation of the last re-sort */
     int reordered;               /* 1: the lists still number discs as before the re-sort */
 
+    /* energy audit and guards */
+    struct bal_audit audit;
+    double overlap_budget;       /* share of the smaller radius; INFINITY = off */
+    int over_budget;             /* a contact loop saw an overlap beyond the budget */
+
     /* progress */
     long step;
     double time;
@@ -262,6 +284,21 @@ void bal_integrate_velocities(struct bal_sim *s);
 /* The velocities v_{N-1/2} of disc i before the last update, recovered from
  * v_{N+1/2} and the force sums by inverting eqs (35)-(36). */
 void bal_integrate_previous(const struct bal_sim *s, int i, double *vx, double *vy, double *w);
+
+/* energy.c */
+/* Take the baseline of the audit (after the first cycle). */
+void bal_energy_begin(struct bal_sim *s);
+/* Add the walls' work of this cycle (after the wall loop). */
+void bal_energy_walls(struct bal_sim *s);
+/* Add global damping's loss of this cycle (after the velocity update). */
+void bal_energy_global(struct bal_sim *s);
+/* Close the interval of constant g_fac when g_fac has changed. */
+void bal_energy_gravity(struct bal_sim *s);
+/* BAL_EUNSTABLE naming the worst contact if an overlap exceeds the budget. */
+enum bal_status bal_energy_overlap(const struct bal_sim *s, struct bal_error *err);
+/* BAL_EUNSTABLE if the run created more energy than settings.energy_guard
+ * times the energy that went through it. */
+enum bal_status bal_energy_guard(const struct bal_sim *s, struct bal_error *err);
 
 /* timestep.c */
 double bal_timestep_estimate(const struct bal_sim *s);

@@ -29,7 +29,7 @@ def load_cases():
 
 def load_checks(cases):
     """Every reference check, validated against the catalogue."""
-    checks = references.load(reference_root())
+    checks = references.expand(references.load(reference_root()), cases)
     references.validate(checks, cases)
     return checks
 

@@ -104,6 +104,7 @@ def namespace(run, sibling=None):
     names.update(_selectors(run.columns["cycle"]))
     names.update(_signal_functions(run.columns["cycle"]))
     names["run"] = _run_field(run.info)
+    names["energy"] = _energy_term(run.info)
     names["series"] = _series_of(sibling)
     from . import piles   # here, not at the top: piles imports EvalError from this module
     names.update(piles.functions(run, sibling))
@@ -203,6 +204,20 @@ def _run_field(info):
             raise EvalError(f"run(): run.json has no field '{key}'")
         return info[key]
     return run
+
+
+def _energy_term(info):
+    """energy(term): a term of the run's energy audit (run.json "energy", core/energy.c)."""
+    def energy(term):
+        audit = info.get("energy")
+        if not isinstance(audit, dict):
+            raise EvalError("energy(): run.json has no energy audit")
+        if term not in audit:
+            raise EvalError(f"energy(): the audit has no term '{term}' (has: {', '.join(audit)})")
+        if audit[term] is None:
+            raise EvalError(f"energy(): the audit's '{term}' is not finite")
+        return audit[term]
+    return energy
 
 
 SHADOWED = "column_shadowed_by_function_"

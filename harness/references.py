@@ -11,7 +11,7 @@ expression and a tolerance.  Tolerance lines:
 load() validates the syntax of every check (errors name file:line); validate() checks
 the case and variant names against the catalogue.
 """
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from . import reference_root
@@ -173,6 +173,29 @@ def _only_with(section, tolerance):
         entry = section.entry(key)
         if entry and owner != tolerance:
             raise section.error(f"'{key}' only goes with 'tolerance = {owner}'", entry.line)
+
+
+EVERY = "*"
+
+
+def expand(checks, cases):
+    """A check with case = * and variant = * stands for one check per DEM variant
+    (command = run) of every case: the gates every run must pass (the energy audit).
+    Its copies are named NAME[variant]."""
+    out = []
+    for check in checks:
+        if check.case != EVERY:
+            out.append(check)
+            continue
+        if check.variant != EVERY or check.tolerance in ("trend", "ratio"):
+            raise IniError(check.path, check.line,
+                           f"check '{check.name}': case = * needs variant = * and an abs, rel or interval tolerance")
+        for case in cases:
+            for variant in case.variants:
+                if variant.command == "run":
+                    out.append(replace(check, name=f"{check.name}[{variant.name}]", case=case.name,
+                                       variant=variant.name))
+    return out
 
 
 def validate(checks, cases):

@@ -95,7 +95,8 @@ def run_status(folder):
         status = f"{status}, exit {record['returncode']}"
     return {"status": status, "wall": info.get("wall_seconds", record.get("wall_seconds")),
             "steps": info.get("steps"), "dt": info.get("dt"), "n_discs": info.get("n_discs"),
-            "message": info.get("message", "") or record.get("cause", "")}
+            "message": info.get("message", "") or record.get("cause", ""),
+            "energy": info.get("energy") if isinstance(info.get("energy"), dict) else None}
 
 
 def run_rows(case, runs_root):
@@ -409,6 +410,13 @@ def _markdown_case(r):
     lines += [f"| {x['variant']} | {_md(x['status'])} | {fmt_number(x['wall'])} | {fmt_number(x['steps'])} | {_md(x['message'])} |"
               for x in r.runs]
     lines.append("")
+    audited = [x for x in r.runs if x.get("energy")]
+    if audited:
+        lines += ["Energy audit (core/energy.c):", "", "| variant | " + " | ".join(c for c, _ in ENERGY_COLUMNS) + " |",
+                  "|---|" + "---|" * len(ENERGY_COLUMNS)]
+        lines += [f"| {x['variant']} | " + " | ".join(fmt_number(v) for v in energy_cells(x["energy"])) + " |"
+                  for x in audited]
+        lines.append("")
     for f in r.figures:
         image = f"![{_md(f.title)}](figures/{f.png.name})" if f.png else "*(no figure)*"
         lines += [f"**{_md(f.title)}**", "", image] + [f"- {_md(n)}" for n in f.notes] + [""]
@@ -472,6 +480,38 @@ def _runs_html(r):
     return table_html(["variant", "status", "wall s", "steps", "dt", "discs", "message"], rows)
 
 
+# The energy audit of core/energy.c: work in = change of stored energy + each loss + imbalance.
+ENERGY_COLUMNS = (("W walls", lambda e: e["work_walls"]), ("W gravity", lambda e: e["work_gravity"]),
+                  ("dE kinetic", lambda e: e["kinetic"] - e["kinetic0"]),
+                  ("dE elastic", lambda e: e["elastic"] - e["elastic0"]),
+                  ("D dashpot", lambda e: e["dissipated_dashpot"]),
+                  ("D friction", lambda e: e["dissipated_friction"]),
+                  ("D global", lambda e: e["dissipated_global"]),
+                  ("imbalance", lambda e: e["imbalance"]), ("relative", lambda e: e["relative_imbalance"]))
+
+
+def energy_cells(audit):
+    """The audit's terms in ENERGY_COLUMNS order (None where a term is missing or not finite)."""
+    out = []
+    for _, term in ENERGY_COLUMNS:
+        try:
+            out.append(term(audit))
+        except (KeyError, TypeError):
+            out.append(None)
+    return out
+
+
+def _energy_html(r):
+    rows = [[cell(x["variant"])] + [cell(fmt_number(v), "num") for v in energy_cells(x["energy"])]
+            for x in r.runs if x.get("energy")]
+    if not rows:
+        return ""
+    return ("<h3>Energy audit</h3><p class=\"meta\">from the first cycle to the end of the run: "
+            "W walls + W gravity = dE kinetic + dE elastic + D dashpot + D friction + D global + imbalance "
+            "(core/energy.c); relative = |imbalance| / (energy at the start + |W walls| + |W gravity|)</p>"
+            + table_html(["variant"] + [c for c, _ in ENERGY_COLUMNS], rows))
+
+
 def _checks_html(r):
     rows = [[cell(v.check), cell(v.variant), cell(v.quantity), cell(fmt_number(v.value), "num"),
              cell(fmt_reference(v), "num"), cell(v.tolerance), cell(v.kind), cell(v.provenance),
@@ -491,7 +531,7 @@ def _case_html(r):
         f"<p><b>Checks:</b> {esc(c.checks)}</p>",
         f"<p class=\"meta\">tier {esc(c.tier)} &middot; {passed} passed, {failed} failed &middot; "
         f"defined at <code>{esc(c.source)}</code></p>",
-        "<h3>Runs</h3>", _runs_html(r),
+        "<h3>Runs</h3>", _runs_html(r), _energy_html(r),
         "<h3>Figures</h3>" if r.figures else "", *[image_html(f) for f in r.figures],
         f"<h3>Checks</h3><p class=\"meta\">verdicts: {esc(r.verdict_source)}</p>", _checks_html(r),
         "</section>"])

@@ -1,0 +1,245 @@
+/*
+ * energy.c — the energy audit of a run, and the guards that stop a run
+ * whose energy runs away or whose overlaps exceed the budget.
+ *
+ * Balance, from the first cycle (t_1, the first time forces exist) to now:
+ *
+ *   W_walls + W_gravity = ΔE_k + ΔE_el + D_dashpot + D_friction + D_global
+ *                         + imbalance
+ *
+ *   E_k        Σ ½ m v_N² + ½ I ω_N², v_N the centred velocity (C&S eq. 31)
+ *   E_el       stored in the contact springs: ½ F_n²/k_n (incremental law) or
+ *              ∫ F_n dδ = k_n δ0² (δ/δ0)^(ν+1)/(ν+1) (power law), + ½ F_s²/k_s
+ *   W_walls    Σ_cycles −(F̄·V + M̄ ω) Δt over the walls, F and M the resultant
+ *              and moment about P of the discs' forces on the wall, F̄ the
+ *              mean of their values at the two ends of the cycle
+ *   W_gravity  Σ_cycles ḡ_fac m g·(x_N − x_{N−1}), ḡ_fac the mean of the
+ *              factors at t_{N−1} and t_N; summed per interval of constant
+ *              g_fac as g_fac m g·Δ(centre of mass)
+ *   D_dashpot  Σ_cycles (D_n ṅ + D_s ṡ) Δt (C&S eqs 26–28, MLH eq. 3), in the
+ *              contact loops
+ *   D_friction Σ_cycles F_max |slip|, slip = (|F_s trial| − F_max)/k_s, where
+ *              the Coulomb limit (eq. 19) cuts the shear force
+ *   D_global   Σ_cycles α (m v_N² + I ω_N²) Δt: eqs (35)–(36) are
+ *              m (v_{N+1/2} − v_{N−1/2})/Δt = F − α m v_N; the first and
+ *              the latest cycle count half (each is centred on an end)
+ *
+ * The imbalance is what the time discretisation creates or destroys (the
+ * centred scheme conserves a shadow energy, not E_k + E_el), plus what the
+ * contact law's choices do: a contact that opens with F_n > 0 under the
+ * incremental law loses ½ F_n²/k_n.  It is reported, never hidden, and the
+ * harness gates its share of the energy that went through the run.
+ * Dissipation terms are separate fields, so a later one (rolling
+ * resistance) adds a field and a term.
+ */
+#include <math.h>
+#include <stdio.h>
+
+#include "sim.h"
+
+/* Σ m g·x over the free discs (held discs do not move). */
+static double gravity_potential(const struct bal_sim *s)
+{
+    double e = 0;
+    for (int i = 0; i < s->n; i++)
+        if (!s->fixed[i])
+            e += bal_mass(s, i) * (s->g[0] * s->x[i] + s->g[1] * s->y[i]);
+    return e;
+}
+
+static double global_loss(const struct bal_sim *s);
+
+void bal_energy_begin(struct bal_sim *s)
+{
+    struct bal_audit *a = &s->audit;
+    *a = (struct bal_audit){0};
+    a->started = 1;
+    a->start_step = s->step;
+    a->ek0 = bal_measure_kinetic(s);
+    a->ee0 = bal_measure_elastic(s);
+    a->gravity = s->g[0] != 0 || s->g[1] != 0;
+    a->g_last = a->gravity ? gravity_potential(s) : 0;
+    a->gfac_last = s->gfac;
+    if (s->alpha != 0)
+        a->d_global = 0.5 * global_loss(s);
+    for (int k = 0; k < s->n_walls; k++) {
+        struct bal_wall *W = &s->walls[k];
+        W->f_prev[0] = W->f[0];
+        W->f_prev[1] = W->f[1];
+        W->moment_prev = W->moment;
+    }
+}
+
+/* Σ m g·v_{N-1/2} of the free discs, v recovered from the force sums. */
+static double gravity_power_before(const struct bal_sim *s)
+{
+    double p = 0;
+    for (int i = 0; i < s->n; i++) {
+        if (s->fixed[i])
+            continue;
+        double vx, vy, w;
+        bal_integrate_previous(s, i, &vx, &vy, &w);
+        p += bal_mass(s, i) * (s->g[0] * vx + s->g[1] * vy);
+    }
+    return p;
+}
+
+/* g_fac changed at this cycle N: the interval of constant g_fac ends at
+ * x_{N-1}, and the step x_{N-1} -> x_N feels the mean of the factors at
+ * its two ends (the trapezoid rule, as for the walls: the centred scheme's
+ * kinetic energy at t_N then balances it to O(Δt² Δg_fac)). */
+void bal_energy_gravity(struct bal_sim *s)
+{
+    struct bal_audit *a = &s->audit;
+    if (!a->gravity || s->gfac == a->gfac_last)
+        return;
+    const double now = gravity_potential(s);
+    const double before = now - s->dt * gravity_power_before(s);
+    a->w_gravity += a->gfac_last * (before - a->g_last) +
+                    0.5 * (a->gfac_last + s->gfac) * (now - before);
+    a->g_last = now;
+    a->gfac_last = s->gfac;
+}
+
+/* The walls moved from t_{N-1} to t_N with their current velocities; the
+ * force on them went from F_{N-1} to F_N: the trapezoid rule, exact for a
+ * linear spring (the rectangle rule errs by ½ F_N V Δt a cycle, 1/M of the
+ * work after M cycles of loading). */
+void bal_energy_walls(struct bal_sim *s)
+{
+    double w = 0;
+    for (int k = 0; k < s->n_walls; k++) {
+        struct bal_wall *W = &s->walls[k];
+        w -= 0.5 * ((W->f[0] + W->f_prev[0]) * W->v[0] + (W->f[1] + W->f_prev[1]) * W->v[1] +
+                    (W->moment + W->moment_prev) * W->omega);
+        W->f_prev[0] = W->f[0];
+        W->f_prev[1] = W->f[1];
+        W->moment_prev = W->moment;
+    }
+    s->audit.w_walls += w * s->dt;
+}
+
+/* The loss of this cycle, α (m v_N² + I ω_N²) Δt, is centred at t_N: half
+ * of it belongs before t_N, half after.  The audit counts half of the first
+ * cycle's and takes back half of the latest (bal_energy_report). */
+void bal_energy_global(struct bal_sim *s)
+{
+    if (s->alpha == 0)
+        return;
+    const double loss = global_loss(s);
+    s->audit.d_global += loss;
+    s->audit.d_global_last = loss;
+}
+
+static double global_loss(const struct bal_sim *s)
+{
+    double d = 0;
+    for (int i = 0; i < s->n; i++) {
+        if (s->fixed[i])
+            continue;
+        double vx, vy, w;
+        bal_integrate_previous(s, i, &vx, &vy, &w);
+        vx = 0.5 * (vx + s->vx[i]);
+        vy = 0.5 * (vy + s->vy[i]);
+        w = 0.5 * (w + s->w[i]);
+        d += bal_mass(s, i) * (vx * vx + vy * vy) + bal_inertia(s, i) * w * w;
+    }
+    return s->alpha * d * s->dt;
+}
+
+void bal_energy_report(const struct bal_sim *s, struct bal_energy *e)
+{
+    const struct bal_audit *a = &s->audit;
+    *e = (struct bal_energy){0};
+    if (!a->started)
+        return;
+    e->started = 1;
+    e->from_step = a->start_step;
+    e->kinetic0 = a->ek0;
+    e->elastic0 = a->ee0;
+    e->kinetic = bal_measure_kinetic(s);
+    e->elastic = bal_measure_elastic(s);
+    e->work_walls = a->w_walls;
+    e->work_gravity = a->w_gravity;
+    if (a->gravity)
+        e->work_gravity += a->gfac_last * (gravity_potential(s) - a->g_last);
+    e->dissipated_dashpot = a->d_dashpot;
+    e->dissipated_friction = a->d_friction;
+    e->dissipated_global = a->d_global - 0.5 * a->d_global_last;
+    e->imbalance = e->work_walls + e->work_gravity -
+                   (e->kinetic - e->kinetic0 + e->elastic - e->elastic0 + e->dissipated_dashpot +
+                    e->dissipated_friction + e->dissipated_global);
+    /* The energy that went through the run: what it started with and every
+     * work and loss, each counted once. */
+    e->throughput = e->kinetic0 + e->elastic0 + fabs(e->work_walls) + fabs(e->work_gravity);
+    e->relative = e->throughput > 0 ? fabs(e->imbalance) / e->throughput
+                                    : (e->imbalance == 0 ? 0 : INFINITY);
+}
+
+enum bal_status bal_energy_guard(const struct bal_sim *s, struct bal_error *err)
+{
+    const double limit = s->scene->settings.energy_guard;
+    if (limit <= 0 || !s->audit.started)
+        return BAL_OK;
+    struct bal_energy e;
+    bal_energy_report(s, &e);
+    /* Created energy (a negative imbalance) beyond `limit` times what went
+     * through the run: the scheme is feeding the motion. */
+    if (-e.imbalance > limit * e.throughput && -e.imbalance > 0)
+        return bal_error(err, BAL_EUNSTABLE,
+                         "%s: energy runaway at step %ld: the run created %.6g of energy, %.3g "
+                         "times the %.6g that went through it (limit %g, settings.energy_guard); "
+                         "E_k = %.6g, E_el = %.6g (time step too large for the stiffness?)",
+                         s->scene->path, s->step, -e.imbalance,
+                         e.throughput > 0 ? -e.imbalance / e.throughput : INFINITY, e.throughput,
+                         limit, e.kinetic, e.elastic);
+    return BAL_OK;
+}
+
+/* The contact of list p with the largest overlap relative to its smaller
+ * radius, after a contact loop flagged one beyond the budget. */
+enum bal_status bal_energy_overlap(const struct bal_sim *s, struct bal_error *err)
+{
+    const double budget = s->scene->settings.overlap_budget;
+    double worst = -1, share = 0;
+    long wc = -1;
+    int wall = 0;
+    for (int list = 0; list < 2; list++) {
+        const struct bal_pairs *p = list ? &s->pw : &s->pp;
+        for (long c = 0; c < p->n; c++) {
+            const int i = p->i[c], j = p->j[c];
+            double delta, rmin;
+            if (list) {
+                double cx, cy;
+                delta = s->r[i] - sqrt(bal_walls_closest(&s->walls[j], s->x[i], s->y[i], &cx, &cy));
+                rmin = s->r[i];
+            } else {
+                delta = s->r[i] + s->r[j] - hypot(s->x[j] - s->x[i], s->y[j] - s->y[i]);
+                rmin = fmin(s->r[i], s->r[j]);
+            }
+            if (delta / rmin > worst) {
+                worst = delta / rmin;
+                share = delta;
+                wc = c;
+                wall = list;
+            }
+        }
+    }
+    if (wc < 0 || worst <= budget)
+        return BAL_OK;
+    const struct bal_pairs *p = wall ? &s->pw : &s->pp;
+    char a[2 * BAL_NAME_MAX], b[3 * BAL_NAME_MAX];
+    bal_output_disc_name(s, s->id[p->i[wc]], a, sizeof a);
+    if (wall)
+        snprintf(b, sizeof b, "wall %s", s->walls[p->j[wc]].name);
+    else {
+        char d[2 * BAL_NAME_MAX];
+        bal_output_disc_name(s, s->id[p->j[wc]], d, sizeof d);
+        snprintf(b, sizeof b, "disc %s", d);
+    }
+    return bal_error(err, BAL_EUNSTABLE,
+                     "%s: overlap beyond the budget at step %ld: disc %s and %s overlap by %.6g, "
+                     "%.3g of the smaller radius (limit %g, settings.overlap_budget) "
+                     "(impact too fast or time step too large for the stiffness?)",
+                     s->scene->path, s->step, a, b, share, worst, budget);
+}

@@ -29,7 +29,7 @@ TEST_SRC := $(wildcard core/tests/check_*.c)
 BENCH_SRC := core/bench/bench.c
 
 .PHONY: all deps test test-c test-prefix test-py test-sanitize validate bench bench-scaling \
-        bench-peer clean keys
+        bench-peer bench-modules clean keys
 
 all: deps bin/ballast
 
@@ -92,6 +92,21 @@ bench: deps $(BUILD)/bench
 	$(BUILD)/bench cases/bench/dense.scene
 	$(BUILD)/bench --settling cases/bench/dense.scene 20000
 	$(BUILD)/bench --pile cases/piles/pile30_bumpy.scene
+
+# What each optional module costs: one simulation per configuration from the same
+# settled packing, then the all-off configuration in a build without the modules
+# (-DBAL_BARE), alternately, so the cost of a switched-off module is measured.
+BARE_OBJ := $(LIB_SRC:core/%.c=$(BUILD)/bare/%.o)
+$(BUILD)/bare/%.o: core/%.c $(wildcard core/*.h) | $(BUILD)
+	@mkdir -p $(BUILD)/bare
+	$(CC) $(ALL_CFLAGS) -DBAL_BARE -c -o $@ $<
+$(BUILD)/bench-bare: $(BENCH_SRC) $(BARE_OBJ)
+	$(CC) $(ALL_CFLAGS) -DBAL_BARE -Icore -o $@ $(BENCH_SRC) $(BARE_OBJ) $(LDLIBS)
+
+bench-modules: deps $(BUILD)/bench $(BUILD)/bench-bare
+	$(BUILD)/bench --modules cases/bench/dense.scene 20000
+	for k in 1 2 3; do $(BUILD)/bench --modules-base cases/bench/dense.scene 20000 | grep '^bench'; \
+	  $(BUILD)/bench-bare --modules-base cases/bench/dense.scene 20000 | grep '^bench'; done
 
 # ballast against LAMMPS (installed with apt-get when missing; not a build or test
 # dependency): a cross-check of the same physics, then 5 alternating repeats per

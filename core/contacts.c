@@ -249,6 +249,19 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
 #define PAIR_VARIANT(name, law, shear, damp) \
     static void name(struct bal_sim *s) { pair_loop(s, law, shear, damp); }
 
+/* BAL_BARE: the build without optional modules, for `make bench-modules`
+ * only: every scene gets the frictionless, undamped power-law loop, so a
+ * scene that switches the contact modules off can be timed against code
+ * that does not have them. */
+#ifdef BAL_BARE
+PAIR_VARIANT(loop_pow, BAL_NORMAL_POWER, 0, 0)
+
+bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping)
+{
+    (void)normal_law, (void)shear, (void)damping;
+    return loop_pow;
+}
+#else
 PAIR_VARIANT(loop_inc, BAL_NORMAL_INCREMENTAL, 0, 0)
 PAIR_VARIANT(loop_inc_d, BAL_NORMAL_INCREMENTAL, 0, 1)
 PAIR_VARIANT(loop_inc_s, BAL_NORMAL_INCREMENTAL, 1, 0)
@@ -266,6 +279,7 @@ bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping)
     };
     return table[normal_law == BAL_NORMAL_POWER][shear != 0][damping != 0];
 }
+#endif
 
 /* ------------------------------------------------------------------ */
 /* Disc–wall contacts                                                  */

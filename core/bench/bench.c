@@ -18,6 +18,12 @@
  *                                  where BAL_GRID_CROSSOVER comes from)
  *        bench --settling SCENE [N]  (the packing timed while it falls)
  *        bench --pile PILE_SCENE  (the L0 = 100 pile relaxed, 5 whole runs)
+ *        bench --modules SCENE [N]       (what each optional module costs, one
+ *                                         simulation per configuration from
+ *                                         the same settled packing)
+ *        bench --modules-base SCENE [N]  (only the configuration with every
+ *                                         module off: run by bench-bare, the
+ *                                         build without them, to compare)
  */
 #include <math.h>
 #include <stdio.h>
@@ -261,6 +267,146 @@ static int pile_bench(const char *path)
     return 0;
 }
 
+/* ------------------------------------------------------------------ */
+/* What each optional module costs (issue 6, item 6)                    */
+/* ------------------------------------------------------------------ */
+
+/* One configuration of the module benchmark: overrides on the dense scene. */
+struct module_config {
+    const char *name;
+    const char *sets[4];
+};
+
+/* The modules are chosen when a simulation is created, so every
+ * configuration is its own simulation, started from the same settled
+ * packing: positions and rotations copied by scene-order id from one
+ * reference run, velocities zero.  All use the power law (its force needs
+ * no history); ν = 1 is the linear baseline.  A frictionless or undamped
+ * copy of a frictional packing would flow, so the timed cycles use a time
+ * step 1e-4 of the scene's: the packing stays put (no rebuilds), and every
+ * configuration does its per-cycle work on the same contacts — the cost of
+ * a cycle does not depend on Δt. */
+static const struct module_config module_configs[] = {
+    {"base (frictionless, undamped, linear)", {"material.grain.friction=0", "material.box.friction=0",
+                                               "settings.beta=0", "settings.alpha=0"}},
+    {"+ tangential history (friction 0.5)", {"settings.beta=0", "settings.alpha=0", NULL, NULL}},
+    {"+ contact damping (beta)", {"material.grain.friction=0", "material.box.friction=0",
+                                  "settings.alpha=0", NULL}},
+    {"+ global damping (alpha)", {"material.grain.friction=0", "material.box.friction=0",
+                                  "settings.beta=0", NULL}},
+    {"+ nonlinear normal law (nu = 3/2)", {"material.grain.friction=0", "material.box.friction=0",
+                                           "settings.beta=0", "settings.alpha=0"}},
+    {"all on", {NULL, NULL, NULL, NULL}},
+};
+
+static int load_config(const char *path, long n, const struct module_config *c, int nonlinear,
+                       struct bal_scene *sc, struct bal_sim **sim, struct bal_error *err)
+{
+    char set[128];
+    bal_scene_default(sc);
+    int ok = bal_scene_load(sc, path, err) == BAL_OK;
+    snprintf(set, sizeof set, "fill.pack.n=%ld", n);
+    ok = ok && bal_scene_set(sc, set, err) == BAL_OK;
+    snprintf(set, sizeof set, "fill.pack.columns=%ld", lround(sqrt(2.0 * (double)n)));
+    ok = ok && bal_scene_set(sc, set, err) == BAL_OK;
+    ok = ok && bal_scene_set(sc, "settings.normal_law=power", err) == BAL_OK;
+    if (nonlinear)
+        ok = ok && bal_scene_set(sc, "settings.nu=1.5", err) == BAL_OK &&
+             bal_scene_set(sc, "settings.delta0=1", err) == BAL_OK;
+    for (int k = 0; c && k < 4 && c->sets[k]; k++)
+        ok = ok && bal_scene_set(sc, c->sets[k], err) == BAL_OK;
+    ok = ok && bal_sim_create(sim, sc, err) == BAL_OK;
+    return ok ? 0 : 1;
+}
+
+static int modules_bench(const char *path, long n, int base_only)
+{
+    struct bal_scene ref_sc;
+    struct bal_sim *ref = NULL;
+    struct bal_error err = {0};
+    /* the reference packing: every module on, settled */
+    if (load_config(path, n, NULL, 0, &ref_sc, &ref, &err)) {
+        fprintf(stderr, "bench: %s\n", err.msg);
+        bal_scene_free(&ref_sc);
+        return 1;
+    }
+    long settle = 0;
+    for (int g = 0; g + 1 < ref_sc.n_stages; g++) {
+        bal_sim_set_stage(ref, g);
+        for (long c = 0; c < ref_sc.stages[g].cycles; c++, settle++)
+            if (bal_sim_cycle(ref, &err)) {
+                fprintf(stderr, "bench: settling: %s\n", err.msg);
+                return 1;
+            }
+    }
+    while (bal_measure_kinetic(ref) > SETTLED_EK_OVER_EE * bal_measure_elastic(ref) &&
+           settle < (MAX_SETTLE_BLOCKS + 1) * ref_sc.stages[0].cycles)
+        for (long c = 0; c < ref_sc.stages[0].cycles; c++, settle++)
+            if (bal_sim_cycle(ref, &err)) {
+                fprintf(stderr, "bench: settling: %s\n", err.msg);
+                return 1;
+            }
+    printf("# module costs: N=%d packing settled for %ld cycles with every module on "
+           "(E_k/E_el = %.2g); each configuration starts from it at rest\n",
+           ref->n, settle, bal_measure_kinetic(ref) / bal_measure_elastic(ref));
+    const size_t n_cfg = base_only ? 1 : sizeof module_configs / sizeof module_configs[0];
+    for (size_t k = 0; k < n_cfg; k++) {
+        const struct module_config *c = &module_configs[k];
+        struct bal_scene sc;
+        struct bal_sim *sim = NULL;
+        if (load_config(path, n, c, k == 4, &sc, &sim, &err) || sim->n != ref->n) {
+            fprintf(stderr, "bench: %s\n", err.msg);
+            bal_sim_free(sim);
+            bal_scene_free(&sc);
+            return 1;
+        }
+        for (int i = 0; i < ref->n; i++) {
+            const int to = sim->slot[ref->id[i]];
+            sim->x[to] = ref->x[i];
+            sim->y[to] = ref->y[i];
+            sim->th[to] = ref->th[i];
+            sim->vx[to] = sim->vy[to] = sim->w[to] = 0;
+        }
+        sim->need_rebuild = 1;
+        sim->dt = ref->dt * 1e-4;
+        bal_sim_set_stage(sim, sc.n_stages - 1);
+        long steps = 50;
+        double t = timed_steps(sim, steps, &err);
+        if (t > 0)
+            steps = (long)fmax(100, TARGET_SECONDS / (t / (double)steps));
+        double rate[REPEATS];
+        for (int r = 0; r < REPEATS && t >= 0; r++) {
+            t = timed_steps(sim, steps, &err);
+            rate[r] = (double)steps * (double)sim->n / t;
+        }
+        if (t < 0) {
+            fprintf(stderr, "bench: %s: %s\n", c->name, err.msg);
+            bal_sim_free(sim);
+            bal_scene_free(&sc);
+            return 1;
+        }
+        qsort(rate, REPEATS, sizeof rate[0], cmp_double);
+        long contacts = 0;
+        for (long q = 0; q < sim->pp.n; q++)
+            contacts += (sim->pp.flags[q] & BAL_PAIR_TOUCHING) != 0;
+        printf("bench module build=%s config=\"%s\" N=%d particle_steps_per_s=%.4g min=%.4g "
+               "max=%.4g contacts=%ld rebuilds=%ld\n",
+#ifdef BAL_BARE
+               "bare",
+#else
+               "full",
+#endif
+               c->name, sim->n, rate[REPEATS / 2], rate[0], rate[REPEATS - 1], contacts,
+               sim->rebuilds);
+        fflush(stdout);
+        bal_sim_free(sim);
+        bal_scene_free(&sc);
+    }
+    bal_sim_free(ref);
+    bal_scene_free(&ref_sc);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -271,6 +417,10 @@ int main(int argc, char **argv)
         return grid_crossover(argv[2]);
     if (strcmp(argv[1], "--pile") == 0 && argc == 3)
         return pile_bench(argv[2]);
+    if (strcmp(argv[1], "--modules") == 0 && argc >= 3)
+        return modules_bench(argv[2], argc > 3 ? atol(argv[3]) : 20000, 0);
+    if (strcmp(argv[1], "--modules-base") == 0 && argc >= 3)
+        return modules_bench(argv[2], argc > 3 ? atol(argv[3]) : 20000, 1);
     if (strcmp(argv[1], "--settling") == 0 && argc >= 3) {
         /* The same packing timed while it falls from the lattice (settle
          * stage cut to one cycle): flow, frequent rebuilds and re-sorts. */

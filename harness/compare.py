@@ -107,6 +107,7 @@ def namespace(run, sibling=None):
     names["series"] = _series_of(sibling)
     from . import piles   # here, not at the top: piles imports EvalError from this module
     names.update(piles.functions(run, sibling))
+    names.update(_collision_functions(run, sibling))
     return names
 
 
@@ -369,3 +370,101 @@ def evaluate_check(check, store):
 def evaluate_all(checks, store):
     """Verdicts of the checks, in the order given."""
     return [evaluate_check(c, store) for c in checks]
+
+
+# ---------------------------------------------------------------- collisions and orders
+# (cases/collisions, reference/collisions.ref, reference/two_discs_order.ref)
+#
+# contact_start(gap), contact_end(gap), contact_duration(gap), restitution(gap): a binary
+# collision measured from the surface gap of two discs (a whole series column expression,
+# e.g. x_b - x_a - 1.75; negative while they overlap).  The first contact is the first run
+# of rows with gap < 0 (C&S eq. 8 is strict).  Its start and end are the zero crossings of
+# the gap, interpolated linearly between the rows that straddle them: the row outside
+# contact lies on the free-flight line, and so does the row inside (the scheme moves the
+# discs with v_{N-1/2}, C&S eq. 23, before the force acts), so the interpolation is exact
+# on the free-flight side.  restitution is -(chord after)/(chord before): the chords across
+# the crossings are the free-flight velocities v_{N+1/2} (C&S eq. 22), which the scheme
+# holds exactly in flight; the centred velocities of eq. 31 would mix a half step in
+# contact.  The straddling rows must be consecutive cycles (output_every = 1 there).
+#
+# of(variant, expr): the value of expr in another variant of the same case.
+# order(expr, exact, coarse, fine): the observed order of accuracy
+# p = log(|q_coarse - exact| / |q_fine - exact|) / log(dt_coarse / dt_fine), q = expr in
+# each variant, dt from each run.json.
+
+def _collision_functions(run, sibling):
+    cycle, time = run.columns["cycle"], run.columns["time"]
+
+    def crossings(gap, fname):
+        gap = np.asarray(gap, dtype=float)
+        if gap.shape != cycle.shape:
+            raise EvalError(f"{fname}(): argument must be a whole series column expression")
+        inside = np.flatnonzero(gap < 0)
+        if inside.size == 0:
+            raise EvalError(f"{fname}(): the gap never becomes negative (no contact)")
+        s = inside[0]
+        after = np.flatnonzero(gap[s:] >= 0)
+        if s == 0 or after.size == 0:
+            raise EvalError(f"{fname}(): the contact must start and end inside the series")
+        e = s + after[0] - 1               # last row of the first contact
+        for a in (s - 1, e):
+            if cycle[a + 1] - cycle[a] != 1:
+                raise EvalError(f"{fname}(): rows {cycle[a]:g} and {cycle[a + 1]:g} are not "
+                                "consecutive cycles (set output_every = 1)")
+        return gap, s, e
+
+    def cross_time(gap, a):
+        """Time where the line through rows a and a + 1 crosses gap = 0."""
+        return float(time[a] + (time[a + 1] - time[a]) * gap[a] / (gap[a] - gap[a + 1]))
+
+    def chord(gap, a):
+        return float((gap[a + 1] - gap[a]) / (time[a + 1] - time[a]))
+
+    def contact_start(gap):
+        gap, s, _ = crossings(gap, "contact_start")
+        return cross_time(gap, s - 1)
+
+    def contact_end(gap):
+        gap, _, e = crossings(gap, "contact_end")
+        return cross_time(gap, e)
+
+    def contact_duration(gap):
+        gap, s, e = crossings(gap, "contact_duration")
+        return cross_time(gap, e) - cross_time(gap, s - 1)
+
+    def restitution(gap):
+        gap, s, e = crossings(gap, "restitution")
+        return -chord(gap, e) / chord(gap, s - 1)
+
+    def other(variant, fname):
+        if sibling is None:
+            raise EvalError(f"{fname}(): no other variants are available here")
+        try:
+            return sibling(variant)
+        except RunProblem as problem:
+            raise EvalError(f"{fname}(): variant '{variant}': {problem}") from None
+
+    def of(variant, expr):
+        try:
+            return evaluate(expr, other(variant, "of"), sibling)
+        except EvalError as exc:
+            raise EvalError(f"of(): variant '{variant}': {exc}") from None
+
+    def order(expr, exact, coarse, fine):
+        errors, steps = [], []
+        for variant in (coarse, fine):
+            errors.append(abs(of(variant, expr) - exact))
+            dt = other(variant, "order").info.get("dt")
+            if not isinstance(dt, (int, float)) or not dt > 0:
+                raise EvalError(f"order(): variant '{variant}': run.json has no positive dt")
+            steps.append(float(dt))
+        if steps[0] == steps[1]:
+            raise EvalError(f"order(): '{coarse}' and '{fine}' have the same dt")
+        if not (errors[0] > 0 and errors[1] > 0):
+            raise EvalError(f"order(): an error is zero ({errors[0]:g}, {errors[1]:g}): "
+                            "no order can be observed")
+        return math.log(errors[0] / errors[1]) / math.log(steps[0] / steps[1])
+
+    return {"contact_start": contact_start, "contact_end": contact_end,
+            "contact_duration": contact_duration, "restitution": restitution,
+            "of": of, "order": order}

@@ -387,6 +387,11 @@ def evaluate_all(checks, store):
 # holds exactly in flight; the centred velocities of eq. 31 would mix a half step in
 # contact.  The straddling rows must be consecutive cycles (output_every = 1 there).
 #
+# sine_period(arr, level), sine_amplitude(arr, level): the period (in rows) and amplitude of
+# a sampled sinusoid about level, y_N = arr_N - level = A sin(N theta + phi), with sub-step
+# resolution: y_{N+1} + y_{N-1} = 2 cos(theta) y_N gives cos(theta) (least squares over all
+# rows), and y_N^2 - y_{N-1} y_{N+1} = A^2 sin^2(theta) gives A (mean over all rows).  Both
+# are exact for a pure sampled sinusoid, whatever the phase of the samples.
 # of(variant, expr): the value of expr in another variant of the same case.
 # order(expr, exact, coarse, fine): the observed order of accuracy
 # p = log(|q_coarse - exact| / |q_fine - exact|) / log(dt_coarse / dt_fine), q = expr in
@@ -465,6 +470,29 @@ def _collision_functions(run, sibling):
                             "no order can be observed")
         return math.log(errors[0] / errors[1]) / math.log(steps[0] / steps[1])
 
+    def sine_theta(arr, level, fname):
+        y = np.atleast_1d(np.asarray(arr, dtype=float)) - level
+        if y.size < 3:
+            raise EvalError(f"{fname}(): needs at least three rows")
+        mid = y[1:-1]
+        denom = 2 * np.dot(mid, mid)
+        if not denom > 0:
+            raise EvalError(f"{fname}(): the signal equals the level")
+        cos_theta = np.dot(mid, y[2:] + y[:-2]) / denom
+        if not -1 < cos_theta < 1:
+            raise EvalError(f"{fname}(): not a sampled sinusoid (cos theta = {cos_theta:g})")
+        return y, math.acos(cos_theta)
+
+    def sine_period(arr, level):
+        _, theta = sine_theta(arr, level, "sine_period")
+        return 2 * math.pi / theta
+
+    def sine_amplitude(arr, level):
+        y, theta = sine_theta(arr, level, "sine_amplitude")
+        a2 = np.mean(y[1:-1] ** 2 - y[:-2] * y[2:])
+        return math.sqrt(max(a2, 0.0)) / math.sin(theta)
+
     return {"contact_start": contact_start, "contact_end": contact_end,
+            "sine_period": sine_period, "sine_amplitude": sine_amplitude,
             "contact_duration": contact_duration, "restitution": restitution,
             "of": of, "order": order}

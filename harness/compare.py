@@ -8,7 +8,8 @@ number of rows between upward crossings of the mean, and settle(col, target, tol
 the cycle from which a column stays within tol of target; and the pile functions of
 piles.py (pile_X, pile_S, middle, horizontal_contacts, contact_error, contact_mismatch,
 weight), which read the run's final state (discs.tsv, contacts.tsv, stress.tsv) when
-called.  evaluate_check() turns one Check into a Verdict; anything that goes wrong
+called; and the collision and order functions of the block at the end (contact_start,
+contact_end, contact_duration, restitution, sine_period, sine_amplitude, of, order).  evaluate_check() turns one Check into a Verdict; anything that goes wrong
 (missing output, failed run, missing column, an expression that raises, a NaN/inf
 value) is a FAIL whose message says which, never a pass and never a skip.
 """

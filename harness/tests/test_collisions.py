@@ -183,3 +183,15 @@ def test_figure_constants_are_the_derived_closed_forms():
         block = text.split(f"[figure {fig}]", 1)[1].split("\n[", 1)[0]
         y = re.search(r"^y = .* - ([0-9.e+-]+)\)$", block, re.M).group(1)
         assert float(y) == derived[fam][idx], fig
+
+
+def test_two_discs_figure_constant_is_the_derived_amplitude():
+    order = load_derive("two_discs_order")
+    p = order.read_scene(order.SCENE)
+    m = p["rho"] * math.pi * p["r"] ** 2
+    omega, T = math.sqrt(3 * p["k"] / m), p["load"] * p["dt"]
+    amp = 4 * p["k"] * p["v"] / (3 * omega) * abs(math.sin(omega * T / 2))
+    text = (ROOT / "cases" / "two_discs" / "case.txt").read_text()
+    block = text.split("[figure order_amplitude]", 1)[1]
+    y = re.search(r"^y = .* - ([0-9.e+-]+)\)$", block, re.M).group(1)
+    assert float(y) == amp

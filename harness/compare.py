@@ -394,9 +394,9 @@ def evaluate_all(checks, store):
 # rows), and y_N^2 - y_{N-1} y_{N+1} = A^2 sin^2(theta) gives A (mean over all rows).  Both
 # are exact for a pure sampled sinusoid, whatever the phase of the samples.
 # of(variant, expr): the value of expr in another variant of the same case.
-# order(expr, exact, coarse, fine): the observed order of accuracy
-# p = log(|q_coarse - exact| / |q_fine - exact|) / log(dt_coarse / dt_fine), q = expr in
-# each variant, dt from each run.json.
+# order(expr, exact, v1, v2, ...): the observed order of accuracy; for two variants
+# p = log(|q_1 - exact| / |q_2 - exact|) / log(dt_1 / dt_2), q = expr in each variant, dt
+# from each run.json; for more, the least-squares slope of log|q - exact| on log dt.
 
 def _collision_functions(run, sibling):
     cycle, time = run.columns["cycle"], run.columns["time"]
@@ -456,20 +456,23 @@ def _collision_functions(run, sibling):
         except EvalError as exc:
             raise EvalError(f"of(): variant '{variant}': {exc}") from None
 
-    def order(expr, exact, coarse, fine):
+    def order(expr, exact, *variants):
+        if len(variants) < 2:
+            raise EvalError("order(): needs at least two variants")
         errors, steps = [], []
-        for variant in (coarse, fine):
+        for variant in variants:
             errors.append(abs(of(variant, expr) - exact))
             dt = other(variant, "order").info.get("dt")
             if not isinstance(dt, (int, float)) or not dt > 0:
                 raise EvalError(f"order(): variant '{variant}': run.json has no positive dt")
             steps.append(float(dt))
-        if steps[0] == steps[1]:
-            raise EvalError(f"order(): '{coarse}' and '{fine}' have the same dt")
-        if not (errors[0] > 0 and errors[1] > 0):
-            raise EvalError(f"order(): an error is zero ({errors[0]:g}, {errors[1]:g}): "
+        if len(set(steps)) < len(steps):
+            raise EvalError(f"order(): two of {', '.join(variants)} have the same dt")
+        if not all(e > 0 for e in errors):
+            raise EvalError(f"order(): an error is zero ({', '.join(f'{e:g}' for e in errors)}): "
                             "no order can be observed")
-        return math.log(errors[0] / errors[1]) / math.log(steps[0] / steps[1])
+        # Two variants: the pairwise order; more: the least-squares slope of log e on log dt.
+        return float(np.polyfit(np.log(steps), np.log(errors), 1)[0])
 
     def sine_theta(arr, level, fname):
         y = np.atleast_1d(np.asarray(arr, dtype=float)) - level

@@ -95,7 +95,7 @@ def orders(tmp_path):
     """Variants whose 'last(Q)' is 1 + 3 dt^2 (order 2), dt = 0.1, 0.05, and one with the
     same dt as another; and the store over them."""
     root = tmp_path / "runs"
-    for name, dt in (("coarse", 0.1), ("fine", 0.05), ("same", 0.05)):
+    for name, dt in (("coarse", 0.1), ("fine", 0.05), ("same", 0.05), ("finer", 0.025)):
         write_run(root / "c" / name, {"cycle": [1, 2], "time": [dt, 2 * dt],
                                       "Q": [0.0, 1 + 3 * dt * dt]}, dt=dt)
     write_run(root / "c" / "nodt", {"cycle": [1], "time": [1], "Q": [1.0]}, dt=None)
@@ -109,10 +109,14 @@ def order_value(store, expr):
 def test_order_of_a_second_order_error(orders):
     assert order_value(orders, "order('last(Q)', 1, 'coarse', 'fine')") == pytest.approx(2, abs=1e-9)
     assert order_value(orders, "of('coarse', 'last(Q)')") == pytest.approx(1.03)
+    three = "order('last(Q)', 1, 'coarse', 'fine', 'finer')"
+    assert order_value(orders, three) == pytest.approx(2, abs=1e-9)
+    assert order_value(orders, "order('last(Q)', 1 - 1e-3, 'coarse', 'fine', 'finer')") < 2
 
 
 @pytest.mark.parametrize("expr, message", [
     ("order('last(Q)', 1, 'fine', 'same')", "same dt"),
+    ("order('last(Q)', 1, 'fine')", "at least two"),
     ("order('last(Q)', 1.03, 'coarse', 'fine')", "an error is zero"),
     ("order('last(Q)', 1, 'coarse', 'nodt')", "no positive dt"),
     ("order('last(Q)', 1, 'coarse', 'missing')", "variant 'missing'"),

@@ -8,7 +8,8 @@ number of rows between upward crossings of the mean, and settle(col, target, tol
 the cycle from which a column stays within tol of target; and the pile functions of
 piles.py (pile_X, pile_S, middle, horizontal_contacts, contact_error, contact_mismatch,
 weight), which read the run's final state (discs.tsv, contacts.tsv, stress.tsv) when
-called.  evaluate_check() turns one Check into a Verdict; anything that goes wrong
+called; and the collision and order functions of the block at the end (contact_start,
+contact_end, contact_duration, restitution, sine_period, sine_amplitude, of, order).  evaluate_check() turns one Check into a Verdict; anything that goes wrong
 (missing output, failed run, missing column, an expression that raises, a NaN/inf
 value) is a FAIL whose message says which, never a pass and never a skip.
 """
@@ -108,6 +109,7 @@ def namespace(run, sibling=None):
     names["series"] = _series_of(sibling)
     from . import piles   # here, not at the top: piles imports EvalError from this module
     names.update(piles.functions(run, sibling))
+    names.update(_collision_functions(run, sibling))
     return names
 
 
@@ -384,3 +386,132 @@ def evaluate_check(check, store):
 def evaluate_all(checks, store):
     """Verdicts of the checks, in the order given."""
     return [evaluate_check(c, store) for c in checks]
+
+
+# ---------------------------------------------------------------- collisions and orders
+# (cases/collisions, reference/collisions.ref, reference/two_discs_order.ref)
+#
+# contact_start(gap), contact_end(gap), contact_duration(gap), restitution(gap): a binary
+# collision measured from the surface gap of two discs (a whole series column expression,
+# e.g. x_b - x_a - 1.75; negative while they overlap).  The first contact is the first run
+# of rows with gap < 0 (C&S eq. 8 is strict).  Its start and end are the zero crossings of
+# the gap, interpolated linearly between the rows that straddle them: the row outside
+# contact lies on the free-flight line, and so does the row inside (the scheme moves the
+# discs with v_{N-1/2}, C&S eq. 23, before the force acts), so the interpolation is exact
+# on the free-flight side.  restitution is -(chord after)/(chord before): the chords across
+# the crossings are the free-flight velocities v_{N+1/2} (C&S eq. 22), which the scheme
+# holds exactly in flight; the centred velocities of eq. 31 would mix a half step in
+# contact.  The straddling rows must be consecutive cycles (output_every = 1 there).
+#
+# sine_period(arr, level), sine_amplitude(arr, level): the period (in rows) and amplitude of
+# a sampled sinusoid about level, y_N = arr_N - level = A sin(N theta + phi), with sub-step
+# resolution: y_{N+1} + y_{N-1} = 2 cos(theta) y_N gives cos(theta) (least squares over all
+# rows), and y_N^2 - y_{N-1} y_{N+1} = A^2 sin^2(theta) gives A (mean over all rows).  Both
+# are exact for a pure sampled sinusoid, whatever the phase of the samples.
+# of(variant, expr): the value of expr in another variant of the same case.
+# order(expr, exact, v1, v2, ...): the observed order of accuracy; for two variants
+# p = log(|q_1 - exact| / |q_2 - exact|) / log(dt_1 / dt_2), q = expr in each variant, dt
+# from each run.json; for more, the least-squares slope of log|q - exact| on log dt.
+
+def _collision_functions(run, sibling):
+    cycle, time = run.columns["cycle"], run.columns["time"]
+
+    def crossings(gap, fname):
+        gap = np.asarray(gap, dtype=float)
+        if gap.shape != cycle.shape:
+            raise EvalError(f"{fname}(): argument must be a whole series column expression")
+        inside = np.flatnonzero(gap < 0)
+        if inside.size == 0:
+            raise EvalError(f"{fname}(): the gap never becomes negative (no contact)")
+        s = inside[0]
+        after = np.flatnonzero(gap[s:] >= 0)
+        if s == 0 or after.size == 0:
+            raise EvalError(f"{fname}(): the contact must start and end inside the series")
+        e = s + after[0] - 1               # last row of the first contact
+        for a in (s - 1, e):
+            if cycle[a + 1] - cycle[a] != 1:
+                raise EvalError(f"{fname}(): rows {cycle[a]:g} and {cycle[a + 1]:g} are not "
+                                "consecutive cycles (set output_every = 1)")
+        return gap, s, e
+
+    def cross_time(gap, a):
+        """Time where the line through rows a and a + 1 crosses gap = 0."""
+        return float(time[a] + (time[a + 1] - time[a]) * gap[a] / (gap[a] - gap[a + 1]))
+
+    def chord(gap, a):
+        return float((gap[a + 1] - gap[a]) / (time[a + 1] - time[a]))
+
+    def contact_start(gap):
+        gap, s, _ = crossings(gap, "contact_start")
+        return cross_time(gap, s - 1)
+
+    def contact_end(gap):
+        gap, _, e = crossings(gap, "contact_end")
+        return cross_time(gap, e)
+
+    def contact_duration(gap):
+        gap, s, e = crossings(gap, "contact_duration")
+        return cross_time(gap, e) - cross_time(gap, s - 1)
+
+    def restitution(gap):
+        gap, s, e = crossings(gap, "restitution")
+        return -chord(gap, e) / chord(gap, s - 1)
+
+    def other(variant, fname):
+        if sibling is None:
+            raise EvalError(f"{fname}(): no other variants are available here")
+        try:
+            return sibling(variant)
+        except RunProblem as problem:
+            raise EvalError(f"{fname}(): variant '{variant}': {problem}") from None
+
+    def of(variant, expr):
+        try:
+            return evaluate(expr, other(variant, "of"), sibling)
+        except EvalError as exc:
+            raise EvalError(f"of(): variant '{variant}': {exc}") from None
+
+    def order(expr, exact, *variants):
+        if len(variants) < 2:
+            raise EvalError("order(): needs at least two variants")
+        errors, steps = [], []
+        for variant in variants:
+            errors.append(abs(of(variant, expr) - exact))
+            dt = other(variant, "order").info.get("dt")
+            if not isinstance(dt, (int, float)) or not dt > 0:
+                raise EvalError(f"order(): variant '{variant}': run.json has no positive dt")
+            steps.append(float(dt))
+        if len(set(steps)) < len(steps):
+            raise EvalError(f"order(): two of {', '.join(variants)} have the same dt")
+        if not all(e > 0 for e in errors):
+            raise EvalError(f"order(): an error is zero ({', '.join(f'{e:g}' for e in errors)}): "
+                            "no order can be observed")
+        # Two variants: the pairwise order; more: the least-squares slope of log e on log dt.
+        return float(np.polyfit(np.log(steps), np.log(errors), 1)[0])
+
+    def sine_theta(arr, level, fname):
+        y = np.atleast_1d(np.asarray(arr, dtype=float)) - level
+        if y.size < 3:
+            raise EvalError(f"{fname}(): needs at least three rows")
+        mid = y[1:-1]
+        denom = 2 * np.dot(mid, mid)
+        if not denom > 0:
+            raise EvalError(f"{fname}(): the signal equals the level")
+        cos_theta = np.dot(mid, y[2:] + y[:-2]) / denom
+        if not -1 < cos_theta < 1:
+            raise EvalError(f"{fname}(): not a sampled sinusoid (cos theta = {cos_theta:g})")
+        return y, math.acos(cos_theta)
+
+    def sine_period(arr, level):
+        _, theta = sine_theta(arr, level, "sine_period")
+        return 2 * math.pi / theta
+
+    def sine_amplitude(arr, level):
+        y, theta = sine_theta(arr, level, "sine_amplitude")
+        a2 = np.mean(y[1:-1] ** 2 - y[:-2] * y[2:])
+        return math.sqrt(max(a2, 0.0)) / math.sin(theta)
+
+    return {"contact_start": contact_start, "contact_end": contact_end,
+            "sine_period": sine_period, "sine_amplitude": sine_amplitude,
+            "contact_duration": contact_duration, "restitution": restitution,
+            "of": of, "order": order}

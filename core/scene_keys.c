@@ -62,6 +62,10 @@ const struct bal_key bal_scene_keys[] = {
      "height of a stress cell; 0 = the width"},
     {BAL_SEC_SETTINGS, "stress_step", BAL_KEY_DOUBLE, S(stress_step), "0", 0, 0, BIG, NULL,
      "horizontal step between overlapping stress cells; 0 = the width"},
+    {BAL_SEC_SETTINGS, "integrator", BAL_KEY_ENUM, S(integrator), "centred", 0, 0, 0,
+     "centred verlet gear5",
+     "law of motion: centred (C&S eqs 22-23, 35-36), verlet (velocity Verlet), gear5 (Gear "
+     "predictor-corrector, MLH Sec. 5.3)"},
 
     /* [material NAME] */
     {BAL_SEC_MATERIAL, "kn", BAL_KEY_DOUBLE, M(kn), NULL, 1, 1e-300, BIG, NULL,

@@ -16,7 +16,9 @@
  *   4. motion      v_{N+1/2} from the force sums (integrate.c)
  *
  * So after cycle N the forces are those of t_N, as in the worked example of
- * Fig. 1: cycle 1 gives F_n = k_n v Δt at the walls (eq. 1).
+ * Fig. 1: cycle 1 gives F_n = k_n v Δt at the walls (eq. 1).  Steps 1 and
+ * 4 are those of the default, time-centred law of motion; settings.integrator
+ * swaps them for velocity Verlet or Gear's predictor-corrector (integrate.c).
  *
  * bal_sim_run() runs the stages of the loading protocol in order and writes
  * a series row every output_every cycles; it stops early, with a status,
@@ -86,6 +88,7 @@ void bal_sim_free(struct bal_sim *s)
     bal_pairs_free(&s->pp);
     bal_pairs_free(&s->pw);
     bal_grid_scratch_free(&s->rs);
+    bal_integrate_free(s);
     free(s);
 }
 
@@ -476,6 +479,12 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
                          s->dt);
     }
 
+    /* Law of motion (integrate.c). */
+    if (bal_integrate_setup(s, err)) {
+        bal_sim_free(s);
+        return err->code;
+    }
+
     /* Law and candidates.  Disc–disc lists carry the shear and dashpot
      * columns only when the scene needs them; wall lists always do (walls
      * are few, and one generic loop serves them). */
@@ -556,6 +565,8 @@ enum bal_status bal_sim_cycle(struct bal_sim *s, struct bal_error *err)
         const int resort = s->use_grid && s->rebuilds % BAL_REORDER_EVERY == 0;
         if ((resort ? bal_grid_reorder(s, err) : bal_grid_rebuild(s, err)) != BAL_OK)
             return err->code;
+        if (resort)
+            bal_integrate_reordered(s);
     }
     t0 = seconds_now();
     s->timers.neighbours += t0 - t1;
@@ -572,7 +583,7 @@ enum bal_status bal_sim_cycle(struct bal_sim *s, struct bal_error *err)
     /* 4. motion: v_{N+1/2} */
     bal_integrate_velocities(s);
     s->timers.velocities += seconds_now() - t0;
-    s->have_old = 1;
+    s->have_old = s->integ->staggered;
     s->step++;
     s->time += s->dt;
     return BAL_OK;
@@ -753,6 +764,8 @@ void bal_sim_memory(const struct bal_sim *s, double *disc_bytes, double *pair_by
         d += 4 * n * sizeof *s->moment;
     if (s->moment_prev)
         d += 4 * n * sizeof *s->moment_prev;
+    if (s->gear)
+        d += BAL_GEAR_COLUMNS * n * sizeof *s->gear;
     d += (double)s->grid.cells_cap * sizeof *s->grid.start;
     const struct bal_rebuild_scratch *rs = &s->rs;
     double p = list_bytes(&s->pp) + list_bytes(&s->pw);

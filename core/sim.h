@@ -120,6 +120,20 @@ struct bal_probe_ref {
     int b_wall, b;
 };
 
+/* A law of motion (integrate.c), chosen once by settings.integrator.  A
+ * cycle calls `positions` before the force evaluation and `velocities`
+ * after it; `previous` gives the velocities the contact law read in the last
+ * cycle (for recomputing dashpot forces).  `staggered`: after a cycle the
+ * stored velocities are v_{N+1/2}, so measurements at t_N average them with
+ * `previous` (C&S eq. 31); otherwise the stored velocities are v_N. */
+struct bal_integrator_type {
+    const char *name;
+    void (*positions)(struct bal_sim *s);
+    void (*velocities)(struct bal_sim *s);
+    void (*previous)(const struct bal_sim *s, int i, double *vx, double *vy, double *w);
+    int staggered;
+};
+
 struct bal_sim {
     const struct bal_scene *scene;
 
@@ -178,7 +192,14 @@ struct bal_sim {
     /* probes */
     int n_probes;
     struct bal_probe_ref *probes;
-    int have_old;                /* a cycle has run: v_{N-1/2} can be recovered */
+    int have_old;                /* a cycle has run with a staggered integrator: the
+                                  * stored velocities are v_{N+1/2}, v_{N-1/2} can be
+                                  * recovered, measurements average them (eq. 31) */
+
+    /* law of motion (integrate.c) */
+    const struct bal_integrator_type *integ;
+    double *gear;                /* gear5 only, else NULL: BAL_GEAR_COLUMNS columns of n */
+    int gear_started;            /* gear5: the start-up derivatives are set */
 
     /* where the time goes (wall-clock seconds per phase of the cycle) */
     struct bal_timers {
@@ -257,10 +278,22 @@ double bal_walls_closest(const struct bal_wall *w, double x, double y,
 double bal_walls_normal(const struct bal_wall *w, double x, double y, double *ex, double *ey);
 
 /* integrate.c */
+/* Set s->integ from the scene and reserve what it needs (gear5: its
+ * derivative columns); after the discs exist. */
+enum bal_status bal_integrate_setup(struct bal_sim *s, struct bal_error *err);
+void bal_integrate_free(struct bal_sim *s);
+/* After bal_grid_reorder: carry the integrator's per-disc columns along the
+ * permutation s->new2old. */
+void bal_integrate_reordered(struct bal_sim *s);
+/* Per-disc columns of gear5: scaled derivatives r2..r5 of x, y, θ (12), the
+ * predicted velocities the contact law read (3), one scratch column. */
+#define BAL_GEAR_COLUMNS 16
+/* The two halves of the law of motion of s->integ (one dispatch each). */
 void bal_integrate_positions(struct bal_sim *s);
 void bal_integrate_velocities(struct bal_sim *s);
-/* The velocities v_{N-1/2} of disc i before the last update, recovered from
- * v_{N+1/2} and the force sums by inverting eqs (35)-(36). */
+/* The velocities of disc i that the contact law read in the last cycle:
+ * centred and verlet v_{N-1/2} (recovered from the stored velocities and
+ * the force sums by inverting the last update), gear5 the predicted v_N. */
 void bal_integrate_previous(const struct bal_sim *s, int i, double *vx, double *vy, double *w);
 
 /* timestep.c */

@@ -83,6 +83,12 @@ enum bal_grid_mode {
     BAL_GRID_OFF = 2   /* always all pairs (built once, never rebuilt) */
 };
 
+enum bal_integrator {
+    BAL_INTEGRATOR_CENTRED = 0, /* C&S eqs (20)-(23a), (35)-(36): v at half steps */
+    BAL_INTEGRATOR_VERLET = 1,  /* velocity Verlet: x and v at whole steps */
+    BAL_INTEGRATOR_GEAR5 = 2    /* Gear's 6-value predictor-corrector (MLH Sec. 5.3) */
+};
+
 struct bal_settings {
     double dt;            /* time step; 0 = dt_fraction × estimate (default 0) */
     double dt_fraction;   /* fraction of the critical-step estimate (0.1) */
@@ -102,6 +108,7 @@ struct bal_settings {
     double stress_step;   /* horizontal step between overlapping cells (0 = the width) */
     double overlap_budget; /* stop when an overlap exceeds this share of the smaller radius (0.5; 0 = off) */
     double energy_guard;  /* stop when the run creates this share of its energy throughput (1; 0 = off) */
+    int integrator;       /* enum bal_integrator (centred) */
     BAL_SECTION_TAIL;
 };
 

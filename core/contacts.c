@@ -167,7 +167,8 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
     const int n_mat = s->n_mat;
     const struct bal_pair_law *restrict laws = s->law;
     const double budget = s->overlap_budget;
-    double lost_dash = 0, lost_fric = 0; /* energy audit (energy.c) */
+    double lost_fric = 0; /* energy audit (energy.c) */
+    float *restrict dfx = s->dash_fx, *restrict dfy = s->dash_fy, *restrict dtq = s->dash_tq;
     int over = 0;
 
     for (long c = 0; c < p->n; c++) {
@@ -200,12 +201,11 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
             fn = power_force(L->kn, delta, delta0, nu);
         }
         p->fn[c] = fn;
-        double ftn = fn, fts = 0;
+        double ftn = fn, fts = 0, dn = 0, ds = 0;
         uint8_t flags = BAL_PAIR_TOUCHING;
         if (damp) {
-            const double dn = (L->cn + viscous(s, delta)) * ndot;
+            dn = (L->cn + viscous(s, delta)) * ndot;
             ftn += dn;
-            lost_dash += dn * ndot;
         }
         if (shear && L->shear) {
             const double tx = ey, ty = -ex;
@@ -221,8 +221,8 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
             p->fs[c] = fs;
             fts = fs;
             if (damp && !(flags & BAL_PAIR_SLIDING)) {
-                fts += L->cs * sdot;
-                lost_dash += L->cs * sdot * sdot;
+                ds = L->cs * sdot;
+                fts += ds;
             }
         }
         p->flags[c] = flags;
@@ -238,9 +238,19 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
             tq[i] += fts * r[i];
             tq[j] += fts * r[j];
         }
+        if (damp) {
+            /* the dashpots' share, for their work at t_N (energy.c) */
+            const float dcx = (float)(dn * ex + ds * ey), dcy = (float)(dn * ey - ds * ex);
+            dfx[i] -= dcx;
+            dfy[i] -= dcy;
+            dfx[j] += dcx;
+            dfy[j] += dcy;
+            if (shear) {
+                dtq[i] += (float)(ds * r[i]);
+                dtq[j] += (float)(ds * r[j]);
+            }
+        }
     }
-    if (damp)
-        s->audit.d_dashpot += lost_dash * dt;
     if (shear)
         s->audit.d_friction += lost_fric;
     s->over_budget |= over;
@@ -296,7 +306,7 @@ void bal_contacts_walls(struct bal_sim *s)
         struct bal_wall *W = &s->walls[k];
         W->f[0] = W->f[1] = W->moment = W->fn_sum = W->fn_s_sum = 0;
     }
-    double lost_dash = 0, lost_fric = 0;
+    double lost_fric = 0, wall_dash = 0;
     for (long c = 0; c < p->n; c++) {
         const int i = p->i[c];
         struct bal_wall *W = &s->walls[p->j[c]];
@@ -349,7 +359,14 @@ void bal_contacts_walls(struct bal_sim *s)
         }
         const double dn = (L->cn + viscous(s, ri - dist)) * ndot;
         const double ds = (!shear || (flags & BAL_PAIR_SLIDING)) ? 0.0 : L->cs * sdot;
-        lost_dash += dn * ndot + ds * sdot;
+        if (s->dash_fx) {
+            /* the dashpots' share on the disc, and their power on the wall
+             * side (its velocity is prescribed): energy.c */
+            s->dash_fx[i] -= (float)(dn * ex + ds * tx);
+            s->dash_fy[i] -= (float)(dn * ey + ds * ty);
+            s->dash_tq[i] += (float)(ds * ri);
+            wall_dash += dn * (wvx * ex + wvy * ey) + ds * (wvx * tx + wvy * ty);
+        }
         p->fn[c] = fn;
         p->fs[c] = fs;
         p->dn[c] = dn;
@@ -369,7 +386,7 @@ void bal_contacts_walls(struct bal_sim *s)
         W->fn_sum += ftn;
         W->fn_s_sum += ftn * along;
     }
-    s->audit.d_dashpot += lost_dash * dt;
+    s->audit.wall_dash = wall_dash;
     s->audit.d_friction += lost_fric;
 }
 

@@ -16,8 +16,9 @@
  *   W_gravity  Σ_cycles ḡ_fac m g·(x_N − x_{N−1}), ḡ_fac the mean of the
  *              factors at t_{N−1} and t_N; summed per interval of constant
  *              g_fac as g_fac m g·Δ(centre of mass)
- *   D_dashpot  Σ_cycles (D_n ṅ + D_s ṡ) Δt (C&S eqs 26–28, MLH eq. 3), in the
- *              contact loops
+ *   D_dashpot  Σ_cycles (D_n ṅ_N + D_s ṡ_N) Δt (C&S eqs 26–28, MLH eq. 3):
+ *              the work of the dashpot forces on the motion at t_N, from
+ *              their per-disc sums; first and latest cycle count half
  *   D_friction Σ_cycles F_max |slip|, slip = (|F_s trial| − F_max)/k_s, where
  *              the Coulomb limit (eq. 19) cuts the shear force
  *   D_global   Σ_cycles α (m v_N² + I ω_N²) Δt: eqs (35)–(36) are
@@ -48,6 +49,7 @@ static double gravity_potential(const struct bal_sim *s)
 }
 
 static double global_loss(const struct bal_sim *s);
+static double dashpot_loss(const struct bal_sim *s);
 
 void bal_energy_begin(struct bal_sim *s)
 {
@@ -62,6 +64,8 @@ void bal_energy_begin(struct bal_sim *s)
     a->gfac_last = s->gfac;
     if (s->alpha != 0)
         a->d_global = 0.5 * global_loss(s);
+    if (s->dash_fx)
+        a->d_dashpot = 0.5 * dashpot_loss(s);
     for (int k = 0; k < s->n_walls; k++) {
         struct bal_wall *W = &s->walls[k];
         W->f_prev[0] = W->f[0];
@@ -70,35 +74,32 @@ void bal_energy_begin(struct bal_sim *s)
     }
 }
 
-/* Σ m g·v_{N-1/2} of the free discs, v recovered from the force sums. */
-static double gravity_power_before(const struct bal_sim *s)
+/* g_fac changes at this cycle N (a ramp): the interval of constant g_fac
+ * ends at x_{N-1}, the positions before the cycle moves them; the step
+ * x_{N-1} -> x_N then feels the mean of the factors at its two ends (the
+ * trapezoid rule, as for the walls: E_k at t_N balances it to
+ * O(Δt² Δg_fac)).  Positions only: the same for every integrator. */
+void bal_energy_gravity_before(struct bal_sim *s)
 {
-    double p = 0;
-    for (int i = 0; i < s->n; i++) {
-        if (s->fixed[i])
-            continue;
-        double vx, vy, w;
-        bal_integrate_previous(s, i, &vx, &vy, &w);
-        p += bal_mass(s, i) * (s->g[0] * vx + s->g[1] * vy);
-    }
-    return p;
+    struct bal_audit *a = &s->audit;
+    if (!a->started || !a->gravity || s->gfac == a->gfac_last)
+        return;
+    const double before = gravity_potential(s);
+    a->w_gravity += a->gfac_last * (before - a->g_last);
+    a->g_last = before;
+    a->gravity_step = 1;
 }
 
-/* g_fac changed at this cycle N: the interval of constant g_fac ends at
- * x_{N-1}, and the step x_{N-1} -> x_N feels the mean of the factors at
- * its two ends (the trapezoid rule, as for the walls: the centred scheme's
- * kinetic energy at t_N then balances it to O(Δt² Δg_fac)). */
 void bal_energy_gravity(struct bal_sim *s)
 {
     struct bal_audit *a = &s->audit;
-    if (!a->gravity || s->gfac == a->gfac_last)
+    if (!a->gravity_step)
         return;
     const double now = gravity_potential(s);
-    const double before = now - s->dt * gravity_power_before(s);
-    a->w_gravity += a->gfac_last * (before - a->g_last) +
-                    0.5 * (a->gfac_last + s->gfac) * (now - before);
+    a->w_gravity += 0.5 * (a->gfac_last + s->gfac) * (now - a->g_last);
     a->g_last = now;
     a->gfac_last = s->gfac;
+    a->gravity_step = 0;
 }
 
 /* The walls moved from t_{N-1} to t_N with their current velocities; the
@@ -131,6 +132,31 @@ void bal_energy_global(struct bal_sim *s)
     s->audit.d_global_last = loss;
 }
 
+/* The contact dashpots' loss in this cycle: the work their forces D do on
+ * the motion at t_N, Σ_c (D_n ṅ_N + D_s ṡ_N) Δt = −Σ_i (F^D_i·v_N + M^D_i ω_N) Δt
+ * − Σ_wall contacts D·V_wall Δt.  Their forces use the velocity half a step
+ * old (C&S eqs 26–27), so the loss measured with that old velocity would
+ * differ from the work they really do by O(Δt): the audit counts the work. */
+static double dashpot_loss(const struct bal_sim *s)
+{
+    double p = 0;
+    for (int i = 0; i < s->n; i++) {
+        double vx, vy, w;
+        bal_measure_velocity(s, i, &vx, &vy, &w);
+        p += (double)s->dash_fx[i] * vx + (double)s->dash_fy[i] * vy + (double)s->dash_tq[i] * w;
+    }
+    return -(p + s->audit.wall_dash) * s->dt;
+}
+
+void bal_energy_dashpots(struct bal_sim *s)
+{
+    if (!s->dash_fx)
+        return;
+    const double loss = dashpot_loss(s);
+    s->audit.d_dashpot += loss;
+    s->audit.d_dashpot_last = loss;
+}
+
 static double global_loss(const struct bal_sim *s)
 {
     double d = 0;
@@ -138,10 +164,7 @@ static double global_loss(const struct bal_sim *s)
         if (s->fixed[i])
             continue;
         double vx, vy, w;
-        bal_integrate_previous(s, i, &vx, &vy, &w);
-        vx = 0.5 * (vx + s->vx[i]);
-        vy = 0.5 * (vy + s->vy[i]);
-        w = 0.5 * (w + s->w[i]);
+        bal_measure_velocity(s, i, &vx, &vy, &w); /* v_N, whatever the integrator */
         d += bal_mass(s, i) * (vx * vx + vy * vy) + bal_inertia(s, i) * w * w;
     }
     return s->alpha * d * s->dt;
@@ -163,7 +186,7 @@ void bal_energy_report(const struct bal_sim *s, struct bal_energy *e)
     e->work_gravity = a->w_gravity;
     if (a->gravity)
         e->work_gravity += a->gfac_last * (gravity_potential(s) - a->g_last);
-    e->dissipated_dashpot = a->d_dashpot;
+    e->dissipated_dashpot = a->d_dashpot - 0.5 * a->d_dashpot_last;
     e->dissipated_friction = a->d_friction;
     e->dissipated_global = a->d_global - 0.5 * a->d_global_last;
     e->imbalance = e->work_walls + e->work_gravity -

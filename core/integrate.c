@@ -1,48 +1,90 @@
 /*
- * integrate.c — the time-centred scheme of Cundall & Strack, eqs (20)–(23a)
- * with global damping in the form of eqs (35)–(36).
+ * integrate.c — the law of motion, three ways, chosen per scene by
+ * settings.integrator.  Each is a `struct bal_integrator_type` of two
+ * halves: `positions` runs before the force evaluation of a cycle and
+ * `velocities` after it (sim.c, bal_sim_cycle).  Forces include the body
+ * force m g scaled by the gravity ramp of the current stage (text after
+ * C&S eq. 23a) and global damping C = α m, C* = α I (eq. 34), i.e. an
+ * acceleration −α v, −α ω.  Held discs keep zero velocity and never move.
  *
- * Velocities live at half steps and positions at whole steps:
+ * centred (default) — the time-centred scheme of Cundall & Strack, eqs
+ * (20)–(23a) with global damping in the form of eqs (35)–(36).  Velocities
+ * live at half steps and positions at whole steps:
  *
  *   v_{N+1/2} = { v_{N−1/2} (1 − α Δt/2) + (ΣF_N/m + g) Δt } / (1 + α Δt/2)
  *   ω_{N+1/2} = { ω_{N−1/2} (1 − α Δt/2) + (ΣM_N/I) Δt } / (1 + α Δt/2)
  *   x_{N+1}   = x_N + v_{N+1/2} Δt,   θ_{N+1} = θ_N + ω_{N+1/2} Δt
  *
- * The body force m g is added to the force sum (text after eq. 23a),
- * scaled by the gravity ramp of the current stage; with
- * C = α m and C* = α I (eq. 34) the mass cancels.  With α = 0 the update is
- * eqs (22)–(23) exactly.  Held discs keep zero velocity.
- *
- * The position update also tracks how far any disc has moved since the
- * neighbour list was built, which decides when it is rebuilt (grid.c).
- *
- * Measurements want velocities at t_N, (v_{N-1/2} + v_{N+1/2})/2 (eq. 31);
- * rather than keep a copy of v_{N-1/2} (24 bytes a disc),
+ * With α = 0 the update is eqs (22)–(23) exactly.  The initial velocities
+ * of a scene are taken as v_{1/2}.  The contact law of cycle N reads
+ * v_{N−1/2}.  Measurements want velocities at t_N, (v_{N−1/2} + v_{N+1/2})/2
+ * (eq. 31); rather than keep a copy of v_{N−1/2} (24 bytes a disc),
  * bal_integrate_previous() recovers it from v_{N+1/2} and the force sums,
  * which stay in place until the next cycle.
+ *
+ * verlet — velocity Verlet, positions and velocities at whole steps.  With
+ * A = ΣF/m + g and h = α Δt/2, cycle N is
+ *
+ *   positions:  v_{N−1/2} = v_{N−1} (1 − h) + A_{N−1} Δt/2   (first half kick)
+ *               x_N       = x_{N−1} + v_{N−1/2} Δt
+ *   forces at t_N from x_N and v_{N−1/2}
+ *   velocities: v_N = (v_{N−1/2} + A_N Δt/2) / (1 + h)      (second half kick)
+ *
+ * The damping force −α m v is taken at the whole step v_N: explicitly in
+ * the first half kick, implicitly (hence the division) in the second.  The
+ * contact law reads v_{N−1/2} = v_{N−1} + a_{N−1} Δt/2, the velocity of the
+ * first half kick (as LAMMPS' fix nve does): it is the exact mean velocity
+ * over [t_{N−1}, t_N], so the incremental springs (F_n += k_n ṅ Δt,
+ * F_s += k_s ṡ Δt) integrate the displacement increment to second order;
+ * the dashpots see a velocity half a step old, as in the centred scheme.
+ * The scene's initial velocities are v_0, the initial force sums zero (so
+ * a_0 = g − α v_0: exact for discs that start apart).  Written out, the two
+ * half kicks compose to eq. (35) and v_N = (v_{N−1/2} + v_{N+1/2})/2 is
+ * eq. (31): the positions, the contact forces and the measured velocities
+ * are those of the centred scheme in exact arithmetic; what differs is the
+ * start (v_0 instead of v_{1/2}), the rounding, and that the stored
+ * velocities are v_N.  A gravity ramp uses, in each half kick, the share
+ * of the cycle in which the kick is taken.
+ *
+ * gear5 — Gear's predictor-corrector for second-order equations with six
+ * values (x and its first five derivatives; Gear 1971, "Numerical initial
+ * value problems in ordinary differential equations", Sec. 9.2; Allen &
+ * Tildesley 1987, "Computer simulation of liquids", App. E, Table E.2),
+ * the "fifth order Gear predictor-corrector" of MLH Sec. 5.3.  With scaled
+ * derivatives r_k = x^(k) Δt^k / k! the predictor is the Taylor (Pascal)
+ * step r_j ← Σ_{k≥j} C(k, j) r_k; the forces are evaluated at the
+ * predicted x_N and v_N; the corrector adds c_k Δ to each r_k, where
+ * Δ = a_N Δt²/2 − r_2^pred and
+ *   c = (3/16, 251/360, 1, 11/18, 1/6, 1/60).
+ * c_0 = 3/16 is Gear's value when the forces depend on the velocity (the
+ * dashpots do; 3/20 for forces of the positions only).  Damping −α v and
+ * the dashpots use the predicted v_N; so do the incremental springs, which
+ * therefore integrate the displacement with an O(Δt) lag (first order).
+ * Start: r_2 = (g − α v_0) Δt²/2 and r_3..r_5 = 0 on the first cycle
+ * (exact for discs that start apart).  The forces are those of the
+ * predicted positions; the stored positions and velocities after a cycle
+ * are the corrected ones.  The derivative columns exist only for gear5.
+ *
+ * The position updates also track how far any disc has moved since the
+ * neighbour list was built, which decides when it is rebuilt (grid.c).
  */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "sim.h"
 
-void bal_integrate_positions(struct bal_sim *s)
+/* After the positions moved: walls move; decide whether to rebuild. */
+static void moved(struct bal_sim *s)
 {
-    const double dt = s->dt;
-    const int n = s->n;
-    double *restrict x = s->x, *restrict y = s->y, *restrict th = s->th;
-    const double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
-    for (int i = 0; i < n; i++) {
-        x[i] += vx[i] * dt;
-        y[i] += vy[i] * dt;
-        th[i] += w[i] * dt;
-    }
     bal_walls_move(s);
     if (!s->use_grid)
         return;
 
     /* Rebuild when two discs may have closed the skin between them, or a
      * disc and a wall. */
+    const int n = s->n;
+    const double *restrict x = s->x, *restrict y = s->y;
     const double *restrict xr = s->x_ref, *restrict yr = s->y_ref;
     double d2max = 0;
     for (int i = 0; i < n; i++) {
@@ -58,7 +100,25 @@ void bal_integrate_positions(struct bal_sim *s)
         s->need_rebuild = 1;
 }
 
-void bal_integrate_previous(const struct bal_sim *s, int i, double *vx, double *vy, double *w)
+/* ------------------------------------------------------------------ */
+/* centred: C&S eqs (22)-(23a), (35)-(36)                              */
+/* ------------------------------------------------------------------ */
+
+static void centred_positions(struct bal_sim *s)
+{
+    const double dt = s->dt;
+    const int n = s->n;
+    double *restrict x = s->x, *restrict y = s->y, *restrict th = s->th;
+    const double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
+    for (int i = 0; i < n; i++) {
+        x[i] += vx[i] * dt;
+        y[i] += vy[i] * dt;
+        th[i] += w[i] * dt;
+    }
+    moved(s);
+}
+
+static void centred_previous(const struct bal_sim *s, int i, double *vx, double *vy, double *w)
 {
     if (s->fixed[i]) {
         *vx = *vy = *w = 0;
@@ -79,7 +139,7 @@ void bal_integrate_previous(const struct bal_sim *s, int i, double *vx, double *
     *w = (s->w[i] * (1 + half) - aw) / (1 - half);
 }
 
-void bal_integrate_velocities(struct bal_sim *s)
+static void centred_velocities(struct bal_sim *s)
 {
     const int n = s->n;
     const double dt = s->dt;
@@ -106,5 +166,235 @@ void bal_integrate_velocities(struct bal_sim *s)
         vx[i] = (vx[i] * keep + fx[i] * im[i] * dt + gxdt) * scale;
         vy[i] = (vy[i] * keep + fy[i] * im[i] * dt + gydt) * scale;
         w[i] = (w[i] * keep + tq[i] * ii[i] * dt) * scale;
+    }
+}
+
+/* ------------------------------------------------------------------ */
+/* verlet: velocity Verlet, damping at whole steps                     */
+/* ------------------------------------------------------------------ */
+
+/* First half kick with the force sums of the last cycle, then the drift. */
+static void verlet_positions(struct bal_sim *s)
+{
+    const int n = s->n;
+    const double dt = s->dt, hdt = dt / 2;
+    const double keep = 1 - s->alpha * dt / 2;
+    const double gx = s->g[0] * s->gfac, gy = s->g[1] * s->gfac;
+    double *restrict x = s->x, *restrict y = s->y, *restrict th = s->th;
+    double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
+    const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict tq = s->tq;
+    const double *restrict im = s->inv_m, *restrict ii = s->inv_i;
+    const uint8_t *restrict fixed = s->fixed;
+    for (int i = 0; i < n; i++) {
+        if (fixed[i])
+            continue;
+        vx[i] = vx[i] * keep + (fx[i] * im[i] + gx) * hdt;
+        vy[i] = vy[i] * keep + (fy[i] * im[i] + gy) * hdt;
+        w[i] = w[i] * keep + tq[i] * ii[i] * hdt;
+        x[i] += vx[i] * dt;
+        y[i] += vy[i] * dt;
+        th[i] += w[i] * dt;
+    }
+    moved(s);
+}
+
+/* Second half kick with the force sums of this cycle. */
+static void verlet_velocities(struct bal_sim *s)
+{
+    const int n = s->n;
+    const double hdt = s->dt / 2;
+    const double scale = 1 / (1 + s->alpha * s->dt / 2);
+    const double gx = s->g[0] * s->gfac, gy = s->g[1] * s->gfac;
+    double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
+    const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict tq = s->tq;
+    const double *restrict im = s->inv_m, *restrict ii = s->inv_i;
+    const uint8_t *restrict fixed = s->fixed;
+    for (int i = 0; i < n; i++) {
+        if (fixed[i])
+            continue;
+        vx[i] = (vx[i] + (fx[i] * im[i] + gx) * hdt) * scale;
+        vy[i] = (vy[i] + (fy[i] * im[i] + gy) * hdt) * scale;
+        w[i] = (w[i] + tq[i] * ii[i] * hdt) * scale;
+    }
+}
+
+/* v_{N-1/2}, by inverting the second half kick. */
+static void verlet_previous(const struct bal_sim *s, int i, double *vx, double *vy, double *w)
+{
+    if (s->fixed[i]) {
+        *vx = *vy = *w = 0;
+        return;
+    }
+    const double hdt = s->dt / 2, undo = 1 + s->alpha * s->dt / 2;
+    *vx = s->vx[i] * undo - (s->fx[i] * s->inv_m[i] + s->g[0] * s->gfac) * hdt;
+    *vy = s->vy[i] * undo - (s->fy[i] * s->inv_m[i] + s->g[1] * s->gfac) * hdt;
+    *w = s->w[i] * undo - s->tq[i] * s->inv_i[i] * hdt;
+}
+
+/* ------------------------------------------------------------------ */
+/* gear5: Gear's six-value predictor-corrector                         */
+/* ------------------------------------------------------------------ */
+
+/* Column offsets (in units of n) into s->gear: r2..r5 of x, y, θ; the
+ * predicted velocities; scratch. */
+enum { GEAR_R2 = 0, GEAR_R3 = 3, GEAR_R4 = 6, GEAR_R5 = 9, GEAR_VP = 12, GEAR_SCRATCH = 15 };
+
+/* Corrector coefficients for second-order equations, six values, forces
+ * that depend on the velocity (Allen & Tildesley 1987, Table E.2). */
+#define GEAR_C0 (3.0 / 16.0)
+#define GEAR_C1 (251.0 / 360.0)
+#define GEAR_C3 (11.0 / 18.0)
+#define GEAR_C4 (1.0 / 6.0)
+#define GEAR_C5 (1.0 / 60.0)
+
+static inline double *gear_col(const struct bal_sim *s, int c)
+{
+    return s->gear + (size_t)c * (size_t)s->n;
+}
+
+/* The Taylor step of one coordinate q with velocity v and scaled
+ * derivatives r2..r5 (each line uses only values not yet advanced). */
+static inline void gear_predict(double *q, double *v, double *r2, double *r3, double *r4,
+                                double *r5, double dt, double inv_dt)
+{
+    *q += *v * dt + *r2 + *r3 + *r4 + *r5;
+    *v += (2 * *r2 + 3 * *r3 + 4 * *r4 + 5 * *r5) * inv_dt;
+    *r2 += 3 * *r3 + 6 * *r4 + 10 * *r5;
+    *r3 += 4 * *r4 + 10 * *r5;
+    *r4 += 5 * *r5;
+}
+
+static inline void gear_correct(double *q, double *v, double *r2, double *r3, double *r4,
+                                double *r5, double acc, double half_dt2, double inv_dt)
+{
+    const double d = acc * half_dt2 - *r2;
+    *q += GEAR_C0 * d;
+    *v += GEAR_C1 * d * inv_dt;
+    *r2 += d;
+    *r3 += GEAR_C3 * d;
+    *r4 += GEAR_C4 * d;
+    *r5 += GEAR_C5 * d;
+}
+
+/* Start-up: a_0 without contact forces, higher derivatives zero. */
+static void gear_start(struct bal_sim *s)
+{
+    const double half_dt2 = s->dt * s->dt / 2;
+    double *r2x = gear_col(s, GEAR_R2), *r2y = gear_col(s, GEAR_R2 + 1);
+    double *r2t = gear_col(s, GEAR_R2 + 2);
+    for (int i = 0; i < s->n; i++) {
+        if (s->fixed[i])
+            continue;
+        r2x[i] = (s->g[0] * s->gfac - s->alpha * s->vx[i]) * half_dt2;
+        r2y[i] = (s->g[1] * s->gfac - s->alpha * s->vy[i]) * half_dt2;
+        r2t[i] = -s->alpha * s->w[i] * half_dt2;
+    }
+    s->gear_started = 1;
+}
+
+static void gear_positions(struct bal_sim *s)
+{
+    if (!s->gear_started)
+        gear_start(s);
+    const int n = s->n;
+    const double dt = s->dt, inv_dt = 1 / s->dt;
+    double *q[3] = {s->x, s->y, s->th}, *v[3] = {s->vx, s->vy, s->w};
+    for (int k = 0; k < 3; k++) {
+        double *restrict qk = q[k], *restrict vk = v[k];
+        double *restrict r2 = gear_col(s, GEAR_R2 + k), *restrict r3 = gear_col(s, GEAR_R3 + k);
+        double *restrict r4 = gear_col(s, GEAR_R4 + k), *restrict r5 = gear_col(s, GEAR_R5 + k);
+        double *restrict vp = gear_col(s, GEAR_VP + k);
+        const uint8_t *restrict fixed = s->fixed;
+        for (int i = 0; i < n; i++) {
+            if (fixed[i])
+                continue;
+            gear_predict(&qk[i], &vk[i], &r2[i], &r3[i], &r4[i], &r5[i], dt, inv_dt);
+            vp[i] = vk[i];
+        }
+    }
+    moved(s);
+}
+
+static void gear_velocities(struct bal_sim *s)
+{
+    const int n = s->n;
+    const double half_dt2 = s->dt * s->dt / 2, inv_dt = 1 / s->dt, alpha = s->alpha;
+    double *q[3] = {s->x, s->y, s->th}, *v[3] = {s->vx, s->vy, s->w};
+    const double *f[3] = {s->fx, s->fy, s->tq}, *inv[3] = {s->inv_m, s->inv_m, s->inv_i};
+    const double g[3] = {s->g[0] * s->gfac, s->g[1] * s->gfac, 0};
+    for (int k = 0; k < 3; k++) {
+        double *restrict qk = q[k], *restrict vk = v[k];
+        double *restrict r2 = gear_col(s, GEAR_R2 + k), *restrict r3 = gear_col(s, GEAR_R3 + k);
+        double *restrict r4 = gear_col(s, GEAR_R4 + k), *restrict r5 = gear_col(s, GEAR_R5 + k);
+        const double *restrict fk = f[k], *restrict ik = inv[k];
+        const uint8_t *restrict fixed = s->fixed;
+        const double gk = g[k];
+        for (int i = 0; i < n; i++) {
+            if (fixed[i])
+                continue;
+            const double acc = fk[i] * ik[i] + gk - alpha * vk[i];
+            gear_correct(&qk[i], &vk[i], &r2[i], &r3[i], &r4[i], &r5[i], acc, half_dt2, inv_dt);
+        }
+    }
+}
+
+static void gear_previous(const struct bal_sim *s, int i, double *vx, double *vy, double *w)
+{
+    *vx = gear_col(s, GEAR_VP)[i];
+    *vy = gear_col(s, GEAR_VP + 1)[i];
+    *w = gear_col(s, GEAR_VP + 2)[i];
+}
+
+/* ------------------------------------------------------------------ */
+/* The table, the dispatch and the life cycle                          */
+/* ------------------------------------------------------------------ */
+
+static const struct bal_integrator_type integrators[] = {
+    [BAL_INTEGRATOR_CENTRED] = {"centred", centred_positions, centred_velocities,
+                                centred_previous, 1},
+    [BAL_INTEGRATOR_VERLET] = {"verlet", verlet_positions, verlet_velocities, verlet_previous, 0},
+    [BAL_INTEGRATOR_GEAR5] = {"gear5", gear_positions, gear_velocities, gear_previous, 0},
+};
+
+void bal_integrate_positions(struct bal_sim *s) { s->integ->positions(s); }
+
+void bal_integrate_velocities(struct bal_sim *s) { s->integ->velocities(s); }
+
+void bal_integrate_previous(const struct bal_sim *s, int i, double *vx, double *vy, double *w)
+{
+    s->integ->previous(s, i, vx, vy, w);
+}
+
+enum bal_status bal_integrate_setup(struct bal_sim *s, struct bal_error *err)
+{
+    const int which = s->scene->settings.integrator;
+    s->integ = &integrators[which >= 0 && which <= BAL_INTEGRATOR_GEAR5 ? which : 0];
+    if (which != BAL_INTEGRATOR_GEAR5)
+        return BAL_OK;
+    const size_t n = (size_t)(s->n ? s->n : 1);
+    s->gear = calloc(BAL_GEAR_COLUMNS * n, sizeof *s->gear);
+    if (!s->gear)
+        return bal_error(err, BAL_ENOMEM, "%s: out of memory for gear5 (%d discs)",
+                         s->scene->path, s->n);
+    return BAL_OK;
+}
+
+void bal_integrate_free(struct bal_sim *s)
+{
+    free(s->gear);
+    s->gear = NULL;
+}
+
+void bal_integrate_reordered(struct bal_sim *s)
+{
+    if (!s->gear || s->n < 2)
+        return;
+    const int n = s->n;
+    double *restrict t = gear_col(s, GEAR_SCRATCH);
+    for (int c = 0; c < GEAR_SCRATCH; c++) {
+        double *restrict a = gear_col(s, c);
+        for (int i = 0; i < n; i++)
+            t[i] = a[s->new2old[i]];
+        memcpy(a, t, (size_t)n * sizeof *a);
     }
 }

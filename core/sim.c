@@ -16,7 +16,9 @@
  *   4. motion      v_{N+1/2} from the force sums (integrate.c)
  *
  * So after cycle N the forces are those of t_N, as in the worked example of
- * Fig. 1: cycle 1 gives F_n = k_n v Δt at the walls (eq. 1).
+ * Fig. 1: cycle 1 gives F_n = k_n v Δt at the walls (eq. 1).  Steps 1 and
+ * 4 are those of the default, time-centred law of motion; settings.integrator
+ * swaps them for velocity Verlet or Gear's predictor-corrector (integrate.c).
  *
  * bal_sim_run() runs the stages of the loading protocol in order and writes
  * a series row every output_every cycles; it stops early, with a status,
@@ -72,6 +74,9 @@ void bal_sim_free(struct bal_sim *s)
                          &s->inv_m, &s->inv_i, &s->fx, &s->fy, &s->tq, &s->x_ref, &s->y_ref};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(*arrays[k]);
+    free(s->dash_fx);
+    free(s->dash_fy);
+    free(s->dash_tq);
     free(s->density);
     free(s->id);
     free(s->slot);
@@ -89,6 +94,7 @@ void bal_sim_free(struct bal_sim *s)
     bal_pairs_free(&s->pp);
     bal_pairs_free(&s->pw);
     bal_grid_scratch_free(&s->rs);
+    bal_integrate_free(s);
     free(s);
 }
 
@@ -415,6 +421,13 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
                          &s->inv_m, &s->inv_i, &s->fx, &s->fy, &s->tq, &s->x_ref, &s->y_ref};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         *arrays[k] = alloc_doubles((size_t)n, &ok);
+    if (s->has_damping) {
+        const size_t nf = (size_t)(n ? n : 1);
+        s->dash_fx = calloc(nf, sizeof *s->dash_fx);
+        s->dash_fy = calloc(nf, sizeof *s->dash_fy);
+        s->dash_tq = calloc(nf, sizeof *s->dash_tq);
+        ok = ok && s->dash_fx && s->dash_fy && s->dash_tq;
+    }
     s->density = alloc_doubles((size_t)s->n_mat, &ok);
     for (int m = 0; ok && m < s->n_mat; m++)
         s->density[m] = sc->materials[m].density;
@@ -478,6 +491,12 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         bal_sim_free(s);
         return bal_error(err, BAL_EINVAL, "%s: time step %g is not a positive number", sc->path,
                          s->dt);
+    }
+
+    /* Law of motion (integrate.c). */
+    if (bal_integrate_setup(s, err)) {
+        bal_sim_free(s);
+        return err->code;
     }
 
     /* Law and candidates.  Disc–disc lists carry the shear and dashpot
@@ -551,6 +570,7 @@ enum bal_status bal_sim_cycle(struct bal_sim *s, struct bal_error *err)
     /* Each phase is timed (five clock reads a cycle, ~0.1 us: negligible
      * beside a cycle of any scene worth timing). */
     double t0 = seconds_now(), t1;
+    bal_energy_gravity_before(s);
     /* 1. positions x_N from v_{N-1/2}; walls move */
     bal_integrate_positions(s);
     t1 = seconds_now();
@@ -560,6 +580,8 @@ enum bal_status bal_sim_cycle(struct bal_sim *s, struct bal_error *err)
         const int resort = s->use_grid && s->rebuilds % BAL_REORDER_EVERY == 0;
         if ((resort ? bal_grid_reorder(s, err) : bal_grid_rebuild(s, err)) != BAL_OK)
             return err->code;
+        if (resort)
+            bal_integrate_reordered(s);
     }
     t0 = seconds_now();
     s->timers.neighbours += t0 - t1;
@@ -567,6 +589,11 @@ enum bal_status bal_sim_cycle(struct bal_sim *s, struct bal_error *err)
     memset(s->fx, 0, (size_t)s->n * sizeof *s->fx);
     memset(s->fy, 0, (size_t)s->n * sizeof *s->fy);
     memset(s->tq, 0, (size_t)s->n * sizeof *s->tq);
+    if (s->dash_fx) {
+        memset(s->dash_fx, 0, (size_t)s->n * sizeof *s->dash_fx);
+        memset(s->dash_fy, 0, (size_t)s->n * sizeof *s->dash_fy);
+        memset(s->dash_tq, 0, (size_t)s->n * sizeof *s->dash_tq);
+    }
     s->pair_loop(s);
     t1 = seconds_now();
     s->timers.contacts += t1 - t0;
@@ -577,7 +604,7 @@ enum bal_status bal_sim_cycle(struct bal_sim *s, struct bal_error *err)
     /* 4. motion: v_{N+1/2} */
     bal_integrate_velocities(s);
     s->timers.velocities += seconds_now() - t0;
-    s->have_old = 1;
+    s->have_old = s->integ->staggered;
     s->step++;
     s->time += s->dt;
     /* 5. the energy audit starts at the first cycle, the first time forces
@@ -586,6 +613,7 @@ enum bal_status bal_sim_cycle(struct bal_sim *s, struct bal_error *err)
         bal_energy_begin(s);
     } else {
         bal_energy_global(s);
+        bal_energy_dashpots(s);
         bal_energy_gravity(s);
     }
     if (s->over_budget)
@@ -772,6 +800,10 @@ void bal_sim_memory(const struct bal_sim *s, double *disc_bytes, double *pair_by
         d += 4 * n * sizeof *s->moment;
     if (s->moment_prev)
         d += 4 * n * sizeof *s->moment_prev;
+    if (s->gear)
+        d += BAL_GEAR_COLUMNS * n * sizeof *s->gear;
+    if (s->dash_fx)
+        d += 3 * n * sizeof *s->dash_fx;
     d += (double)s->grid.cells_cap * sizeof *s->grid.start;
     const struct bal_rebuild_scratch *rs = &s->rs;
     double p = list_bytes(&s->pp) + list_bytes(&s->pw);

@@ -123,7 +123,10 @@ struct bal_audit {
     double w_gravity;      /* work of gravity up to the last change of g_fac */
     double g_last;         /* Σ m g·x of the free discs at the last change of g_fac */
     double gfac_last;      /* g_fac since then */
+    int gravity_step;      /* this cycle changes g_fac: close it after the update */
     double d_dashpot;      /* dissipated by contact dashpots (disc pairs and walls) */
+    double d_dashpot_last; /* ... in the latest cycle */
+    double wall_dash;      /* Σ D·v_wall of the wall contacts' dashpots in this cycle */
     double d_friction;     /* dissipated by sliding at the Coulomb limit */
     double d_global;       /* dissipated by global damping */
     double d_global_last;  /* ... in the latest cycle */
@@ -137,6 +140,20 @@ struct bal_probe_ref {
     int b_wall, b;
 };
 
+/* A law of motion (integrate.c), chosen once by settings.integrator.  A
+ * cycle calls `positions` before the force evaluation and `velocities`
+ * after it; `previous` gives the velocities the contact law read in the last
+ * cycle (for recomputing dashpot forces).  `staggered`: after a cycle the
+ * stored velocities are v_{N+1/2}, so measurements at t_N average them with
+ * `previous` (C&S eq. 31); otherwise the stored velocities are v_N. */
+struct bal_integrator_type {
+    const char *name;
+    void (*positions)(struct bal_sim *s);
+    void (*velocities)(struct bal_sim *s);
+    void (*previous)(const struct bal_sim *s, int i, double *vx, double *vy, double *w);
+    int staggered;
+};
+
 struct bal_sim {
     const struct bal_scene *scene;
 
@@ -148,6 +165,8 @@ struct bal_sim {
     double *vx, *vy, *w;         /* velocities at t_{N-1/2} (t_{N+1/2} after a step) */
     double *r, *inv_m, *inv_i;   /* radius, 1/m, 1/I (m and I: bal_mass, bal_inertia) */
     double *fx, *fy, *tq;        /* force and moment sums of the last cycle */
+    float *dash_fx, *dash_fy, *dash_tq; /* the dashpots' part of them (only with damping:
+                                  * the energy audit; float: it needs 1e-6, not 1e-16) */
     double *x_ref, *y_ref;       /* positions at the last rebuild */
     int32_t *mat;
     uint8_t *fixed;
@@ -195,7 +214,14 @@ struct bal_sim {
     /* probes */
     int n_probes;
     struct bal_probe_ref *probes;
-    int have_old;                /* a cycle has run: v_{N-1/2} can be recovered */
+    int have_old;                /* a cycle has run with a staggered integrator: the
+                                  * stored velocities are v_{N+1/2}, v_{N-1/2} can be
+                                  * recovered, measurements average them (eq. 31) */
+
+    /* law of motion (integrate.c) */
+    const struct bal_integrator_type *integ;
+    double *gear;                /* gear5 only, else NULL: BAL_GEAR_COLUMNS columns of n */
+    int gear_started;            /* gear5: the start-up derivatives are set */
 
     /* where the time goes (wall-clock seconds per phase of the cycle) */
     struct bal_timers {
@@ -279,10 +305,22 @@ double bal_walls_closest(const struct bal_wall *w, double x, double y,
 double bal_walls_normal(const struct bal_wall *w, double x, double y, double *ex, double *ey);
 
 /* integrate.c */
+/* Set s->integ from the scene and reserve what it needs (gear5: its
+ * derivative columns); after the discs exist. */
+enum bal_status bal_integrate_setup(struct bal_sim *s, struct bal_error *err);
+void bal_integrate_free(struct bal_sim *s);
+/* After bal_grid_reorder: carry the integrator's per-disc columns along the
+ * permutation s->new2old. */
+void bal_integrate_reordered(struct bal_sim *s);
+/* Per-disc columns of gear5: scaled derivatives r2..r5 of x, y, θ (12), the
+ * predicted velocities the contact law read (3), one scratch column. */
+#define BAL_GEAR_COLUMNS 16
+/* The two halves of the law of motion of s->integ (one dispatch each). */
 void bal_integrate_positions(struct bal_sim *s);
 void bal_integrate_velocities(struct bal_sim *s);
-/* The velocities v_{N-1/2} of disc i before the last update, recovered from
- * v_{N+1/2} and the force sums by inverting eqs (35)-(36). */
+/* The velocities of disc i that the contact law read in the last cycle:
+ * centred and verlet v_{N-1/2} (recovered from the stored velocities and
+ * the force sums by inverting the last update), gear5 the predicted v_N. */
 void bal_integrate_previous(const struct bal_sim *s, int i, double *vx, double *vy, double *w);
 
 /* energy.c */
@@ -290,9 +328,13 @@ void bal_integrate_previous(const struct bal_sim *s, int i, double *vx, double *
 void bal_energy_begin(struct bal_sim *s);
 /* Add the walls' work of this cycle (after the wall loop). */
 void bal_energy_walls(struct bal_sim *s);
-/* Add global damping's loss of this cycle (after the velocity update). */
+/* Add the losses of global damping and of the contact dashpots in this
+ * cycle (after the velocity update). */
 void bal_energy_global(struct bal_sim *s);
-/* Close the interval of constant g_fac when g_fac has changed. */
+void bal_energy_dashpots(struct bal_sim *s);
+/* Around a cycle in which g_fac changes (before it moves the discs, after
+ * the velocity update): the gravity's work in intervals of constant g_fac. */
+void bal_energy_gravity_before(struct bal_sim *s);
 void bal_energy_gravity(struct bal_sim *s);
 /* BAL_EUNSTABLE naming the worst contact if an overlap exceeds the budget. */
 enum bal_status bal_energy_overlap(const struct bal_sim *s, struct bal_error *err);

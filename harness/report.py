@@ -604,7 +604,7 @@ def render_cost(case, rows, figures_dir):
     if not shutil.which("gnuplot"):
         out.notes.append("gnuplot not found: figure not rendered")
         return out
-    figure = Figure_(out.title)
+    figure = _CostAxes(out.title)
     with tempfile.TemporaryDirectory(prefix="ballast-cost-") as workdir:
         clauses = []
         for i, (name, pts) in enumerate(curves.items()):
@@ -627,7 +627,7 @@ def render_cost(case, rows, figures_dir):
 
 
 @dataclass
-class Figure_:
+class _CostAxes:
     """What gnuplot_script needs of a figure, for the cost diagram."""
     title: str
     xlabel: str = "cost: particle-steps (steps x discs)"

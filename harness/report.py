@@ -566,6 +566,9 @@ def cost_section(case, reports_dir, figures_dir):
     except (OSError, ValueError, IndexError) as exc:
         out.notes.append(f"no sweep results ({exc}); run `python3 -m harness cost {case.name}`")
         return out
+    if case.path and Path(case.path).is_file() and path.stat().st_mtime < Path(case.path).stat().st_mtime:
+        out.notes.append(f"{path.name} is older than {Path(case.path).name}: the sweeps may have changed "
+                         f"since (run `python3 -m harness cost {case.name}`)")
     out.cheapest = sweep.cheapest(out.rows)
     out.figure = render_cost(case, out.rows, figures_dir)
     return out

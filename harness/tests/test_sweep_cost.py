@@ -1,5 +1,6 @@
 """Error against cost (harness/sweep.py): [sweep] declarations, the error of a run, the
 cheapest-setting table, `harness cost` and the report section, on the fake project."""
+import os
 import shutil
 from pathlib import Path
 
@@ -298,3 +299,14 @@ def test_report_without_results_says_how_to_get_them(project, capsys):
     assert main(["report", "spring"]) == 0
     capsys.readouterr()
     assert "python3 -m harness cost spring" in (project / "reports" / "index.html").read_text()
+
+
+def test_report_notes_a_cost_table_older_than_the_declarations(project, capsys):
+    path = add_sweeps(project)
+    assert main(["run", "spring"]) == 0
+    assert main(["cost", "spring"]) == 0
+    later = (project / "reports" / "sweeps" / "spring" / "cost.tsv").stat().st_mtime + 10
+    os.utime(path, (later, later))
+    assert main(["report", "spring"]) == 0
+    capsys.readouterr()
+    assert "cost.tsv is older than case.txt" in (project / "reports" / "index.html").read_text()

@@ -1,6 +1,7 @@
 # ballast — build, test, validate, benchmark.
 #
-#   make validate     build, run the default tier of the catalogue, gate, report
+#   make validate     build, run the default tier of the catalogue, gate, sweeps, report
+#   make sweep        the declared error-against-cost sweeps alone (needs the default runs)
 #   make test         C unit tests (Check), symbol-prefix check, harness tests (pytest)
 #   make test-sanitize  C unit tests under AddressSanitizer + UndefinedBehaviorSanitizer
 #   make bench        dense-packing benchmark (median and spread of 5 repeats)
@@ -29,7 +30,7 @@ TEST_SRC := $(wildcard core/tests/check_*.c)
 BENCH_SRC := core/bench/bench.c
 
 .PHONY: all deps test test-c test-prefix test-py test-sanitize validate bench bench-scaling \
-        bench-peer bench-modules clean keys
+        bench-peer bench-modules clean keys sweep
 
 all: deps bin/ballast
 
@@ -83,6 +84,11 @@ test-sanitize: deps $(BUILD)/san/check_ballast
 # ---- validation -----------------------------------------------------------
 validate: all
 	$(PYTHON) -m harness validate --tier $(TIER) -j $(JOBS)
+
+# Error against cost: every [sweep] of the tier's cases -> reports/sweeps/<case>/cost.tsv
+# (validate runs them too, between the gate and the report; `harness report` draws them).
+sweep: all
+	$(PYTHON) -m harness cost --tier $(TIER) -j $(JOBS)
 
 # ---- benchmark ------------------------------------------------------------
 $(BUILD)/bench: $(BENCH_SRC) $(BUILD)/libballast.a

@@ -1,4 +1,4 @@
-"""The command line: python3 -m harness {list,run,check,report,validate,rebaseline,sweep}.
+"""The command line: python3 -m harness {list,run,check,report,validate,rebaseline,sweep,cost}.
 
 Each command is a small function that loads the catalogue and references, picks the
 cases, and hands over to runner, gate, report or rebaseline.  Errors in case.txt or .ref
@@ -11,6 +11,7 @@ from pathlib import Path
 
 from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_root
 from . import catalogue, references
+from . import sweep as sweeps
 from .compare import RunStore, evaluate_all, folder_locator
 from .gate import gate, sweep_table
 from .ini import IniError
@@ -31,6 +32,7 @@ def load_checks(cases):
     """Every reference check, validated against the catalogue."""
     checks = references.expand(references.load(reference_root()), cases)
     references.validate(checks, cases)
+    sweeps.validate(cases, checks)
     return checks
 
 
@@ -83,6 +85,8 @@ def cmd_validate(args):
     load_checks(load_cases())          # a broken reference file stops us before any run
     run_status = cmd_run(args)
     check_status = cmd_check(args)
+    if not args.no_sweeps:
+        cmd_cost(args)
     cmd_report(args)
     return run_status or check_status
 
@@ -103,6 +107,15 @@ def cmd_sweep(args):
     checks = [c for c in load_checks(cases) if c.case == case.name and c.run_variants == [variant.name]]
     print_sweep(case, variant, checks, jobs)
     return 0 if all(o.ok for o in outcomes) else 1
+
+
+def cmd_cost(args):
+    """Every declared [sweep] of the selected cases: run, write reports/sweeps/<case>/cost.tsv."""
+    all_cases = load_cases()
+    checks = load_checks(all_cases)
+    sweeps.run_declared(selected(args, all_cases), checks, args.bin, args.jobs, runs_root(),
+                        reports_root() / "sweeps", sys.stdout, run_all)
+    return 0
 
 
 def sweep_variant(case, name):
@@ -149,7 +162,8 @@ def parser():
     _selection(_command(sub, "check", cmd_check,
                         "evaluate the checks, print the gate table, write summary.json and junit.xml"))
     _selection(_command(sub, "report", cmd_report, "render figures, write reports/summary.md and reports/index.html"))
-    _runs(_selection(_command(sub, "validate", cmd_validate, "run + check + report")))
+    validate = _runs(_selection(_command(sub, "validate", cmd_validate, "run + check + cost + report")))
+    validate.add_argument("--no-sweeps", action="store_true", help="skip the declared sweeps (cost)")
     rebase = _command(sub, "rebaseline", cmd_rebaseline, "rewrite the regression values of CASE from its current outputs")
     rebase.add_argument("case", metavar="CASE")
     sweep = _command(sub, "sweep", cmd_sweep, "run one variant once per value of a --set key and tabulate its checks")
@@ -157,6 +171,9 @@ def parser():
     sweep.add_argument("--set", required=True, metavar="KEY=V1,V2,...")
     sweep.add_argument("--variant", metavar="NAME", help="the variant to sweep (needed when the case has several)")
     _runs(sweep)
+    _runs(_selection(_command(sub, "cost", cmd_cost,
+                              "run every declared [sweep] of the selected cases (error against cost); "
+                              "needs their default runs; writes reports/sweeps/<case>/cost.tsv")))
     return p
 
 

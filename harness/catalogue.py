@@ -23,6 +23,7 @@ takes kind, title, variants and paper; variants default to all of the case's):
                xlabel, ylabel, xrange, yrange
 
 A key that the figure's kind does not use is an error, as is an unknown kind.
+[sweep NAME] sections declare the case's error-against-cost sweeps (keys in sweep.py).
 """
 import ast
 import re
@@ -97,6 +98,7 @@ class Case:
     line: int = 0
     variants: list = field(default_factory=list)
     figures: list = field(default_factory=list)
+    sweeps: list = field(default_factory=list)     # [sweep NAME] sections as sweep.Sweep (error against cost)
 
     @property
     def source(self):
@@ -141,8 +143,11 @@ def load_file(path):
             _add_variant(cases[-1], section)
         elif section.kind == "figure":
             _add_figure(cases[-1], section)
+        elif section.kind == "sweep":
+            from .sweep import parse as parse_sweep     # here: sweep.py imports the runner
+            cases[-1].sweeps.append(parse_sweep(section))
         else:
-            raise section.error(f"unknown section kind '{section.kind}' (known: case, variant, figure)")
+            raise section.error(f"unknown section kind '{section.kind}' (known: case, variant, figure, sweep)")
     for case in cases:
         _finish(case)
     return cases

@@ -58,6 +58,7 @@ class CaseReport:
     figures: list
     verdicts: list
     verdict_source: str
+    cost: object = None          # CostOut: the error-against-cost section (see the end of this module)
 
 
 # ---------------------------------------------------------------- header facts
@@ -384,7 +385,8 @@ def gather(cases, checks, store, runs_root, reports_dir):
     for case in cases:
         verdicts, source = verdicts_for(case, checks, summary, saved, runs_root, store)
         figures = [render_figure(case, f, store, figures_dir) for f in case.figures]
-        reports.append(CaseReport(case, run_rows(case, runs_root), figures, verdicts, source))
+        reports.append(CaseReport(case, run_rows(case, runs_root), figures, verdicts, source,
+                                  cost_section(case, reports_dir, figures_dir)))
     return reports
 
 
@@ -429,7 +431,7 @@ def _markdown_case(r):
               f"{'PASS' if v.passed else '**FAIL**'} | {_md(v.provenance)} | {_md(v.message)} |" for v in r.verdicts]
     if not r.verdicts:
         lines.append("| *(no checks for this case)* | | | | | | | | |")
-    return lines + [""]
+    return lines + [""] + _cost_markdown(r.cost)
 
 
 # ---------------------------------------------------------------- index.html
@@ -534,7 +536,7 @@ def _case_html(r):
         "<h3>Runs</h3>", _runs_html(r), _energy_html(r),
         "<h3>Figures</h3>" if r.figures else "", *[image_html(f) for f in r.figures],
         f"<h3>Checks</h3><p class=\"meta\">verdicts: {esc(r.verdict_source)}</p>", _checks_html(r),
-        "</section>"])
+        _cost_html(r.cost), "</section>"])
 
 
 def _index_html(reports):
@@ -571,3 +573,153 @@ def write_report(cases, checks, store, runs_root, reports_dir, out=None):
     if out:
         print(f"wrote {reports_dir / 'summary.md'} and {index}", file=out)
     return index
+
+
+# ---------------------------------------------------------------- error against cost
+
+COST_TEXT = ("Error against cost: every declared [sweep] of the case (harness/sweep.py). "
+             "Error = the largest |q - ref| / |ref| over the checks of the swept variant that have a "
+             "point reference of kind analytic, exact or paper, and of the sweep's `error =` quantities "
+             "(relative deviations from a reference solution). Cost = particle-steps = steps x discs. "
+             "Each curve is one swept parameter (points labelled by the factor applied to its default); "
+             "the black star is the default tier's setting.")
+
+
+@dataclass
+class CostOut:
+    figure: FigureOut = None
+    rows: list = field(default_factory=list)
+    cheapest: dict = field(default_factory=dict)
+    notes: list = field(default_factory=list)
+
+
+def cost_section(case, reports_dir, figures_dir):
+    """The error-against-cost section of a case from reports/sweeps/<case>/cost.tsv; None when the
+    case declares no sweep."""
+    from . import sweep
+    if not case.sweeps:
+        return None
+    out = CostOut()
+    path = sweep.cost_path(Path(reports_dir) / "sweeps", case.name)
+    try:
+        out.rows = sweep.read_tsv(path)
+    except (OSError, ValueError, IndexError) as exc:
+        out.notes.append(f"no sweep results ({exc}); run `python3 -m harness cost {case.name}`")
+        return out
+    if case.path and Path(case.path).is_file() and path.stat().st_mtime < Path(case.path).stat().st_mtime:
+        out.notes.append(f"{path.name} is older than {Path(case.path).name}: the sweeps may have changed "
+                         f"since (run `python3 -m harness cost {case.name}`)")
+    out.cheapest = sweep.cheapest(out.rows)
+    out.figure = render_cost(case, out.rows, figures_dir)
+    return out
+
+
+def cost_points(rows):
+    """({sweep: [(cost, error, label)]} sorted by factor, the default point or None, notes)."""
+    curves, default, notes = {}, None, []
+    for r in rows:
+        x, y = r["particle_steps"], r["error"]
+        what = "default" if r["factor"] == 1.0 else f"{r['sweep']} x{r['factor']:g}"
+        if r["status"] != "ok" or x is None or y is None:
+            if r["factor"] != 1.0 or default is None:
+                notes.append(f"{what}: not drawn (status {r['status']}; {r['note'] or 'no error'})")
+            continue
+        if not (x > 0 and y > 0):
+            notes.append(f"{what}: not drawn: error {y:.3g} is not positive (log scale)")
+            continue
+        if r["factor"] == 1.0:
+            default = (x, y)
+        curves.setdefault(r["sweep"], []).append((r["factor"], x, y))
+    return ({k: [(x, y, "" if f == 1.0 else f"x{f:g}") for f, x, y in sorted(v)] for k, v in curves.items()}, default,
+            list(dict.fromkeys(notes)))
+
+
+def render_cost(case, rows, figures_dir):
+    """The log-log diagram: error (y) against particle-steps (x), one curve per sweep, default marked."""
+    out = FigureOut("error_cost_sweep", f"{case.name}: error against cost (declared sweeps)")
+    png, svg = (Path(figures_dir) / f"{case.name}_error_cost_sweep.{ext}" for ext in ("png", "svg"))
+    for old in (png, svg):
+        old.unlink(missing_ok=True)
+    curves, default, out.notes = cost_points(rows)
+    if not curves:
+        out.notes.append("nothing to plot")
+        return out
+    if not shutil.which("gnuplot"):
+        out.notes.append("gnuplot not found: figure not rendered")
+        return out
+    figure = _CostAxes(out.title)
+    with tempfile.TemporaryDirectory(prefix="ballast-cost-") as workdir:
+        clauses = []
+        for i, (name, pts) in enumerate(curves.items()):
+            path = Path(workdir) / f"curve{i}.dat"
+            path.write_text("".join(f"{x!r}\t{y!r}\t{label}\n" for x, y, label in pts), encoding="utf-8")
+            clauses += [f"{gp_string(path)} using 1:2 with linespoints pt 7 ps 1 lc {i + 1} title {gp_string(name)}",
+                        f"{gp_string(path)} using 1:2:3 with labels left offset char 0.6,0.5 tc lt {i + 1} notitle"]
+        if default:
+            path = Path(workdir) / "default.dat"
+            path.write_text(f"{default[0]!r}\t{default[1]!r}\n", encoding="utf-8")
+            clauses.append(f"{gp_string(path)} using 1:2 with points pt 3 ps 3 lw 2 lc rgb 'black' "
+                           "title 'default tier setting'")
+        error = _run_gnuplot(gnuplot_script(figure, clauses, png, svg, ["set logscale xy", "set key outside"]),
+                             workdir)
+    if error:
+        out.notes.append(f"gnuplot failed: {error}")
+    out.png = png if png.is_file() and png.stat().st_size else None
+    out.svg = svg if svg.is_file() and svg.stat().st_size else None
+    return out
+
+
+@dataclass
+class _CostAxes:
+    """What gnuplot_script needs of a figure, for the cost diagram."""
+    title: str
+    xlabel: str = "cost: particle-steps (steps x discs)"
+    ylabel: str = "error: max |q - ref| / |ref| over the error terms"
+    xrange: str = ""
+    yrange: str = ""
+
+
+def _setting(r):
+    from .sweep import setting
+    return setting(r)
+
+
+def _cost_html(cost):
+    if cost is None:
+        return ""
+    parts = ["<h3>Error against cost</h3>", f"<p class=\"meta\">{esc(COST_TEXT)}</p>"]
+    parts += [f"<p class=\"bad\">{esc(n)}</p>" for n in cost.notes]
+    if cost.figure:
+        parts.append(image_html(cost.figure))
+    if cost.rows:
+        rows = [[cell(f"{tol:g}"), cell(_setting(r) if r else "none of the swept settings"),
+                 cell(fmt_number(r["error"]) if r else "-", "num"),
+                 cell(fmt_number(r["particle_steps"]) if r else "-", "num"),
+                 cell(fmt_number(r["steps"]) if r else "-", "num"),
+                 cell(fmt_number(r["wall_seconds"]) if r else "-", "num")] for tol, r in cost.cheapest.items()]
+        parts.append("<p>Cheapest setting meeting each tolerance (least particle-steps with error &le; tolerance):</p>")
+        parts.append(table_html(["tolerance", "cheapest setting", "error", "particle-steps", "steps", "wall s"], rows))
+        every = [[cell(r["sweep"]), cell(f"{r['factor']:g}", "num"), cell(r["sets"]), cell(r["status"]),
+                  cell(fmt_number(r["error"]), "num"), cell(r["worst"]), cell(fmt_number(r["particle_steps"]), "num"),
+                  cell(fmt_number(r["steps"]), "num"), cell(fmt_number(r["wall_seconds"]), "num"), cell(r["note"])]
+                 for r in cost.rows]
+        parts.append("<details><summary>every point</summary>" +
+                     table_html(["sweep", "factor", "settings", "status", "error", "largest term", "particle-steps",
+                                 "steps", "wall s", "note"], every) + "</details>")
+    return "\n".join(parts)
+
+
+def _cost_markdown(cost):
+    if cost is None:
+        return []
+    lines = ["**Error against cost** (declared sweeps; cost = particle-steps)", ""]
+    lines += [f"- {_md(n)}" for n in cost.notes]
+    if cost.figure and cost.figure.png:
+        lines += [f"![error against cost](figures/{cost.figure.png.name})", ""]
+    lines += [f"- {_md(n)}" for n in (cost.figure.notes if cost.figure else [])]
+    if cost.rows:
+        lines += ["", "| tolerance | cheapest setting | error | particle-steps |", "|---|---|---|---|"]
+        lines += [f"| {tol:g} | {_md(_setting(r)) if r else 'none of the swept settings'} | "
+                  f"{fmt_number(r['error']) if r else '-'} | {fmt_number(r['particle_steps']) if r else '-'} |"
+                  for tol, r in cost.cheapest.items()]
+    return lines + [""]

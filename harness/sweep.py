@@ -1,0 +1,405 @@
+"""Error against cost: the declared parameter sweeps of the catalogue (issue 6, item 1).
+
+A case declares its sweeps in case.txt, one [sweep NAME] section per swept parameter
+(after the [case], like [variant] and [figure]):
+
+    [sweep dt]
+    variant = damped                         # the variant whose run each point replaces
+    keys = settings.dt=0.01                  # KEY=DEFAULT ...: every key is set to DEFAULT x factor
+    factors = 0.5 2 4                        # a few factors around the default (1, the default, is implicit)
+    scale = stage.load.cycles=40             # optional KEY=DEFAULT ...: set to DEFAULT / factor, a
+                                             #   whole number (same simulated time, or same closure)
+    checks = damped_eq_A damped_eq_B         # optional: the error terms (default: every eligible check)
+    error = contact_error('exact')           # optional, repeatable: a quantity that is itself a
+                                             #   relative deviation from a reference solution
+
+The default point of every curve is the variant's own run of the default tier
+(reports/runs/<case>/<variant>); the swept runs go to reports/sweeps/<case>/<sweep>_x<factor>.
+
+The error of a run (one number, documented in README.md) is the largest of its error terms:
+
+  * a check of the case (reference/*.ref) of kind analytic, exact or paper with a point
+    reference (tolerance abs, rel or ratio): |q - ref| / |ref|, where q is the check's
+    quantity (for ratio: quantity / other); |q - ref| when ref = 0.  It is evaluated with the
+    check machinery of compare.py, the swept run standing in for the variant.  Eligible are
+    the checks that read the variant and, besides it, only reference solutions (command =
+    exact, which no sweep changes).  A check that reads another DEM variant (a ratio or trend
+    between runs, or series()/contact_error() of a DEM sibling) relates two runs and is left
+    out: found before any run for ratio/trend, and at evaluation for siblings read inside an
+    expression (the term is then dropped from the whole curve and a note says so).
+    Interval and trend checks have no point reference and never count; nor do regressions.
+  * each `error =` expression: |value|.
+
+Cost is particle-steps = steps x n_discs from run.json (wall-clock seconds are recorded too).
+"""
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .compare import EvalError, RunStore, quantity_in
+from .ini import IniError
+from .runner import Job
+from .tables import RunProblem, load_run, read_run_json
+
+SWEEP_KEYS = {"variant", "keys", "factors", "scale", "checks", "error"}
+POINT_TOLERANCES = ("abs", "rel", "ratio")
+ERROR_KINDS = ("analytic", "exact", "paper")
+TOLERANCES = (1e-2, 1e-3, 1e-4)
+COST_COLUMNS = ("sweep", "factor", "sets", "status", "steps", "n_discs", "particle_steps", "wall_seconds",
+                "error", "worst", "note")
+
+
+@dataclass
+class Sweep:
+    name: str
+    variant: str
+    keys: list                   # [(key, default)]
+    factors: list                # floats, never 1
+    scale: list = field(default_factory=list)    # [(key, default)] set to default / factor
+    checks: list = field(default_factory=list)   # names; [] = every eligible check
+    errors: list = field(default_factory=list)   # expressions
+    path: str = ""
+    line: int = 0
+
+    def sets(self, factor):
+        """The --set overrides of the point at factor."""
+        out = [f"{k}={number(d * factor)}" for k, d in self.keys]
+        out += [f"{k}={round(d / factor)}" for k, d in self.scale]
+        return out
+
+    def label(self, factor):
+        return f"{self.name}_x{number(factor)}"
+
+
+def number(x):
+    """A value as the core reads it back exactly enough: 12 significant digits."""
+    return f"{x:.12g}"
+
+
+# ---------------------------------------------------------------- declarations
+
+def parse(section):
+    """A [sweep NAME] section -> Sweep; errors name file:line."""
+    section.check_keys(SWEEP_KEYS)
+    keys = _pairs(section, "keys", required=True)
+    scale = _pairs(section, "scale", required=False)
+    entry = section.entry("factors")
+    if entry is None or not entry.value:
+        raise section.error(f"[sweep {section.name}] needs 'factors = F1 F2 ...' (factors of the default)")
+    factors = []
+    for word in entry.value.split():
+        try:
+            f = float(word)
+        except ValueError:
+            raise section.error(f"factor '{word}' is not a number", entry.line) from None
+        if not (math.isfinite(f) and f > 0):
+            raise section.error(f"factor '{word}' must be a positive number", entry.line)
+        if f == 1:
+            raise section.error("factor 1 is the default run itself (drawn on every curve): leave it out",
+                                entry.line)
+        if f in factors:
+            raise section.error(f"factor '{word}' given twice", entry.line)
+        factors.append(f)
+    for key, default in scale:
+        for f in factors:
+            scaled = default / f
+            if abs(scaled - round(scaled)) > 1e-9 * max(1.0, abs(scaled)) or round(scaled) < 1:
+                raise section.error(f"scale: {key} = {number(default)} / factor {number(f)} = {scaled:g} "
+                                    "is not a whole number >= 1", section.entry("scale").line)
+    return Sweep(name=section.name, variant=section.require("variant"), keys=keys, factors=factors,
+                 scale=scale, checks=section.get("checks", "").split(),
+                 errors=[e.value for e in section.all("error")], path=section.path, line=section.line)
+
+
+def _pairs(section, key, required):
+    entry = section.entry(key)
+    if entry is None or not entry.value:
+        if required:
+            raise section.error(f"[sweep {section.name}] needs '{key} = KEY=DEFAULT ...'")
+        return []
+    pairs = []
+    for word in entry.value.split():
+        name, sep, value = word.partition("=")
+        try:
+            default = float(value)
+        except ValueError:
+            default = None
+        if not sep or not name or default is None or not math.isfinite(default):
+            raise section.error(f"'{key}' takes KEY=DEFAULT words (a number, no blanks), got '{word}'", entry.line)
+        if any(name == n for n, _ in pairs):
+            raise section.error(f"'{key}': {name} given twice", entry.line)
+        pairs.append((name, default))
+    return pairs
+
+
+def validate(cases, checks):
+    """Every sweep names a run variant of its case and has something to measure its error by."""
+    for case in cases:
+        names = [s.name for s in case.sweeps]
+        for sweep in case.sweeps:
+            where = lambda msg: IniError(sweep.path, sweep.line, f"sweep '{sweep.name}' of case '{case.name}': {msg}")
+            if names.count(sweep.name) > 1:
+                raise where("defined twice")
+            variant = case.variant(sweep.variant)
+            if variant is None:
+                raise where(f"no variant '{sweep.variant}' (has: {', '.join(case.variant_names())})")
+            if variant.command != "run":
+                raise where(f"variant '{sweep.variant}' has command = {variant.command}: only DEM runs are swept")
+            mine = {c.name: c for c in checks if c.case == case.name}
+            for name in sweep.checks:
+                if name not in mine:
+                    raise where(f"no check '{name}' in the references of the case")
+                why = ineligible(mine[name], sweep.variant, case)
+                if why:
+                    raise where(f"check '{name}' cannot measure the error: {why}")
+            if not terms_of(sweep, case, checks)[0] and not sweep.errors:
+                raise where(f"nothing measures the error: no eligible check of variant '{sweep.variant}' "
+                            "(kind analytic/exact/paper, tolerance abs/rel/ratio) and no 'error ='")
+
+
+def ineligible(check, variant, case):
+    """Why check cannot be an error term of a run of variant ('' when it can)."""
+    if check.kind not in ERROR_KINDS:
+        return f"kind {check.kind} (only {', '.join(ERROR_KINDS)} references count)"
+    if check.tolerance not in POINT_TOLERANCES:
+        return f"tolerance {check.tolerance} has no point reference"
+    if variant not in check.run_variants:
+        return f"it is evaluated in {check.variant_label}, not {variant}"
+    others = [v for v in check.run_variants if v != variant and case.variant(v).command != "exact"]
+    if others:
+        return f"it also reads the DEM variant(s) {', '.join(others)}"
+    return ""
+
+
+def terms_of(sweep, case, checks):
+    """(the checks that make up the error, the names of eligible checks left out by `checks =`)."""
+    mine = [c for c in checks if c.case == case.name and not ineligible(c, sweep.variant, case)]
+    if sweep.checks:
+        return [c for c in mine if c.name in sweep.checks], [c.name for c in mine if c.name not in sweep.checks]
+    return mine, []
+
+
+# ---------------------------------------------------------------- the error of one run
+
+class _Recording(RunStore):
+    """A RunStore for one point: the variant from its own folder, every other from the default runs;
+    remembers which other variants an evaluation read.  `loaded` (folder -> Run or RunProblem) is
+    shared between the stores of a case, so a reference solution is read once."""
+
+    def __init__(self, variant, folder, runs_root, loaded):
+        self.read, self._loaded = set(), loaded
+
+        def locate(c, v):
+            if v == variant:
+                return Path(folder)
+            self.read.add(v)
+            return Path(runs_root) / c / v
+        super().__init__(locate)
+
+    def get(self, case, variant):
+        folder = self.locate(case, variant)
+        if folder not in self._loaded:
+            try:
+                self._loaded[folder] = load_run(folder)
+            except RunProblem as problem:
+                self._loaded[folder] = problem
+        found = self._loaded[folder]
+        if isinstance(found, RunProblem):
+            raise found
+        return found
+
+
+def deviation(q, ref):
+    """|q - ref| / |ref|, or |q - ref| when ref = 0."""
+    return abs(q - ref) / abs(ref) if ref != 0 else abs(q - ref)
+
+
+def term_errors(case, variant, folder, runs_root, terms, errors, loaded=None):
+    """{term name: error or an EvalError/RunProblem message (str)}, and {term: DEM siblings it read}."""
+    out, siblings, loaded = {}, {}, {} if loaded is None else loaded
+    for check in terms:
+        store = _Recording(variant, folder, runs_root, loaded)
+        try:
+            q = quantity_in(store, case.name, variant, check.quantity)
+            if check.tolerance == "ratio":
+                other = quantity_in(store, case.name, check.other_variant, check.other)
+                if other == 0:
+                    raise EvalError(f"other quantity '{check.other}' is zero")
+                q = q / other
+            out[check.name] = deviation(q, check.value)
+        except (RunProblem, EvalError) as exc:
+            out[check.name] = str(exc)
+        siblings[check.name] = _dem(case, store.read)
+    for expr in errors:
+        store = _Recording(variant, folder, runs_root, loaded)
+        try:
+            out[expr] = abs(quantity_in(store, case.name, variant, expr))
+        except (RunProblem, EvalError) as exc:
+            out[expr] = str(exc)
+        siblings[expr] = _dem(case, store.read)
+    return out, siblings
+
+
+def _dem(case, variants):
+    return sorted(v for v in variants if case.variant(v) is None or case.variant(v).command != "exact")
+
+
+def run_error(by_term, dropped=()):
+    """(error, the term giving it, note): the largest term; None when a term could not be evaluated."""
+    kept = {k: v for k, v in by_term.items() if k not in dropped}
+    bad = {k: v for k, v in kept.items() if isinstance(v, str)}
+    if bad:
+        name = next(iter(bad))
+        return None, name, f"{name}: {bad[name]}"
+    if not kept:
+        return None, "", "no error term"
+    worst = max(kept, key=lambda k: kept[k])
+    return kept[worst], worst, ""
+
+
+def run_cost(folder):
+    """{status, steps, n_discs, particle_steps, wall_seconds} from run.json (None where absent),
+    and 'unsettled': the stages that have a stop rule but ran to their cycle limit."""
+    try:
+        info = read_run_json(folder)
+    except RunProblem as problem:
+        return {"status": f"no run.json ({problem})", "steps": None, "n_discs": None,
+                "particle_steps": None, "wall_seconds": None, "unsettled": []}
+    steps, n = info.get("steps"), info.get("n_discs")
+    unsettled = [st.get("name", "?") for st in info.get("stages", []) or []
+                 if isinstance(st, dict) and st.get("stop_rule") and not st.get("stopped")]
+    return {"status": info.get("status", "?"), "steps": steps, "n_discs": n,
+            "particle_steps": steps * n if isinstance(steps, int) and isinstance(n, int) else None,
+            "wall_seconds": info.get("wall_seconds"), "unsettled": unsettled}
+
+
+# ---------------------------------------------------------------- running and tabulating
+
+def jobs(case, sweeps_root):
+    """One runner Job per declared point of the case."""
+    out = []
+    for sweep in case.sweeps:
+        variant = case.variant(sweep.variant)
+        for f in sweep.factors:
+            label = sweep.label(f)
+            out.append(Job(case.name, label, variant.scene, list(variant.sets) + sweep.sets(f),
+                           Path(sweeps_root) / case.name / label, case.runtime / max(len(case.variants), 1),
+                           variant.command))
+    return out
+
+
+def points(case, checks, runs_root, sweeps_root):
+    """Rows of cost.tsv: per sweep the default run (factor 1) and every swept point."""
+    rows, loaded = [], {}
+    for sweep in case.sweeps:
+        terms, _ = terms_of(sweep, case, checks)
+        pts = [(1.0, Path(runs_root) / case.name / sweep.variant, [])]
+        pts += [(f, Path(sweeps_root) / case.name / sweep.label(f), sweep.sets(f)) for f in sweep.factors]
+        evaluated = [(f, folder, sets, *term_errors(case, sweep.variant, folder, runs_root, terms, sweep.errors,
+                                                     loaded))
+                     for f, folder, sets in pts]
+        dropped = sorted({t for *_, sib in evaluated for t, read in sib.items() if read})
+        for f, folder, sets, by_term, _ in evaluated:
+            error, worst, note = run_error(by_term, dropped)
+            cost = run_cost(folder)
+            unsettled = cost.pop("unsettled")
+            notes = [note]
+            if dropped:
+                notes.append(f"left out (reads a DEM sibling): {', '.join(dropped)}")
+            if unsettled:
+                notes.append("stage(s) " + ", ".join(unsettled) +
+                             " ran to their cycle limit without meeting the stop rule")
+            rows.append({"sweep": sweep.name, "factor": f, "sets": " ".join(sets) or "(default)",
+                         **cost, "error": error, "worst": worst, "note": "; ".join(filter(None, notes))})
+    return rows
+
+
+def cheapest(rows, tolerances=TOLERANCES):
+    """Per tolerance: the row of least particle-steps (then wall seconds) with error <= tolerance, or None."""
+    ok = [r for r in rows if r["status"] == "ok" and r["error"] is not None and r["particle_steps"] is not None]
+    out = {}
+    for tol in tolerances:
+        meeting = [r for r in ok if r["error"] <= tol]
+        out[tol] = min(meeting, key=lambda r: (r["particle_steps"], r["wall_seconds"] or 0.0)) if meeting else None
+    return out
+
+
+def _cell(x):
+    if x is None:
+        return "-"
+    if isinstance(x, float):
+        return f"{x:.6g}"
+    return str(x).replace("\t", " ").replace("\n", " ")
+
+
+def write_tsv(rows, path):
+    """cost.tsv: one row per point, COST_COLUMNS; '-' for nothing (tmp file + rename)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    text = "\t".join(COST_COLUMNS) + "\n" + "".join(
+        "\t".join(_cell(r[c]) for c in COST_COLUMNS) + "\n" for r in rows)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    tmp.replace(path)
+
+
+def read_tsv(path):
+    """The rows of a cost.tsv (numbers back as numbers, '-' as None)."""
+    lines = Path(path).read_text(encoding="utf-8").splitlines()
+    header = lines[0].split("\t")
+    if tuple(header) != COST_COLUMNS:
+        raise ValueError(f"{path}: header is not {' '.join(COST_COLUMNS)}")
+    rows = []
+    for line in lines[1:]:
+        cells = line.split("\t")
+        if len(cells) != len(header):
+            raise ValueError(f"{path}: row with {len(cells)} cells, not {len(header)}")
+        row = dict(zip(header, cells))
+        for key in ("factor", "error", "wall_seconds"):
+            row[key] = None if row[key] == "-" else float(row[key])
+        for key in ("steps", "n_discs", "particle_steps"):
+            row[key] = None if row[key] == "-" else int(float(row[key]))
+        rows.append(row)
+    return rows
+
+
+def cost_path(sweeps_root, case_name):
+    return Path(sweeps_root) / case_name / "cost.tsv"
+
+
+def run_declared(cases, checks, binary, workers, runs_root, sweeps_root, out, run_all):
+    """Run every declared point of the cases (one parallel batch), write each case's cost.tsv;
+    print the cheapest setting per tolerance.  The list of (case, rows)."""
+    swept = [c for c in cases if c.sweeps]
+    for case in cases:
+        if not case.sweeps:
+            print(f"{case.name}: no [sweep] declared", file=out)
+    all_jobs = [j for c in swept for j in jobs(c, sweeps_root)]
+    if all_jobs:
+        run_all(all_jobs, binary, workers, out)
+    done = []
+    for case in swept:
+        rows = points(case, checks, runs_root, sweeps_root)
+        write_tsv(rows, cost_path(sweeps_root, case.name))
+        done.append((case, rows))
+        print(summary_text(case.name, rows), file=out)
+    return done
+
+
+def setting(row):
+    """'default' or 'dt x2 (settings.dt=0.02 ...)'."""
+    if row["factor"] == 1.0:
+        return "default"
+    return f"{row['sweep']} x{number(row['factor'])} ({row['sets']})"
+
+
+def summary_text(name, rows):
+    """A few lines: the default's error and the cheapest setting per tolerance."""
+    default = next((r for r in rows if r["factor"] == 1.0), None)
+    lines = [f"{name}: default error {_cell(default['error']) if default else '-'}, "
+             f"{_cell(default['particle_steps']) if default else '-'} particle-steps"]
+    for tol, r in cheapest(rows).items():
+        lines.append(f"  error <= {tol:g}: " + (f"{setting(r)}, error {_cell(r['error'])}, "
+                                                 f"{r['particle_steps']} particle-steps"
+                                                 if r else "no swept setting"))
+    return "\n".join(lines)

@@ -1,0 +1,312 @@
+"""Error against cost (harness/sweep.py): [sweep] declarations, the error of a run, the
+cheapest-setting table, `harness cost` and the report section, on the fake project."""
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+
+from harness import catalogue, references, report, sweep
+from harness.__main__ import main
+from harness.ini import IniError, parse
+from harness.tests.fakes import spring_columns, write_run, write_spring_runs
+
+needs_gnuplot = pytest.mark.skipif(not shutil.which("gnuplot"), reason="gnuplot not installed")
+
+SWEEPS = """
+[sweep stiffness]
+variant = soft
+keys = settings.k=1
+factors = 2 0.5
+scale = stage.n=10
+checks = abs_at2
+
+[sweep length]
+variant = stiff
+keys = stage.n=10
+factors = 2
+error = abs(at(F, 1) - 1)
+"""
+
+
+def section(body, name="dt"):
+    return parse(f"[sweep {name}]\n{body}", "cases/x/case.txt")[0]
+
+
+def add_sweeps(project, text=SWEEPS):
+    path = project / "cases" / "springs" / "case.txt"
+    path.write_text(path.read_text() + text)
+    return path
+
+
+# ---------------------------------------------------------------- declarations
+
+def test_parse_a_full_declaration():
+    s = sweep.parse(section("variant = v\nkeys = settings.dt=0.01 stage.a.b=2\nfactors = 0.5 2 4\n"
+                            "scale = stage.load.cycles=40\nchecks = c1 c2\nerror = e(1)\nerror = e(2)\n"))
+    assert (s.name, s.variant, s.factors) == ("dt", "v", [0.5, 2.0, 4.0])
+    assert s.keys == [("settings.dt", 0.01), ("stage.a.b", 2.0)] and s.scale == [("stage.load.cycles", 40.0)]
+    assert s.checks == ["c1", "c2"] and s.errors == ["e(1)", "e(2)"]
+    assert s.sets(2) == ["settings.dt=0.02", "stage.a.b=4", "stage.load.cycles=20"]
+    assert s.sets(0.5) == ["settings.dt=0.005", "stage.a.b=1", "stage.load.cycles=80"]
+    assert s.label(0.5) == "dt_x0.5"
+
+
+@pytest.mark.parametrize("body, message, line", [
+    ("variant = v\nfactors = 2\n", "needs 'keys = KEY=DEFAULT", 1),
+    ("variant = v\nkeys = settings.dt=0.01\n", "needs 'factors = F1 F2", 1),
+    ("variant = v\nkeys = settings.dt=0.01\nfactors = 2 1\n", "factor 1 is the default run", 4),
+    ("variant = v\nkeys = settings.dt=0.01\nfactors = 2 x\n", "factor 'x' is not a number", 4),
+    ("variant = v\nkeys = settings.dt=0.01\nfactors = 2 -1\n", "must be a positive number", 4),
+    ("variant = v\nkeys = settings.dt=0.01\nfactors = 2 2\n", "given twice", 4),
+    ("variant = v\nkeys = settings.dt\nfactors = 2\n", "KEY=DEFAULT words", 3),
+    ("variant = v\nkeys = settings.dt=abc\nfactors = 2\n", "KEY=DEFAULT words", 3),
+    ("variant = v\nkeys = a=1 a=2\nfactors = 2\n", "a given twice", 3),
+    ("variant = v\nkeys = a=1\nfactors = 3\nscale = stage.load.cycles=40\n", "is not a whole number", 5),
+    ("variant = v\nkeys = a=1\nfactors = 2\nvalues = 1 2\n", "unknown key 'values'", 5),
+    ("keys = a=1\nfactors = 2\n", "needs 'variant = ...'", 1),
+])
+def test_parse_errors_name_file_and_line(body, message, line):
+    with pytest.raises(IniError) as err:
+        sweep.parse(section(body))
+    assert message in str(err.value) and f"case.txt:{line}:" in str(err.value)
+
+
+def test_catalogue_attaches_sweeps_to_their_case(project):
+    add_sweeps(project)
+    case = catalogue.select(catalogue.load(), ["spring"])[0]
+    assert [s.name for s in case.sweeps] == ["stiffness", "length"]
+
+
+def test_catalogue_error_from_a_sweep_section_names_its_line(project):
+    path = add_sweeps(project, "\n[sweep bad]\nvariant = soft\nkeys = settings.k=1\nfactors = 1\n")
+    with pytest.raises(IniError) as err:
+        catalogue.load()
+    assert f"case.txt:{len(path.read_text().splitlines())}:" in str(err.value)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("\n[sweep s]\nvariant = nope\nkeys = k=1\nfactors = 2\n", "no variant 'nope'"),
+    ("\n[sweep s]\nvariant = soft\nkeys = k=1\nfactors = 2\nchecks = nope\n", "no check 'nope'"),
+    ("\n[sweep s]\nvariant = soft\nkeys = k=1\nfactors = 2\nchecks = interval_ek\n", "has no point reference"),
+    ("\n[sweep s]\nvariant = soft\nkeys = k=1\nfactors = 2\nchecks = regress_mean\n", "kind regression"),
+    ("\n[sweep s]\nvariant = soft\nkeys = k=1\nfactors = 2\nchecks = rel_last\n", "evaluated in stiff, not soft"),
+    ("\n[sweep s]\nvariant = stiff\nkeys = k=1\nfactors = 2\nchecks = ratio_k\n", "reads the DEM variant(s) soft"),
+    ("\n[sweep s]\nvariant = stiffer\nkeys = k=1\nfactors = 2\n", "nothing measures the error"),
+    ("\n[sweep s]\nvariant = soft\nkeys = k=1\nfactors = 2\n[sweep s]\nvariant = soft\nkeys = k=1\nfactors = 3\n",
+     "defined twice"),
+])
+def test_validate_against_the_references(project, capsys, text, message):
+    add_sweeps(project, text)
+    assert main(["list"]) == 0        # list loads the catalogue only
+    assert main(["check"]) == 2       # commands that load the references validate the sweeps
+    assert message in capsys.readouterr().err
+
+
+def test_only_run_variants_are_swept(project, capsys):
+    path = project / "cases" / "springs" / "case.txt"
+    path.write_text(path.read_text() + "\n[variant solved]\nscene = spring.scene\ncommand = exact\n"
+                    "\n[sweep s]\nvariant = solved\nkeys = k=1\nfactors = 2\nerror = 1\n")
+    assert main(["check"]) == 2
+    assert "only DEM runs are swept" in capsys.readouterr().err
+
+
+def test_eligible_terms_by_default_and_by_name(project):
+    add_sweeps(project)
+    cases = catalogue.load()
+    checks = references.load()
+    case = catalogue.select(cases, ["spring"])[0]
+    named, left = sweep.terms_of(case.sweeps[0], case, checks)
+    assert [c.name for c in named] == ["abs_at2"] and left == []
+    every, _ = sweep.terms_of(case.sweeps[1], case, checks)
+    # stiff: rel_last counts; ratio_k reads soft (a DEM run) and the trend has no point reference
+    assert [c.name for c in every] == ["rel_last"]
+
+
+# ---------------------------------------------------------------- the error of a run
+
+def test_deviation_is_relative_and_absolute_at_zero():
+    assert sweep.deviation(2.2, 2.0) == pytest.approx(0.1)
+    assert sweep.deviation(-1.8, -2.0) == pytest.approx(0.1)
+    assert sweep.deviation(1e-3, 0.0) == 1e-3
+
+
+def test_run_error_is_the_largest_term_and_any_failure_is_no_error():
+    assert sweep.run_error({"a": 1e-3, "b": 2e-2}) == (2e-2, "b", "")
+    assert sweep.run_error({"a": 1e-3, "b": 2e-2}, dropped=["b"]) == (1e-3, "a", "")
+    error, worst, note = sweep.run_error({"a": 1e-3, "b": "column 'X' missing"})
+    assert error is None and worst == "b" and "column 'X' missing" in note
+    assert sweep.run_error({})[0] is None
+
+
+def _case_and_checks(project):
+    add_sweeps(project)
+    cases, checks = catalogue.load(), references.load()
+    return catalogue.select(cases, ["spring"])[0], checks
+
+
+def test_swept_run_stands_in_for_its_variant(project, runs, tmp_path):
+    case, checks = _case_and_checks(project)
+    write_spring_runs(runs)
+    swept = write_run(tmp_path / "point", spring_columns(1.1))       # at(F, 2) = 2.2 against 2
+    terms, _ = sweep.terms_of(case.sweeps[0], case, checks)
+    by_term, read = sweep.term_errors(case, "soft", swept, runs, terms, ["at(F, 2) / 2 - 1"])
+    assert by_term["abs_at2"] == pytest.approx(0.1)
+    assert by_term["at(F, 2) / 2 - 1"] == pytest.approx(0.1)
+    assert read == {"abs_at2": [], "at(F, 2) / 2 - 1": []}
+
+
+def test_ratio_check_against_the_same_variant_and_zero_reference(project, runs, tmp_path):
+    ref = project / "reference" / "springs.ref"
+    ref.write_text(ref.read_text() + "\n[check self_ratio]\ncase = spring\nvariant = soft\nquantity = at(F, 4)\n"
+                   "other = at(F, 2)\nvalue = 2\ntolerance = ratio 1e-9\nkind = exact\nprovenance = linear\n"
+                   "\n[check zero]\ncase = spring\nvariant = soft\nquantity = at(F, 2) - 2 * at(F, 1)\n"
+                   "value = 0\ntolerance = abs 1e-9\nkind = analytic\nprovenance = linear\n")
+    case, checks = _case_and_checks(project)
+    mine = {c.name: c for c in checks}
+    point = write_run(tmp_path / "p", {"cycle": [1, 2, 3, 4], "time": [0.1, 0.2, 0.3, 0.4], "F": [1, 2.5, 3, 4.5],
+                                       "Ek": [0, 0, 0, 0]})
+    by_term, _ = sweep.term_errors(case, "soft", point, runs, [mine["self_ratio"], mine["zero"]], [])
+    assert by_term["self_ratio"] == pytest.approx(abs(4.5 / 2.5 - 2) / 2)
+    assert by_term["zero"] == pytest.approx(0.5)           # |q - 0|: absolute when the reference is 0
+
+
+def test_terms_reading_a_dem_sibling_are_dropped_from_the_whole_curve(project, runs):
+    case, checks = _case_and_checks(project)
+    write_spring_runs(runs)
+    case.sweeps[0].errors = ["abs(last(F) / last(series('stiff', 'F')) - 0.5)"]
+    sweeps_root = project / "reports" / "sweeps"
+    for f in case.sweeps[0].factors:
+        write_run(sweeps_root / "spring" / case.sweeps[0].label(f), spring_columns(f), steps=int(10 / f))
+    rows = [r for r in sweep.points(case, checks, runs, sweeps_root) if r["sweep"] == "stiffness"]
+    assert [r["factor"] for r in rows] == [1.0, 2.0, 0.5]
+    assert all("left out (reads a DEM sibling)" in r["note"] and r["worst"] == "abs_at2" for r in rows)
+    assert [r["error"] for r in rows] == [0.0, pytest.approx(1.0), pytest.approx(0.5)]
+    assert [r["particle_steps"] for r in rows] == [20, 10, 40]
+
+
+def test_missing_run_gives_no_error_and_says_why(project, runs):
+    case, checks = _case_and_checks(project)
+    write_spring_runs(runs)
+    rows = sweep.points(case, checks, runs, project / "reports" / "sweeps")
+    missing = [r for r in rows if r["factor"] != 1.0]
+    assert all(r["error"] is None and r["status"].startswith("no run.json") for r in missing)
+    assert all(r["note"] for r in missing)
+
+
+def test_unsettled_stop_rule_is_noted(tmp_path):
+    folder = write_run(tmp_path / "r", stages=[{"name": "relax", "stop_rule": True, "stopped": False},
+                                               {"name": "load", "stop_rule": False, "stopped": False}])
+    assert sweep.run_cost(folder)["unsettled"] == ["relax"]
+
+
+# ---------------------------------------------------------------- the cheapest-setting table
+
+def row(sweep_name, factor, error, ps, status="ok", wall=1.0):
+    return {"sweep": sweep_name, "factor": factor, "sets": f"k={factor}", "status": status, "steps": ps,
+            "n_discs": 1, "particle_steps": ps, "wall_seconds": wall, "error": error, "worst": "t", "note": ""}
+
+
+def test_cheapest_setting_per_tolerance():
+    rows = [row("dt", 1.0, 5e-4, 100), row("dt", 2.0, 5e-3, 50), row("dt", 4.0, 0.5, 25),
+            row("k", 10.0, 5e-5, 400), row("k", 0.1, 1e-6, 20, status="unstable"),
+            row("k", 0.5, None, 10), row("tol", 10.0, 5e-4, 100, wall=0.5)]
+    table = sweep.cheapest(rows, (1e-2, 1e-3, 1e-4, 1e-7))
+    assert table[1e-2]["factor"] == 2.0
+    assert table[1e-3]["sweep"] == "tol"                   # same particle-steps as the default: less wall time
+    assert table[1e-4]["sweep"] == "k" and table[1e-4]["factor"] == 10.0
+    assert table[1e-7] is None                             # the unstable run does not count
+    assert sweep.setting(rows[0]) == "default" and sweep.setting(rows[1]) == "dt x2 (k=2.0)"
+
+
+def test_cost_tsv_round_trip(tmp_path):
+    rows = [row("dt", 1.0, 5e-4, 100), row("dt", 2.0, None, None, status="no run.json")]
+    rows[1]["note"] = "tab\there"
+    path = tmp_path / "s" / "cost.tsv"
+    sweep.write_tsv(rows, path)
+    back = sweep.read_tsv(path)
+    assert back[0] == rows[0]
+    assert back[1]["error"] is None and back[1]["particle_steps"] is None and back[1]["note"] == "tab here"
+    path.write_text("nope\n")
+    with pytest.raises(ValueError):
+        sweep.read_tsv(path)
+
+
+# ---------------------------------------------------------------- the command and the report
+
+def test_cost_command_runs_every_declared_point(project, capsys):
+    add_sweeps(project)
+    assert main(["run", "spring"]) == 0
+    assert main(["cost", "spring", "-j", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "3 runs: 3 ok" in out and "spring: default error" in out and "error <= 0.01:" in out
+    rows = sweep.read_tsv(project / "reports" / "sweeps" / "spring" / "cost.tsv")
+    assert [(r["sweep"], r["factor"]) for r in rows] == [("stiffness", 1.0), ("stiffness", 2.0), ("stiffness", 0.5),
+                                                         ("length", 1.0), ("length", 2.0)]
+    by = {(r["sweep"], r["factor"]): r for r in rows}
+    assert by[("stiffness", 2.0)]["sets"] == "settings.k=2 stage.n=5"
+    assert by[("stiffness", 2.0)]["error"] == pytest.approx(1.0) and by[("stiffness", 2.0)]["steps"] == 5
+    assert by[("length", 2.0)]["error"] == pytest.approx(1.0)     # last(F) = 40 against 20
+    assert by[("stiffness", 1.0)]["error"] == 0.0
+
+
+def test_cost_command_reports_cases_without_sweeps(project, capsys):
+    assert main(["cost", "spring"]) == 0
+    assert "spring: no [sweep] declared" in capsys.readouterr().out
+    assert not (project / "reports" / "sweeps").exists()
+
+
+def test_validate_runs_the_sweeps_unless_told_not_to(project, capsys):
+    add_sweeps(project)
+    main(["validate", "spring", "--no-sweeps"])
+    assert not (project / "reports" / "sweeps" / "spring" / "cost.tsv").exists()
+    main(["validate", "spring"])
+    assert (project / "reports" / "sweeps" / "spring" / "cost.tsv").exists()
+    capsys.readouterr()
+
+
+def test_cost_points_mark_the_default_and_note_what_is_not_drawn():
+    rows = [row("dt", 1.0, 5e-4, 100), row("dt", 2.0, 5e-3, 50), row("dt", 0.5, 0.0, 200),
+            row("k", 1.0, 5e-4, 100), row("k", 3.0, None, 80, status="unstable")]
+    curves, default, notes = report.cost_points(rows)
+    assert default == (100, 5e-4)
+    assert curves["dt"] == [(100, 5e-4, ""), (50, 5e-3, "x2")] and curves["k"] == [(100, 5e-4, "")]
+    assert any("dt x0.5: not drawn: error 0 is not positive" in n for n in notes)
+    assert any("k x3: not drawn (status unstable" in n for n in notes)
+
+
+@needs_gnuplot
+def test_report_section_draws_the_diagram_and_the_table(project, capsys):
+    add_sweeps(project)
+    assert main(["run", "spring"]) == 0
+    assert main(["cost", "spring"]) == 0
+    assert main(["report", "spring"]) == 0
+    capsys.readouterr()
+    page = (project / "reports" / "index.html").read_text()
+    assert "Error against cost" in page and "Cheapest setting meeting each tolerance" in page
+    assert (project / "reports" / "figures" / "spring_error_cost_sweep.svg").is_file()
+    assert "default tier setting" in (project / "reports" / "figures" / "spring_error_cost_sweep.svg").read_text()
+    for tol in ("0.01", "0.001", "0.0001"):
+        assert f"<td>{tol}</td>" in page
+    assert "<td>default</td>" in page           # the default (error 0) is the cheapest meeting every tolerance
+    summary = (project / "reports" / "summary.md").read_text()
+    assert "**Error against cost**" in summary and "| 0.01 | default |" in summary
+
+
+def test_report_without_results_says_how_to_get_them(project, capsys):
+    add_sweeps(project)
+    write_spring_runs(project / "reports" / "runs")
+    assert main(["report", "spring"]) == 0
+    capsys.readouterr()
+    assert "python3 -m harness cost spring" in (project / "reports" / "index.html").read_text()
+
+
+def test_report_notes_a_cost_table_older_than_the_declarations(project, capsys):
+    path = add_sweeps(project)
+    assert main(["run", "spring"]) == 0
+    assert main(["cost", "spring"]) == 0
+    later = (project / "reports" / "sweeps" / "spring" / "cost.tsv").stat().st_mtime + 10
+    os.utime(path, (later, later))
+    assert main(["report", "spring"]) == 0
+    capsys.readouterr()
+    assert "cost.tsv is older than case.txt" in (project / "reports" / "index.html").read_text()

@@ -108,6 +108,8 @@ struct bal_settings {
     double stress_step;   /* horizontal step between overlapping cells (0 = the width) */
     double overlap_budget; /* stop when an overlap exceeds this share of the smaller radius (0.5; 0 = off) */
     double energy_guard;  /* stop when the run creates this share of its energy throughput (1; 0 = off) */
+    long allow_overlap;   /* 1: discs may overlap each other or walls at the start (0) */
+    long force_dt;        /* 1: accept a time step at or above the stability estimate (0) */
     int integrator;       /* enum bal_integrator (centred) */
     BAL_SECTION_TAIL;
 };

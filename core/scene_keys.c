@@ -66,6 +66,10 @@ const struct bal_key bal_scene_keys[] = {
      "stop the run when an overlap exceeds this share of the smaller radius of the pair; 0 = off"},
     {BAL_SEC_SETTINGS, "energy_guard", BAL_KEY_DOUBLE, S(energy_guard), "1", 0, 0, BIG, NULL,
      "stop the run when it has created this share of the energy that went through it; 0 = off"},
+    {BAL_SEC_SETTINGS, "allow_overlap", BAL_KEY_LONG, S(allow_overlap), "0", 0, 0, 1, NULL,
+     "1: bodies may overlap at the start (refused otherwise: the overlap is named)"},
+    {BAL_SEC_SETTINGS, "force_dt", BAL_KEY_LONG, S(force_dt), "0", 0, 0, 1, NULL,
+     "1: run with a time step at or above the stability estimate (refused otherwise)"},
     {BAL_SEC_SETTINGS, "integrator", BAL_KEY_ENUM, S(integrator), "centred", 0, 0, 0,
      "centred verlet gear5",
      "law of motion: centred (C&S eqs 22-23, 35-36), verlet (velocity Verlet), gear5 (Gear "

@@ -313,6 +313,54 @@ static enum bal_status resolve_body(const struct bal_sim *s, const struct bal_sc
     return BAL_EINVAL;
 }
 
+/* Bodies that overlap at the start are refused unless the scene allows it:
+ * an overlap nobody meant is a typo, and it starts the run with energy the
+ * scene never declared.  Two held discs may overlap (they never move: MLH's
+ * bumpy bottoms with c < 0); touching within 1e-9 of the radius is contact. */
+static enum bal_status check_overlaps(const struct bal_sim *s, struct bal_error *err)
+{
+    const struct bal_settings *st = &s->scene->settings;
+    if (st->allow_overlap)
+        return BAL_OK;
+    for (int list = 0; list < 2; list++) {
+        const struct bal_pairs *p = list ? &s->pw : &s->pp;
+        for (long c = 0; c < p->n; c++) {
+            const int i = p->i[c], j = p->j[c];
+            double delta, rmin;
+            if (list) {
+                double cx, cy;
+                delta = s->r[i] - sqrt(bal_walls_closest(&s->walls[j], s->x[i], s->y[i], &cx, &cy));
+                rmin = s->r[i];
+                if (s->fixed[i])
+                    continue;
+            } else {
+                delta = s->r[i] + s->r[j] - hypot(s->x[j] - s->x[i], s->y[j] - s->y[i]);
+                rmin = fmin(s->r[i], s->r[j]);
+                if (s->fixed[i] && s->fixed[j])
+                    continue;
+            }
+            if (delta <= 1e-9 * rmin)
+                continue;
+            char a[2 * BAL_NAME_MAX], b[3 * BAL_NAME_MAX];
+            bal_output_disc_name(s, s->id[i], a, sizeof a);
+            if (list) {
+                snprintf(b, sizeof b, "wall %s", s->walls[j].name);
+            } else {
+                char d[2 * BAL_NAME_MAX];
+                bal_output_disc_name(s, s->id[j], d, sizeof d);
+                snprintf(b, sizeof b, "disc %s", d);
+            }
+            const int line = st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "allow_overlap")];
+            return bal_error(err, BAL_EINVAL,
+                             "%s:%d: allow_overlap: disc %s and %s overlap by %.6g (%.3g of the "
+                             "smaller radius) at the start; expected bodies apart or touching, or "
+                             "settings.allow_overlap = 1",
+                             s->scene->path, line, a, b, delta, delta / rmin);
+        }
+    }
+    return BAL_OK;
+}
+
 enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
                                struct bal_error *err)
 {
@@ -487,6 +535,16 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
     /* Time step. */
     s->dt_estimate = bal_timestep_estimate(s);
     s->dt = st->dt > 0 ? st->dt : st->dt_fraction * s->dt_estimate;
+    if (s->dt >= s->dt_estimate && !st->force_dt) {
+        const char *key = st->dt > 0 ? "dt" : "dt_fraction";
+        const int line = st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, key)];
+        bal_error(err, BAL_EINVAL,
+                  "%s:%d: %s: the time step %.6g is at or above the stability estimate %.6g "
+                  "(bin/ballast info); expected a smaller one, or settings.force_dt = 1 to run it "
+                  "anyway", sc->path, line, key, s->dt, s->dt_estimate);
+        bal_sim_free(s);
+        return BAL_EINVAL;
+    }
     if (!(s->dt > 0 && isfinite(s->dt))) {
         bal_sim_free(s);
         return bal_error(err, BAL_EINVAL, "%s: time step %g is not a positive number", sc->path,
@@ -507,7 +565,7 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
     s->pw.shear = 1;
     s->pw.damping = 1;
     s->pair_loop = bal_contacts_select(s->normal_law, s->has_shear, s->has_damping);
-    if (bal_grid_rebuild(s, err)) {
+    if (bal_grid_rebuild(s, err) || check_overlaps(s, err)) {
         bal_sim_free(s);
         return err->code;
     }

@@ -234,6 +234,8 @@ START_TEST(energy_runaway_guard)
     snprintf(text + len, sizeof text - (size_t)len, "[stage s]\ncycles = 100000\n");
     struct tfx *f = tfx_parse(text, "runaway");
     f->sc.settings.dt = 0;
+    f->sc.settings.allow_overlap = 1;
+    f->sc.settings.force_dt = 1;
     ck_assert_int_eq(tfx_create(f), BAL_OK);
     /* 1.3 x the single-spring limit, whatever the estimate says */
     const double m = BAL_PI * 0.25, k = 1e4;

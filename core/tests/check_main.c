@@ -69,6 +69,10 @@ enum bal_status tfx_create(struct tfx *f)
 struct tfx *tfx_new(const char *text, const char *name)
 {
     struct tfx *f = tfx_parse(text, name);
+    /* Unit tests place bodies in contact and pick steps on purpose: the
+     * refusals of bal_sim_create are tested on their own (check_scene.c). */
+    f->sc.settings.allow_overlap = 1;
+    f->sc.settings.force_dt = 1;
     enum bal_status st = tfx_create(f);
     ck_assert_msg(st == BAL_OK, "scene %s: bal_sim_create failed: %s", name, f->err.msg);
     return f;

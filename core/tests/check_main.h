@@ -47,7 +47,9 @@ struct tfx {
 /* A fresh scene parsed from `text` (named `name` in messages); asserts that
  * the text parses.  No simulation yet. */
 struct tfx *tfx_parse(const char *text, const char *name);
-/* tfx_parse, then bal_sim_create; asserts both succeed. */
+/* tfx_parse, then bal_sim_create; asserts both succeed.  It sets
+ * settings.allow_overlap and force_dt: unit tests start bodies in contact
+ * and pick their steps on purpose (the refusals are tested on their own). */
 struct tfx *tfx_new(const char *text, const char *name);
 /* Same, with the text formatted like printf (at most T_TEXT_MAX chars). */
 struct tfx *tfx_newf(const char *name, const char *fmt, ...)

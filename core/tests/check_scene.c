@@ -252,7 +252,7 @@ END_TEST
 struct bad_scene {
     const char *what;
     const char *text;
-    char refused_by;      /* 'p': bal_scene_parse, 'v': bal_scene_validate */
+    char refused_by;      /* 'p': bal_scene_parse, 'v': bal_scene_validate, 'c': bal_sim_create */
     const char *expect;   /* substring of the message */
 };
 
@@ -340,11 +340,57 @@ static const struct bad_scene bad_scenes[] = {
      "[material m]\nkn = 1e5\ndensity = 2\n[fill f]\nn = 4\ncolumns = 2\nrmin = 0.5\n"
      "rmax = 0.25\nmaterial = m\n" STAGE,
      'v', "bad:8: rmax: expected rmax >= rmin"},
+    {"stage without cycles", HEAD "[stage s]\nstop_ke = 1e-6\n", 'v',
+     "bad:8: [stage s]: cycles: required key is missing"},
+    {"discs overlapping at the start",
+     "[material m]\nkn = 1e5\ndensity = 2\n[disc a]\nx = 0 0\nr = 0.5\nmaterial = m\n"
+     "[disc b]\nx = 0.9 0\nr = 0.5\nmaterial = m\n" STAGE, 'c',
+     "allow_overlap: disc a and disc b overlap by 0.1 (0.2 of the smaller radius) at the start"},
+    {"disc overlapping a wall at the start",
+     "[material m]\nkn = 1e5\ndensity = 2\n[disc a]\nx = 0 0.25\nr = 0.5\nmaterial = m\n"
+     "[wall floor]\np = -1 0\nangle = 0\nh1 = 0\nh2 = 2\nmaterial = m\n" STAGE, 'c',
+     "allow_overlap: disc a and wall floor overlap by 0.25"},
+    {"explicit time step above the estimate",
+     "[settings]\ndt = 1\n[material m]\nkn = 1e5\ndensity = 2\n"
+     "[disc a]\nx = 0 0\nr = 0.5\nmaterial = m\n" STAGE, 'c',
+     "bad:2: dt: the time step 1 is at or above the stability estimate"},
+    {"time-step fraction 1", "[settings]\ndt_fraction = 1\n" HEAD STAGE, 'c',
+     "bad:2: dt_fraction: the time step"},
     {"fill box without wall material",
      "[material m]\nkn = 1e5\ndensity = 2\n[fill f]\nn = 4\ncolumns = 2\nrmin = 0.5\n"
      "rmax = 0.5\nmaterial = m\nbox = 1\n" STAGE,
      'v', "bad:4: wall_material: required with box = 1"},
 };
+
+/* What the refusals let through: touching bodies, two held discs that
+ * overlap (MLH's bumpy bottoms with c < 0), and overlaps or steps the
+ * scene allows or forces. */
+START_TEST(scene_allowed_overlaps_and_forced_steps)
+{
+    static const char *const good[] = {
+        "[material m]\nkn = 1e5\ndensity = 2\n[disc a]\nx = 0 0\nr = 0.5\nmaterial = m\n"
+        "[disc b]\nx = 1 0\nr = 0.5\nmaterial = m\n" STAGE,
+        "[material m]\nkn = 1e5\ndensity = 2\n[disc a]\nx = 0 0\nr = 0.5\nfixed = 1\nmaterial = m\n"
+        "[disc b]\nx = 0.9 0\nr = 0.5\nfixed = 1\nmaterial = m\n" STAGE,
+        "[settings]\nallow_overlap = 1\n[material m]\nkn = 1e5\ndensity = 2\n"
+        "[disc a]\nx = 0 0\nr = 0.5\nmaterial = m\n[disc b]\nx = 0.9 0\nr = 0.5\nmaterial = m\n" STAGE,
+        "[settings]\ndt = 1\nforce_dt = 1\n[material m]\nkn = 1e5\ndensity = 2\n"
+        "[disc a]\nx = 0 0\nr = 0.5\nmaterial = m\n" STAGE,
+    };
+    for (size_t k = 0; k < sizeof good / sizeof good[0]; k++) {
+        struct bal_scene sc;
+        struct bal_error err = {0};
+        struct bal_sim *sim = NULL;
+        bal_scene_default(&sc);
+        enum bal_status st = bal_scene_parse(&sc, good[k], "good", &err);
+        if (st == BAL_OK)
+            st = bal_sim_create(&sim, &sc, &err);
+        bal_sim_free(sim);
+        bal_scene_free(&sc);
+        ck_assert_msg(st == BAL_OK, "scene %zu refused: %s", k, err.msg);
+    }
+}
+END_TEST
 
 START_TEST(scene_bad_scene_refused)
 {
@@ -358,19 +404,26 @@ START_TEST(scene_bad_scene_refused)
         stage = 'v';
         st = bal_scene_validate(&sc, &err);
     }
-    /* bal_sim_create validates too: it must refuse the scene as well. */
+    /* bal_sim_create validates too: it must refuse the scene as well; and
+     * what only a built simulation can see (overlaps, the time step against
+     * the estimate) it refuses itself ('c'). */
     enum bal_status st_create = BAL_OK;
     if (stage == 'v' && st != BAL_OK) {
         struct bal_sim *sim = NULL;
         struct bal_error err2 = {0};
         st_create = bal_sim_create(&sim, &sc, &err2);
         bal_sim_free(sim);
+    } else if (stage == 'v') {
+        struct bal_sim *sim = NULL;
+        stage = 'c';
+        st = bal_sim_create(&sim, &sc, &err);
+        bal_sim_free(sim);
     }
     bal_scene_free(&sc);
     ck_assert_msg(st == BAL_EINVAL, "%s: status %d, message '%s'", b->what, st, err.msg);
     ck_assert_int_eq(err.code, BAL_EINVAL);
-    ck_assert_msg(stage == b->refused_by, "%s: refused by %s, expected by %s", b->what,
-                  stage == 'p' ? "parse" : "validate", b->refused_by == 'p' ? "parse" : "validate");
+    ck_assert_msg(stage == b->refused_by, "%s: refused at stage %c, expected %c (p parse, "
+                  "v validate, c create)", b->what, stage, b->refused_by);
     ck_assert_msg(t_contains(err.msg, b->expect), "%s: message '%s' lacks '%s'", b->what, err.msg,
                   b->expect);
     if (stage == 'v')
@@ -776,6 +829,7 @@ Suite *suite_scene(void)
                         (int)(sizeof bad_files / sizeof bad_files[0]));
     tcase_add_loop_test(tc, scene_bad_set_refused, 0, (int)(sizeof bad_sets / sizeof bad_sets[0]));
     tcase_add_test(tc, scene_long_line_refused);
+    tcase_add_test(tc, scene_allowed_overlaps_and_forced_steps);
     tcase_add_test(tc, scene_missing_file_is_eio);
     tcase_add_test(tc, scene_strerror_names_every_status);
     suite_add_tcase(s, tc);

@@ -4,6 +4,7 @@
 #   make sweep        the declared error-against-cost sweeps alone (needs the default runs)
 #   make test         C unit tests (Check), symbol-prefix check, harness tests (pytest)
 #   make test-sanitize  C unit tests under AddressSanitizer + UndefinedBehaviorSanitizer
+#   make test-valgrind  one case under valgrind memcheck
 #   make bench        dense-packing benchmark (median and spread of 5 repeats)
 #   make bench-peer   ballast against LAMMPS on the same physics (cross-check, then the race)
 #   make clean
@@ -30,7 +31,7 @@ TEST_SRC := $(wildcard core/tests/check_*.c)
 BENCH_SRC := core/bench/bench.c
 
 .PHONY: all deps test test-c test-prefix test-py test-sanitize validate bench bench-scaling \
-        bench-peer bench-modules clean keys sweep
+        bench-peer bench-modules clean keys sweep test-valgrind
 
 all: deps bin/ballast
 
@@ -80,6 +81,22 @@ $(BUILD)/san/check_ballast: $(TEST_SRC) $(SAN_OBJ) core/tests/check_main.h
 test-sanitize: deps $(BUILD)/san/check_ballast
 	cd core/tests && CK_FORK=no ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ../../$(BUILD)/san/check_ballast
+
+# Cases under valgrind's memcheck: an independent look at the memory the
+# sanitizers also watch, on the real command line (scene file, outputs, run.json):
+# two discs (all pairs, damping), a pile (cell grid, ramp, stop rule) and the exact solver.
+test-valgrind: bin/ballast
+	@command -v valgrind >/dev/null || { echo "test-valgrind: valgrind is not installed (sh .ci/install-deps)"; exit 1; }
+	rm -rf $(BUILD)/valgrind && mkdir -p $(BUILD)/valgrind
+	valgrind -q --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite,possible \
+	  bin/ballast run cases/two_discs/two_discs.scene --out $(BUILD)/valgrind/two_discs \
+	  --set settings.alpha=10 --set settings.beta=0.005
+	valgrind -q --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite,possible \
+	  bin/ballast run cases/piles/pile30_smooth.scene --out $(BUILD)/valgrind/pile \
+	  --set stage.ramp.cycles=500 --set stage.relax.cycles=500
+	valgrind -q --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite,possible \
+	  bin/ballast exact cases/piles/pile30_smooth.scene --out $(BUILD)/valgrind/exact
+	@echo "test-valgrind: two_discs (damped), a pile (grid, stages) and the exact solver clean under memcheck"
 
 # ---- validation -----------------------------------------------------------
 validate: all

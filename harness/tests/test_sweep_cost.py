@@ -203,7 +203,8 @@ def test_unsettled_stop_rule_is_noted(tmp_path):
 # ---------------------------------------------------------------- the cheapest-setting table
 
 def row(sweep_name, factor, error, ps, status="ok", wall=1.0):
-    return {"sweep": sweep_name, "factor": factor, "sets": f"k={factor}", "status": status, "steps": ps,
+    return {"sweep": sweep_name, "factor": factor, "sets": "(default)" if factor == 1.0 else f"k={factor}",
+            "status": status, "steps": ps,
             "n_discs": 1, "particle_steps": ps, "wall_seconds": wall, "error": error, "worst": "t", "note": ""}
 
 
@@ -268,11 +269,12 @@ def test_validate_runs_the_sweeps_unless_told_not_to(project, capsys):
 def test_cost_points_mark_the_default_and_note_what_is_not_drawn():
     rows = [row("dt", 1.0, 5e-4, 100), row("dt", 2.0, 5e-3, 50), row("dt", 0.5, 0.0, 200),
             row("k", 1.0, 5e-4, 100), row("k", 3.0, None, 80, status="unstable")]
-    curves, default, notes = report.cost_points(rows)
+    curves, default, notes, bad = report.cost_points(rows)
     assert default == (100, 5e-4)
     assert curves["dt"] == [(100, 5e-4, ""), (50, 5e-3, "x2")] and curves["k"] == [(100, 5e-4, "")]
     assert any("dt x0.5: not drawn: error 0 is not positive" in n for n in notes)
-    assert any("k x3: not drawn (status unstable" in n for n in notes)
+    assert bad == {"k": [(80, "x3 unstable")]}          # drawn at the top, labelled
+    assert any("k x3: unstable (drawn at the top" in n for n in notes)
 
 
 @needs_gnuplot

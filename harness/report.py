@@ -596,6 +596,7 @@ class CostOut:
     rows: list = field(default_factory=list)
     cheapest: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
+    meta: list = field(default_factory=list)     # what the error means, when not the usual definition
 
 
 def cost_section(case, reports_dir, figures_dir):
@@ -605,6 +606,12 @@ def cost_section(case, reports_dir, figures_dir):
     if not case.sweeps:
         return None
     out = CostOut()
+    selfconv = [s.name for s in case.sweeps if s.converge]
+    if selfconv:
+        out.meta.append(f"Self-convergence ({', '.join(selfconv)}): the error of these sweeps is the largest "
+                        "|q - q_finest| / |q_finest| over their `converge =` quantities, against the finest "
+                        "(most particle-steps) run of the same sweep — an error against the finest swept run, "
+                        "not against a reference. The finest run itself has no error.")
     path = sweep.cost_path(Path(reports_dir) / "sweeps", case.name)
     try:
         out.rows = sweep.read_tsv(path)
@@ -620,10 +627,10 @@ def cost_section(case, reports_dir, figures_dir):
 
 
 def cost_points(rows):
-    """({sweep: [(cost, error, label)]} sorted by factor, the default point or None, notes,
+    """({sweep: [(cost, error, label)]} sorted by factor, the default points (one per swept variant), notes,
     {sweep: [(cost, label)]} of the failed points (unstable: drawn at the top of the diagram))."""
     from .sweep import failed, is_default
-    curves, default, notes, bad = {}, None, [], {}
+    curves, defaults, notes, bad = {}, [], [], {}
     for r in rows:
         x, y = r["particle_steps"], r["error"]
         what = "default" if is_default(r) else f"{r['sweep']} x{r['factor']:g}"
@@ -635,21 +642,22 @@ def cost_points(rows):
                 notes.append(f"{what}: {r['status']}, not drawn ({r['note'] or 'no cost'})")
             continue
         if x is None or y is None:
-            if not is_default(r) or default is None:
+            if not is_default(r) or not defaults:
                 notes.append(f"{what}: not drawn (no error: {r['note'] or 'no error term'})")
             continue
         if not (x > 0 and y > 0):
             notes.append(f"{what}: not drawn: error {y:.3g} is not positive (log scale)")
             continue
-        if is_default(r):
-            default = (x, y)
+        if is_default(r) and (x, y) not in defaults:
+            defaults.append((x, y))
         curves.setdefault(r["sweep"], []).append((r["factor"], x, y, is_default(r)))
-    return ({k: [(x, y, "" if d else f"x{f:g}") for f, x, y, d in sorted(v)] for k, v in curves.items()}, default,
+    return ({k: [(x, y, "" if d else f"x{f:g}") for f, x, y, d in sorted(v)] for k, v in curves.items()}, defaults,
             list(dict.fromkeys(notes)),
             {k: [(x, f"x{f:g} {UNSTABLE}") for f, x in sorted(v)] for k, v in bad.items()})
 
 
 UNSTABLE = "unstable"
+POINT_TYPES = (7, 6, 5, 4, 9, 8, 11, 10, 13, 12)
 
 
 def render_cost(case, rows, figures_dir):
@@ -659,7 +667,7 @@ def render_cost(case, rows, figures_dir):
     png, svg = (Path(figures_dir) / f"{case.name}_error_cost_sweep.{ext}" for ext in ("png", "svg"))
     for old in (png, svg):
         old.unlink(missing_ok=True)
-    curves, default, out.notes, bad = cost_points(rows)
+    curves, defaults, out.notes, bad = cost_points(rows)
     if not curves and not bad:
         out.notes.append("nothing to plot")
         return out
@@ -678,18 +686,20 @@ def render_cost(case, rows, figures_dir):
             if name in curves:
                 path = Path(workdir) / f"curve{i}.dat"
                 path.write_text("".join(f"{x!r}\t{y!r}\t{label}\n" for x, y, label in curves[name]), encoding="utf-8")
-                clauses += [f"{gp_string(path)} using 1:2 with linespoints pt 7 ps 1 lc {i + 1} title {gp_string(name)}",
+                # point types cycle filled/open, so curves that coincide (verlet on centred) stay visible
+                clauses += [f"{gp_string(path)} using 1:2 with linespoints pt {POINT_TYPES[i % len(POINT_TYPES)]} "
+                            f"ps {1.0 if i % 2 == 0 else 1.6} lc {i + 1} title {gp_string(name)}",
                             f"{gp_string(path)} using 1:2:3 with labels left offset char 0.6,0.5 tc lt {i + 1} notitle"]
             if name in bad:
                 path = Path(workdir) / f"failed{i}.dat"
-                path.write_text("".join(f"{x!r}\t{top!r}\t{label}\n" for x, label in bad[name]), encoding="utf-8")
+                path.write_text("".join(f"{x!r}\t{top!r}\t\"{label}\"\n" for x, label in bad[name]), encoding="utf-8")
                 clauses += [f"{gp_string(path)} using 1:2 with points pt 2 ps 2 lw 2 lc {i + 1} "
                             f"title {gp_string(name + ': ' + UNSTABLE)}",
                             f"{gp_string(path)} using 1:2:3 with labels rotate by 90 left offset char 0,1 "
                             f"tc lt {i + 1} notitle"]
-        if default:
+        if defaults:
             path = Path(workdir) / "default.dat"
-            path.write_text(f"{default[0]!r}\t{default[1]!r}\n", encoding="utf-8")
+            path.write_text("".join(f"{x!r}\t{y!r}\n" for x, y in defaults), encoding="utf-8")
             clauses.append(f"{gp_string(path)} using 1:2 with points pt 3 ps 3 lw 2 lc rgb 'black' "
                            "title 'default tier setting'")
         extra = ["set logscale xy", "set key outside"]
@@ -726,6 +736,7 @@ def _cost_html(cost):
     if cost is None:
         return ""
     parts = ["<h3>Error against cost</h3>", f"<p class=\"meta\">{esc(COST_TEXT)}</p>"]
+    parts += [f"<p><b>{esc(m)}</b></p>" for m in cost.meta]
     parts += [f"<p class=\"bad\">{esc(n)}</p>" for n in cost.notes]
     if cost.figure:
         parts.append(image_html(cost.figure))
@@ -756,6 +767,7 @@ def _cost_markdown(cost):
     if cost is None:
         return []
     lines = ["**Error against cost** (declared sweeps; cost = particle-steps)", ""]
+    lines += [f"- {_md(m)}" for m in cost.meta]
     lines += [f"- {_md(n)}" for n in cost.notes]
     if cost.figure and cost.figure.png:
         lines += [f"![error against cost](figures/{cost.figure.png.name})", ""]

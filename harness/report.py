@@ -582,7 +582,12 @@ COST_TEXT = ("Error against cost: every declared [sweep] of the case (harness/sw
              "point reference of kind analytic, exact or paper, and of the sweep's `error =` quantities "
              "(relative deviations from a reference solution). Cost = particle-steps = steps x discs. "
              "Each curve is one swept parameter (points labelled by the factor applied to its default); "
-             "the black star is the default tier's setting.")
+             "a sweep with fixed `set =` overrides (e.g. the integrator) is a curve of its own, its factor 1 "
+             "run with the overrides. The black star is the default tier's setting. A run that failed "
+             "(unstable: the overlap-budget or energy-runaway guard stopped it) has no error: it is a cross "
+             "labelled 'unstable' on the dotted line at the top, at the cost it spent before stopping. "
+             "A sweep with `converge =` quantities measures self-convergence: the error is against the "
+             "finest (most expensive) run of the same sweep, not against a reference.")
 
 
 @dataclass
@@ -591,6 +596,7 @@ class CostOut:
     rows: list = field(default_factory=list)
     cheapest: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
+    meta: list = field(default_factory=list)     # what the error means, when not the usual definition
 
 
 def cost_section(case, reports_dir, figures_dir):
@@ -600,6 +606,12 @@ def cost_section(case, reports_dir, figures_dir):
     if not case.sweeps:
         return None
     out = CostOut()
+    selfconv = [s.name for s in case.sweeps if s.converge]
+    if selfconv:
+        out.meta.append(f"Self-convergence ({', '.join(selfconv)}): the error of these sweeps is the largest "
+                        "|q - q_finest| / |q_finest| over their `converge =` quantities, against the finest "
+                        "(most particle-steps) run of the same sweep — an error against the finest swept run, "
+                        "not against a reference. The finest run itself has no error.")
     path = sweep.cost_path(Path(reports_dir) / "sweeps", case.name)
     try:
         out.rows = sweep.read_tsv(path)
@@ -615,53 +627,89 @@ def cost_section(case, reports_dir, figures_dir):
 
 
 def cost_points(rows):
-    """({sweep: [(cost, error, label)]} sorted by factor, the default point or None, notes)."""
-    curves, default, notes = {}, None, []
+    """({sweep: [(cost, error, label)]} sorted by factor, the default points (one per swept variant), notes,
+    {sweep: [(cost, label)]} of the failed points (unstable: drawn at the top of the diagram))."""
+    from .sweep import failed, is_default
+    curves, defaults, notes, bad = {}, [], [], {}
     for r in rows:
         x, y = r["particle_steps"], r["error"]
-        what = "default" if r["factor"] == 1.0 else f"{r['sweep']} x{r['factor']:g}"
-        if r["status"] != "ok" or x is None or y is None:
-            if r["factor"] != 1.0 or default is None:
-                notes.append(f"{what}: not drawn (status {r['status']}; {r['note'] or 'no error'})")
+        what = "default" if is_default(r) else f"{r['sweep']} x{r['factor']:g}"
+        if failed(r):
+            if x is not None and x > 0:
+                bad.setdefault(r["sweep"], []).append((r["factor"], x))
+                notes.append(f"{what}: {r['status']} (drawn at the top, at the cost it spent before stopping)")
+            else:
+                notes.append(f"{what}: {r['status']}, not drawn ({r['note'] or 'no cost'})")
+            continue
+        if x is None or y is None:
+            if not is_default(r) or not defaults:
+                notes.append(f"{what}: not drawn (no error: {r['note'] or 'no error term'})")
             continue
         if not (x > 0 and y > 0):
             notes.append(f"{what}: not drawn: error {y:.3g} is not positive (log scale)")
             continue
-        if r["factor"] == 1.0:
-            default = (x, y)
-        curves.setdefault(r["sweep"], []).append((r["factor"], x, y))
-    return ({k: [(x, y, "" if f == 1.0 else f"x{f:g}") for f, x, y in sorted(v)] for k, v in curves.items()}, default,
-            list(dict.fromkeys(notes)))
+        if is_default(r) and (x, y) not in defaults:
+            defaults.append((x, y))
+        curves.setdefault(r["sweep"], []).append((r["factor"], x, y, is_default(r)))
+    return ({k: [(x, y, "" if d else f"x{f:g}") for f, x, y, d in sorted(v)] for k, v in curves.items()}, defaults,
+            list(dict.fromkeys(notes)),
+            {k: [(x, f"x{f:g} {UNSTABLE}") for f, x in sorted(v)] for k, v in bad.items()})
+
+
+UNSTABLE = "unstable"
+POINT_TYPES = (7, 6, 5, 4, 9, 8, 11, 10, 13, 12)
 
 
 def render_cost(case, rows, figures_dir):
-    """The log-log diagram: error (y) against particle-steps (x), one curve per sweep, default marked."""
+    """The log-log diagram: error (y) against particle-steps (x), one curve per sweep, default marked;
+    failed (unstable) points as crosses on a line at the top, labelled "unstable"."""
     out = FigureOut("error_cost_sweep", f"{case.name}: error against cost (declared sweeps)")
     png, svg = (Path(figures_dir) / f"{case.name}_error_cost_sweep.{ext}" for ext in ("png", "svg"))
     for old in (png, svg):
         old.unlink(missing_ok=True)
-    curves, default, out.notes = cost_points(rows)
-    if not curves:
+    curves, defaults, out.notes, bad = cost_points(rows)
+    if not curves and not bad:
         out.notes.append("nothing to plot")
         return out
     if not shutil.which("gnuplot"):
         out.notes.append("gnuplot not found: figure not rendered")
         return out
     figure = _CostAxes(out.title)
+    if any(str(r["worst"]).startswith("vs finest: ") for r in rows):
+        figure.ylabel = "error: max |q - q_finest| / |q_finest| (against the finest swept run)"
+    errors = [y for pts in curves.values() for _, y, _ in pts]
+    top = max(errors) * 10 if errors else 1.0
+    names = list(dict.fromkeys(list(curves) + list(bad)))
     with tempfile.TemporaryDirectory(prefix="ballast-cost-") as workdir:
         clauses = []
-        for i, (name, pts) in enumerate(curves.items()):
-            path = Path(workdir) / f"curve{i}.dat"
-            path.write_text("".join(f"{x!r}\t{y!r}\t{label}\n" for x, y, label in pts), encoding="utf-8")
-            clauses += [f"{gp_string(path)} using 1:2 with linespoints pt 7 ps 1 lc {i + 1} title {gp_string(name)}",
-                        f"{gp_string(path)} using 1:2:3 with labels left offset char 0.6,0.5 tc lt {i + 1} notitle"]
-        if default:
+        for i, name in enumerate(names):
+            if name in curves:
+                path = Path(workdir) / f"curve{i}.dat"
+                path.write_text("".join(f"{x!r}\t{y!r}\t{label}\n" for x, y, label in curves[name]), encoding="utf-8")
+                # point types cycle filled/open, so curves that coincide (verlet on centred) stay visible
+                clauses += [f"{gp_string(path)} using 1:2 with linespoints pt {POINT_TYPES[i % len(POINT_TYPES)]} "
+                            f"ps {1.0 if i % 2 == 0 else 1.6} lc {i + 1} title {gp_string(name)}",
+                            f"{gp_string(path)} using 1:2:3 with labels left offset char 0.6,0.5 tc lt {i + 1} notitle"]
+            if name in bad:
+                path = Path(workdir) / f"failed{i}.dat"
+                path.write_text("".join(f"{x!r}\t{top!r}\t\"{label}\"\n" for x, label in bad[name]), encoding="utf-8")
+                clauses += [f"{gp_string(path)} using 1:2 with points pt 2 ps 2 lw 2 lc {i + 1} "
+                            f"title {gp_string(name + ': ' + UNSTABLE)}",
+                            f"{gp_string(path)} using 1:2:3 with labels rotate by 90 left offset char 0,1 "
+                            f"tc lt {i + 1} notitle"]
+        if defaults:
             path = Path(workdir) / "default.dat"
-            path.write_text(f"{default[0]!r}\t{default[1]!r}\n", encoding="utf-8")
+            path.write_text("".join(f"{x!r}\t{y!r}\n" for x, y in defaults), encoding="utf-8")
             clauses.append(f"{gp_string(path)} using 1:2 with points pt 3 ps 3 lw 2 lc rgb 'black' "
                            "title 'default tier setting'")
-        error = _run_gnuplot(gnuplot_script(figure, clauses, png, svg, ["set logscale xy", "set key outside"]),
-                             workdir)
+        extra = ["set logscale xy", "set key outside"]
+        if bad:
+            extra.append(f"set arrow from graph 0, first {top!r} to graph 1, first {top!r} nohead dt 3 lc rgb 'gray'")
+            extra.append(f"set label {gp_string('failed runs (' + UNSTABLE + '): no error')} at graph 0.01, "
+                         f"first {top!r} offset 0,-0.8 tc rgb 'gray'")
+            if errors:
+                extra.append(f"set yrange [{min(errors) / 3!r}:{top * 30!r}]")
+        error = _run_gnuplot(gnuplot_script(figure, clauses, png, svg, extra), workdir)
     if error:
         out.notes.append(f"gnuplot failed: {error}")
     out.png = png if png.is_file() and png.stat().st_size else None
@@ -688,6 +736,7 @@ def _cost_html(cost):
     if cost is None:
         return ""
     parts = ["<h3>Error against cost</h3>", f"<p class=\"meta\">{esc(COST_TEXT)}</p>"]
+    parts += [f"<p><b>{esc(m)}</b></p>" for m in cost.meta]
     parts += [f"<p class=\"bad\">{esc(n)}</p>" for n in cost.notes]
     if cost.figure:
         parts.append(image_html(cost.figure))
@@ -700,7 +749,7 @@ def _cost_html(cost):
         parts.append("<p>Cheapest setting meeting each tolerance (least particle-steps with error &le; tolerance):</p>")
         parts.append(table_html(["tolerance", "cheapest setting", "error", "particle-steps", "steps", "wall s"], rows))
         every = [[cell(r["sweep"]), cell(f"{r['factor']:g}", "num"), cell(r["sets"]), cell(r["status"]),
-                  cell(fmt_number(r["error"]), "num"), cell(r["worst"]), cell(fmt_number(r["particle_steps"]), "num"),
+                  cell(r["status"], "bad") if _failed(r) else cell(fmt_number(r["error"]), "num"), cell(r["worst"]), cell(fmt_number(r["particle_steps"]), "num"),
                   cell(fmt_number(r["steps"]), "num"), cell(fmt_number(r["wall_seconds"]), "num"), cell(r["note"])]
                  for r in cost.rows]
         parts.append("<details><summary>every point</summary>" +
@@ -709,10 +758,16 @@ def _cost_html(cost):
     return "\n".join(parts)
 
 
+def _failed(r):
+    from .sweep import failed
+    return failed(r)
+
+
 def _cost_markdown(cost):
     if cost is None:
         return []
     lines = ["**Error against cost** (declared sweeps; cost = particle-steps)", ""]
+    lines += [f"- {_md(m)}" for m in cost.meta]
     lines += [f"- {_md(n)}" for n in cost.notes]
     if cost.figure and cost.figure.png:
         lines += [f"![error against cost](figures/{cost.figure.png.name})", ""]
@@ -722,4 +777,7 @@ def _cost_markdown(cost):
         lines += [f"| {tol:g} | {_md(_setting(r)) if r else 'none of the swept settings'} | "
                   f"{fmt_number(r['error']) if r else '-'} | {fmt_number(r['particle_steps']) if r else '-'} |"
                   for tol, r in cost.cheapest.items()]
+        bad = [f"{r['sweep']} x{r['factor']:g}" for r in cost.rows if _failed(r)]
+        if bad:
+            lines += ["", f"- {UNSTABLE} (run failed, no error): {_md(', '.join(bad))}"]
     return lines + [""]

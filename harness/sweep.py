@@ -9,12 +9,22 @@ A case declares its sweeps in case.txt, one [sweep NAME] section per swept param
     factors = 0.5 2 4                        # a few factors around the default (1, the default, is implicit)
     scale = stage.load.cycles=40             # optional KEY=DEFAULT ...: set to DEFAULT / factor, a
                                              #   whole number (same simulated time, or same closure)
-    checks = damped_eq_A damped_eq_B         # optional: the error terms (default: every eligible check)
+    checks = damped_eq_A damped_eq_B         # optional: the error terms (default: every eligible check;
+                                             #   `checks = none`: no check, only error/converge terms)
     error = contact_error('exact')           # optional, repeatable: a quantity that is itself a
                                              #   relative deviation from a reference solution
+    set = settings.integrator=gear5          # optional, repeatable: a fixed override of every point
+    converge = max(Fn_C)                     # optional, repeatable: self-convergence (see below)
 
-The default point of every curve is the variant's own run of the default tier
-(reports/runs/<case>/<variant>); the swept runs go to reports/sweeps/<case>/<sweep>_x<factor>.
+The default point of a curve (factor 1) is the variant's own run of the default tier
+(reports/runs/<case>/<variant>), unless the sweep has `set =` overrides: then factor 1 is a
+point of its own, run with the overrides (reports/sweeps/<case>/<sweep>_x1), and the curve
+is labelled by the sweep's name (e.g. one curve per integrator).  The swept runs go to
+reports/sweeps/<case>/<sweep>_x<factor>.
+
+A point whose run failed (status unstable: the overlap budget or energy runaway guard stopped
+it, or no run.json) has no error; its row says so (status, note = the run's message) and the
+report draws it as "unstable" at the top of the diagram, at the cost it spent before stopping.
 
 The error of a run (one number, documented in README.md) is the largest of its error terms:
 
@@ -29,9 +39,16 @@ The error of a run (one number, documented in README.md) is the largest of its e
     expression (the term is then dropped from the whole curve and a note says so).
     Interval and trend checks have no point reference and never count; nor do regressions.
   * each `error =` expression: |value|.
+  * each `converge =` expression q (a scalar of the run): |q - q_f| / |q_f| (|q - q_f| when
+    q_f = 0), where q_f is the same quantity of the FINEST point of the same sweep, i.e. the
+    ok point of the most particle-steps.  This is self-convergence: an error against the
+    finest swept run, not against a reference; it is meaningful only for sweeps whose most
+    expensive run is the most accurate (dt, stop tolerances).  The finest point itself has
+    no such term (its note says so).
 
 Cost is particle-steps = steps x n_discs from run.json (wall-clock seconds are recorded too).
 """
+import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -41,7 +58,7 @@ from .ini import IniError
 from .runner import Job
 from .tables import RunProblem, load_run, read_run_json
 
-SWEEP_KEYS = {"variant", "keys", "factors", "scale", "checks", "error"}
+SWEEP_KEYS = {"variant", "keys", "factors", "scale", "checks", "error", "set", "converge"}
 POINT_TOLERANCES = ("abs", "rel", "ratio")
 ERROR_KINDS = ("analytic", "exact", "paper")
 TOLERANCES = (1e-2, 1e-3, 1e-4)
@@ -60,10 +77,18 @@ class Sweep:
     errors: list = field(default_factory=list)   # expressions
     path: str = ""
     line: int = 0
+    fixed: list = field(default_factory=list)    # `set =` overrides of every point: "KEY=VALUE"
+    converge: list = field(default_factory=list)  # self-convergence expressions
+    no_checks: bool = False                      # `checks = none`
+
+    def run_factors(self):
+        """The factors that are run by the sweep: with fixed overrides, 1 as well."""
+        return ([1.0] if self.fixed else []) + list(self.factors)
 
     def sets(self, factor):
         """The --set overrides of the point at factor."""
-        out = [f"{k}={number(d * factor)}" for k, d in self.keys]
+        out = list(self.fixed)
+        out += [f"{k}={number(d * factor)}" for k, d in self.keys]
         out += [f"{k}={round(d / factor)}" for k, d in self.scale]
         return out
 
@@ -106,9 +131,24 @@ def parse(section):
             if abs(scaled - round(scaled)) > 1e-9 * max(1.0, abs(scaled)) or round(scaled) < 1:
                 raise section.error(f"scale: {key} = {number(default)} / factor {number(f)} = {scaled:g} "
                                     "is not a whole number >= 1", section.entry("scale").line)
+    fixed = []
+    for entry in section.all("set"):
+        name, sep, value = entry.value.partition("=")
+        if not sep or not name.strip() or not value.strip() or " " in entry.value.strip():
+            raise section.error(f"'set' needs KEY=VALUE (no blanks), got '{entry.value}'", entry.line)
+        if name in [k for k, _ in keys + scale]:
+            raise section.error(f"'set': {name} is swept (keys/scale) and cannot be fixed", entry.line)
+        if name in [f.partition("=")[0] for f in fixed]:
+            raise section.error(f"'set': {name} given twice", entry.line)
+        fixed.append(entry.value.strip())
+    checks = section.get("checks", "").split()
+    no_checks = checks == ["none"]
+    if "none" in checks and not no_checks:
+        raise section.error("'checks = none' takes no other name", section.entry("checks").line)
     return Sweep(name=section.name, variant=section.require("variant"), keys=keys, factors=factors,
-                 scale=scale, checks=section.get("checks", "").split(),
-                 errors=[e.value for e in section.all("error")], path=section.path, line=section.line)
+                 scale=scale, checks=[] if no_checks else checks,
+                 errors=[e.value for e in section.all("error")], path=section.path, line=section.line,
+                 fixed=fixed, converge=[e.value for e in section.all("converge")], no_checks=no_checks)
 
 
 def _pairs(section, key, required):
@@ -152,9 +192,10 @@ def validate(cases, checks):
                 why = ineligible(mine[name], sweep.variant, case)
                 if why:
                     raise where(f"check '{name}' cannot measure the error: {why}")
-            if not terms_of(sweep, case, checks)[0] and not sweep.errors:
+            if not terms_of(sweep, case, checks)[0] and not sweep.errors and not sweep.converge:
                 raise where(f"nothing measures the error: no eligible check of variant '{sweep.variant}' "
-                            "(kind analytic/exact/paper, tolerance abs/rel/ratio) and no 'error ='")
+                            "(kind analytic/exact/paper, tolerance abs/rel/ratio), no 'error =' "
+                            "and no 'converge ='")
 
 
 def ineligible(check, variant, case):
@@ -174,6 +215,8 @@ def ineligible(check, variant, case):
 def terms_of(sweep, case, checks):
     """(the checks that make up the error, the names of eligible checks left out by `checks =`)."""
     mine = [c for c in checks if c.case == case.name and not ineligible(c, sweep.variant, case)]
+    if sweep.no_checks:
+        return [], [c.name for c in mine]
     if sweep.checks:
         return [c for c in mine if c.name in sweep.checks], [c.name for c in mine if c.name not in sweep.checks]
     return mine, []
@@ -240,6 +283,41 @@ def term_errors(case, variant, folder, runs_root, terms, errors, loaded=None):
     return out, siblings
 
 
+CONVERGE = "vs finest: "      # the name of a self-convergence term: CONVERGE + expression
+
+
+def converge_values(case, variant, folder, runs_root, exprs, loaded=None):
+    """{expression: its value in the run at folder, or a message (str)} for `converge =`."""
+    out, loaded = {}, {} if loaded is None else loaded
+    for expr in exprs:
+        store = _Recording(variant, folder, runs_root, loaded)
+        try:
+            out[expr] = quantity_in(store, case.name, variant, expr)
+        except (RunProblem, EvalError) as exc:
+            out[expr] = str(exc)
+    return out
+
+
+def converge_terms(values, finest):
+    """{CONVERGE + expr: |q - q_f| / |q_f| or a message}: a point's values against the finest's."""
+    out = {}
+    for expr, q in values.items():
+        ref = finest.get(expr, "the finest point has no value")
+        if isinstance(q, str):
+            out[CONVERGE + expr] = q
+        elif isinstance(ref, str):
+            out[CONVERGE + expr] = f"finest point: {ref}"
+        else:
+            out[CONVERGE + expr] = deviation(q, ref)
+    return out
+
+
+def finest_index(costs):
+    """The index of the finest point: status ok and the most particle-steps (None if none is ok)."""
+    ok = [i for i, c in enumerate(costs) if c["status"] == "ok" and c["particle_steps"] is not None]
+    return max(ok, key=lambda i: costs[i]["particle_steps"]) if ok else None
+
+
 def _dem(case, variants):
     return sorted(v for v in variants if case.variant(v) is None or case.variant(v).command != "exact")
 
@@ -280,7 +358,7 @@ def jobs(case, sweeps_root):
     out = []
     for sweep in case.sweeps:
         variant = case.variant(sweep.variant)
-        for f in sweep.factors:
+        for f in sweep.run_factors():
             label = sweep.label(f)
             out.append(Job(case.name, label, variant.scene, list(variant.sets) + sweep.sets(f),
                            Path(sweeps_root) / case.name / label, case.runtime / max(len(case.variants), 1),
@@ -289,29 +367,72 @@ def jobs(case, sweeps_root):
 
 
 def points(case, checks, runs_root, sweeps_root):
-    """Rows of cost.tsv: per sweep the default run (factor 1) and every swept point."""
+    """Rows of cost.tsv: per sweep the default run (factor 1; with `set =`, its own run) and every
+    swept point."""
     rows, loaded = [], {}
     for sweep in case.sweeps:
         terms, _ = terms_of(sweep, case, checks)
-        pts = [(1.0, Path(runs_root) / case.name / sweep.variant, [])]
-        pts += [(f, Path(sweeps_root) / case.name / sweep.label(f), sweep.sets(f)) for f in sweep.factors]
+        pts = [] if sweep.fixed else [(1.0, Path(runs_root) / case.name / sweep.variant, [])]
+        pts += [(f, Path(sweeps_root) / case.name / sweep.label(f), sweep.sets(f)) for f in sweep.run_factors()]
+        costs = [run_cost(folder) for _, folder, _ in pts]
         evaluated = [(f, folder, sets, *term_errors(case, sweep.variant, folder, runs_root, terms, sweep.errors,
                                                      loaded))
                      for f, folder, sets in pts]
         dropped = sorted({t for *_, sib in evaluated for t, read in sib.items() if read})
-        for f, folder, sets, by_term, _ in evaluated:
-            error, worst, note = run_error(by_term, dropped)
-            cost = run_cost(folder)
+        finest, values = None, []
+        if sweep.converge:
+            finest = finest_index(costs)
+            values = [converge_values(case, sweep.variant, folder, runs_root, sweep.converge, loaded)
+                      for _, folder, _ in pts]
+        for i, ((f, folder, sets, by_term, _), cost) in enumerate(zip(evaluated, costs)):
             unsettled = cost.pop("unsettled")
-            notes = [note]
+            notes = []
+            if sweep.converge:
+                if i == finest:
+                    notes.append("the finest run: the reference of the self-convergence error")
+                elif finest is None:
+                    by_term = {**by_term, CONVERGE + "*": "no ok point to converge to"}
+                else:
+                    by_term = {**by_term, **converge_terms(values[i], values[finest])}
+            if cost["status"] != "ok":
+                error, worst = None, ""
+                notes.append(f"{cost['status']}: {_message(folder)}")
+            else:
+                error, worst, note = run_error(by_term, dropped)
+                if not (i == finest and note == "no error term"):
+                    notes.append(note)
+                if unsettled:
+                    notes.append("stage(s) " + ", ".join(unsettled) +
+                                 " ran to their cycle limit without meeting the stop rule")
             if dropped:
                 notes.append(f"left out (reads a DEM sibling): {', '.join(dropped)}")
-            if unsettled:
-                notes.append("stage(s) " + ", ".join(unsettled) +
-                             " ran to their cycle limit without meeting the stop rule")
             rows.append({"sweep": sweep.name, "factor": f, "sets": " ".join(sets) or "(default)",
                          **cost, "error": error, "worst": worst, "note": "; ".join(filter(None, notes))})
     return rows
+
+
+def _message(folder):
+    """The run's own account of its failure: run.json message, else harness.json cause."""
+    try:
+        info = read_run_json(folder)
+        if info.get("message"):
+            return str(info["message"])
+    except RunProblem:
+        pass
+    try:
+        return str(json.loads((Path(folder) / "harness.json").read_text(encoding="utf-8")).get("cause") or "no message")
+    except (OSError, ValueError):
+        return "no run.json and no harness.json"
+
+
+def is_default(row):
+    """Whether a row is the variant's own default-tier run (not a point run by the sweep)."""
+    return row["factor"] == 1.0 and row["sets"] == "(default)"
+
+
+def failed(row):
+    """Whether a row's run failed (unstable, or no usable run.json)."""
+    return row["status"] != "ok"
 
 
 def cheapest(rows, tolerances=TOLERANCES):
@@ -388,18 +509,21 @@ def run_declared(cases, checks, binary, workers, runs_root, sweeps_root, out, ru
 
 def setting(row):
     """'default' or 'dt x2 (settings.dt=0.02 ...)'."""
-    if row["factor"] == 1.0:
+    if is_default(row):
         return "default"
     return f"{row['sweep']} x{number(row['factor'])} ({row['sets']})"
 
 
 def summary_text(name, rows):
     """A few lines: the default's error and the cheapest setting per tolerance."""
-    default = next((r for r in rows if r["factor"] == 1.0), None)
+    default = next((r for r in rows if is_default(r)), None)
     lines = [f"{name}: default error {_cell(default['error']) if default else '-'}, "
              f"{_cell(default['particle_steps']) if default else '-'} particle-steps"]
     for tol, r in cheapest(rows).items():
         lines.append(f"  error <= {tol:g}: " + (f"{setting(r)}, error {_cell(r['error'])}, "
                                                  f"{r['particle_steps']} particle-steps"
                                                  if r else "no swept setting"))
+    bad = [f"{r['sweep']} x{number(r['factor'])}" for r in rows if failed(r)]
+    if bad:
+        lines.append(f"  failed (unstable or no run.json; no error): {', '.join(bad)}")
     return "\n".join(lines)

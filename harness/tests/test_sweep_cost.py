@@ -203,7 +203,8 @@ def test_unsettled_stop_rule_is_noted(tmp_path):
 # ---------------------------------------------------------------- the cheapest-setting table
 
 def row(sweep_name, factor, error, ps, status="ok", wall=1.0):
-    return {"sweep": sweep_name, "factor": factor, "sets": f"k={factor}", "status": status, "steps": ps,
+    return {"sweep": sweep_name, "factor": factor, "sets": "(default)" if factor == 1.0 else f"k={factor}",
+            "status": status, "steps": ps,
             "n_discs": 1, "particle_steps": ps, "wall_seconds": wall, "error": error, "worst": "t", "note": ""}
 
 
@@ -268,11 +269,12 @@ def test_validate_runs_the_sweeps_unless_told_not_to(project, capsys):
 def test_cost_points_mark_the_default_and_note_what_is_not_drawn():
     rows = [row("dt", 1.0, 5e-4, 100), row("dt", 2.0, 5e-3, 50), row("dt", 0.5, 0.0, 200),
             row("k", 1.0, 5e-4, 100), row("k", 3.0, None, 80, status="unstable")]
-    curves, default, notes = report.cost_points(rows)
-    assert default == (100, 5e-4)
+    curves, defaults, notes, bad = report.cost_points(rows)
+    assert defaults == [(100, 5e-4)]
     assert curves["dt"] == [(100, 5e-4, ""), (50, 5e-3, "x2")] and curves["k"] == [(100, 5e-4, "")]
     assert any("dt x0.5: not drawn: error 0 is not positive" in n for n in notes)
-    assert any("k x3: not drawn (status unstable" in n for n in notes)
+    assert bad == {"k": [(80, "x3 unstable")]}          # drawn at the top, labelled
+    assert any("k x3: unstable (drawn at the top" in n for n in notes)
 
 
 @needs_gnuplot
@@ -310,3 +312,164 @@ def test_report_notes_a_cost_table_older_than_the_declarations(project, capsys):
     assert main(["report", "spring"]) == 0
     capsys.readouterr()
     assert "cost.tsv is older than case.txt" in (project / "reports" / "index.html").read_text()
+
+
+# ---------------------------------------------------------------- fixed overrides, failed points, self-convergence
+
+def test_parse_fixed_overrides_make_factor_one_a_point_of_its_own():
+    s = sweep.parse(section("variant = v\nset = settings.integrator=gear5\nset = settings.psi=0\n"
+                            "keys = settings.dt=0.01\nfactors = 0.5\nchecks = none\nerror = e(1)\n"))
+    assert s.fixed == ["settings.integrator=gear5", "settings.psi=0"] and s.no_checks and s.checks == []
+    assert s.run_factors() == [1.0, 0.5]
+    assert s.sets(1) == ["settings.integrator=gear5", "settings.psi=0", "settings.dt=0.01"]
+    assert s.label(1) == "dt_x1"
+    plain = sweep.parse(section("variant = v\nkeys = settings.dt=0.01\nfactors = 0.5\n"))
+    assert plain.run_factors() == [0.5] and plain.fixed == [] and not plain.no_checks
+
+
+@pytest.mark.parametrize("body, message, line", [
+    ("variant = v\nkeys = a=1\nfactors = 2\nset = settings.integrator\n", "'set' needs KEY=VALUE", 5),
+    ("variant = v\nkeys = a=1\nfactors = 2\nset = a=3\n", "a is swept", 5),
+    ("variant = v\nkeys = a=1\nfactors = 2\nscale = b=4\nset = b=3\n", "b is swept", 6),
+    ("variant = v\nkeys = a=1\nfactors = 2\nset = b=1\nset = b=2\n", "b given twice", 6),
+    ("variant = v\nkeys = a=1\nfactors = 2\nchecks = none c1\n", "'checks = none' takes no other name", 5),
+])
+def test_parse_errors_of_the_new_keys(body, message, line):
+    with pytest.raises(IniError) as err:
+        sweep.parse(section(body))
+    assert message in str(err.value) and f"case.txt:{line}:" in str(err.value)
+
+
+def test_checks_none_leaves_out_every_check(project, capsys):
+    add_sweeps(project, "\n[sweep s]\nvariant = stiff\nkeys = k=1\nfactors = 2\nchecks = none\nerror = 0.5\n")
+    cases, checks = catalogue.load(), references.load()
+    case = catalogue.select(cases, ["spring"])[0]
+    terms, left = sweep.terms_of(case.sweeps[0], case, checks)
+    assert terms == [] and left == ["rel_last"]
+    add_sweeps(project, "\n[sweep t]\nvariant = stiff\nkeys = k=1\nfactors = 2\nchecks = none\n")
+    assert main(["check"]) == 2
+    assert "nothing measures the error" in capsys.readouterr().err
+
+
+FIXED = """
+[sweep k_fixed]
+variant = soft
+set = settings.n=20
+keys = settings.k=1
+factors = 2
+checks = none
+error = abs(last(F) / 20 - 1)
+"""
+
+
+def test_a_fixed_sweep_runs_factor_one_and_is_not_the_default(project, capsys):
+    add_sweeps(project, FIXED)
+    assert main(["run", "spring"]) == 0
+    assert main(["cost", "spring"]) == 0
+    out = capsys.readouterr().out
+    assert "2 runs: 2 ok" in out                      # factor 1 and factor 2, both run by the sweep
+    rows = sweep.read_tsv(project / "reports" / "sweeps" / "spring" / "cost.tsv")
+    assert [(r["factor"], r["sets"]) for r in rows] == [(1.0, "settings.n=20 settings.k=1"),
+                                                        (2.0, "settings.n=20 settings.k=2")]
+    assert (project / "reports" / "sweeps" / "spring" / "k_fixed_x1" / "run.json").is_file()
+    assert rows[0]["steps"] == 20 and rows[0]["error"] == 0.0 and rows[1]["error"] == pytest.approx(1.0)
+    assert not sweep.is_default(rows[0])
+    assert sweep.setting(rows[0]) == "k_fixed x1 (settings.n=20 settings.k=1)"
+    curves, defaults, _, _ = report.cost_points(rows)
+    assert defaults == [] and curves["k_fixed"] == [(40, pytest.approx(1.0), "x2")]   # error 0 is off the log scale
+
+
+UNSTABLE = """
+[sweep blows_up]
+variant = soft
+set = settings.status=unstable
+keys = settings.k=1
+factors = 2
+error = abs(last(F) - 10)
+
+[sweep no_output]
+variant = soft
+set = settings.fail=1
+keys = settings.k=1
+factors = 2
+error = abs(last(F) - 10)
+"""
+
+
+def test_failed_points_have_no_error_and_say_why(project, capsys):
+    add_sweeps(project, UNSTABLE)
+    assert main(["run", "spring"]) == 0
+    assert main(["cost", "spring"]) == 0
+    out = capsys.readouterr().out
+    assert "failed (unstable or no run.json; no error): blows_up x1, blows_up x2, no_output x1, no_output x2" in out
+    rows = sweep.read_tsv(project / "reports" / "sweeps" / "spring" / "cost.tsv")
+    by = {(r["sweep"], r["factor"]): r for r in rows}
+    blown = by[("blows_up", 2.0)]
+    assert blown["status"] == "unstable" and blown["error"] is None and blown["particle_steps"] == 20
+    assert blown["note"].startswith("unstable: ") and "stage(s)" not in blown["note"]
+    gone = by[("no_output", 1.0)]
+    assert gone["status"].startswith("no run.json") and gone["error"] is None
+    assert "fail: asked to fail" in gone["note"]          # the runner's cause (harness.json)
+    assert all(sweep.failed(r) for r in rows)
+    assert all(r is None for r in sweep.cheapest(rows).values())
+    _, _, notes, bad = report.cost_points(rows)
+    assert bad == {"blows_up": [(20, "x1 unstable"), (20, "x2 unstable")]}
+    assert any(n.startswith("no_output x1: no run.json") and "not drawn" in n for n in notes)
+
+
+@needs_gnuplot
+def test_report_draws_and_tabulates_failed_points_as_unstable(project, capsys):
+    add_sweeps(project, SWEEPS + UNSTABLE)
+    assert main(["run", "spring"]) == 0
+    assert main(["cost", "spring"]) == 0
+    assert main(["report", "spring"]) == 0
+    capsys.readouterr()
+    svg = (project / "reports" / "figures" / "spring_error_cost_sweep.svg").read_text()
+    assert "blows_up: unstable" in svg and "x2 unstable" in svg
+    page = (project / "reports" / "index.html").read_text()
+    assert '<td class="bad">unstable</td>' in page
+    summary = (project / "reports" / "summary.md").read_text()
+    assert "- unstable (run failed, no error): blows_up x1, blows_up x2, no_output x1, no_output x2" in summary
+
+
+def test_converge_terms_and_the_finest_point():
+    costs = [{"status": "ok", "particle_steps": 100}, {"status": "unstable", "particle_steps": 900},
+             {"status": "ok", "particle_steps": 400}, {"status": "ok", "particle_steps": None}]
+    assert sweep.finest_index(costs) == 2                  # the most particle-steps among the ok points
+    assert sweep.finest_index([costs[1]]) is None
+    terms = sweep.converge_terms({"a": 1.1, "b": 0.5, "c": "no column"}, {"a": 1.0, "b": 0.0, "c": 3.0})
+    assert terms["vs finest: a"] == pytest.approx(0.1) and terms["vs finest: b"] == 0.5
+    assert terms["vs finest: c"] == "no column"
+    assert sweep.converge_terms({"a": 1.0}, {"a": "bad"}) == {"vs finest: a": "finest point: bad"}
+
+
+CONVERGE = """
+[sweep n]
+variant = soft
+keys = stage.n=10
+factors = 2 0.5
+checks = none
+converge = last(F)
+converge = mean(F)
+"""
+
+
+def test_self_convergence_is_against_the_finest_swept_run(project, capsys):
+    add_sweeps(project, CONVERGE)
+    assert main(["run", "spring"]) == 0
+    assert main(["cost", "spring"]) == 0
+    rows = sweep.read_tsv(project / "reports" / "sweeps" / "spring" / "cost.tsv")
+    by = {r["factor"]: r for r in rows}
+    # soft: F = cycle, n cycles: last(F) = n, mean(F) = (n + 1) / 2; the finest is n = 20 (factor 2)
+    assert by[2.0]["error"] is None and "the finest run: the reference" in by[2.0]["note"]
+    assert by[1.0]["error"] == pytest.approx(0.5) and by[1.0]["worst"] == "vs finest: last(F)"
+    assert by[0.5]["error"] == pytest.approx(0.75)
+    assert main(["report", "spring"]) == 0
+    capsys.readouterr()
+    page = (project / "reports" / "index.html").read_text()
+    assert "Self-convergence (n)" in page and "not against a reference" in page
+
+
+def test_validate_accepts_a_sweep_measured_by_converge_alone(project):
+    add_sweeps(project, "\n[sweep s]\nvariant = stiffer\nkeys = k=1\nfactors = 2\nconverge = last(F)\n")
+    assert main(["check"]) in (0, 1)                      # no declaration error (exit 2)

@@ -265,6 +265,8 @@ void bal_integrate_previous(const struct bal_sim *s, int i, double *vx, double *
 
 /* timestep.c */
 double bal_timestep_estimate(const struct bal_sim *s);
+double bal_timestep_single_spring(const struct bal_sim *s);
+void bal_timestep_detail(const struct bal_sim *s, struct bal_dt_detail *d);
 
 /* measure.c */
 /* Velocities of disc i at t_N (eq. 31), recovered after a cycle. */

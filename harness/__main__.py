@@ -6,6 +6,7 @@ files (named file:line) and unknown case names end the command with status 2.
 """
 import argparse
 import os
+import shutil
 import sys
 from pathlib import Path
 
@@ -105,6 +106,32 @@ def cmd_sweep(args):
     return 0 if all(o.ok for o in outcomes) else 1
 
 
+def cmd_stability(args):
+    """Stability limits per variant and the extreme probes (harness/stability.py)."""
+    from . import stability
+    work = reports_root() / "stability-runs"
+    status = 0
+    if not args.extremes_only:
+        cases = selected(args, load_cases())
+        targets = stability.targets_for(cases)
+        print(f"stability: bisecting {len(targets)} variant(s)")
+        limits = stability.measure_all(args.bin, targets, work, args.jobs, args.cap, args.tolerance, sys.stdout)
+        rows = stability.limit_rows(limits)
+        stability.write_tsv(rows, stability.LIMIT_COLUMNS, reports_root() / "stability.tsv")
+        print(f"wrote {reports_root() / 'stability.tsv'}")
+        status = 0 if all(r["in_target"] == "yes" for r in rows) else 1
+    if not args.no_extremes:
+        probes = stability.load_probes(cases_root() / "extremes" / "extremes.txt")
+        print(f"stability: {len(probes)} extreme probe(s)")
+        rows = stability.run_probes(args.bin, probes, work, args.jobs)
+        stability.write_tsv(rows, stability.EXTREME_COLUMNS, reports_root() / "extremes.tsv")
+        for r in rows:
+            print(f"  {r['group']}/{r['probe']}: {r['outcome']}{'' if r['as_expected'] == 'yes' else '  UNEXPECTED'}")
+        print(f"wrote {reports_root() / 'extremes.tsv'}")
+    shutil.rmtree(work, ignore_errors=True)
+    return status
+
+
 def sweep_variant(case, name):
     if name:
         if not case.variant(name):
@@ -157,6 +184,14 @@ def parser():
     sweep.add_argument("--set", required=True, metavar="KEY=V1,V2,...")
     sweep.add_argument("--variant", metavar="NAME", help="the variant to sweep (needed when the case has several)")
     _runs(sweep)
+    stab = _command(sub, "stability", cmd_stability,
+                    "bisect the largest stable dt fraction of every DEM variant; run the extreme probes "
+                    "(writes reports/stability.tsv and reports/extremes.tsv)")
+    _runs(_selection(stab))
+    stab.add_argument("--cap", type=int, default=20000, help="most cycles per stage of a trial (default 20000)")
+    stab.add_argument("--tolerance", type=float, default=0.01, help="bisect until hi/lo <= 1 + this (default 0.01)")
+    stab.add_argument("--extremes-only", action="store_true", help="only the probes of cases/extremes")
+    stab.add_argument("--no-extremes", action="store_true", help="only the catalogue's limits")
     return p
 
 

@@ -441,7 +441,7 @@ def read_tsv(path):
 
 # ---------------------------------------------------------------- extremes
 
-EXTREME_KEYS = {"scene", "set", "group", "what", "expect", "energy_ratio", "overlap_max", "bound"}
+EXTREME_KEYS = {"scene", "set", "group", "what", "expect", "energy_ratio", "e_in", "overlap_max", "bound"}
 EXPECTS = ("stable", "stop")
 
 
@@ -459,6 +459,7 @@ class Probe:
     overlap_max: float       # stable: largest final overlap / smaller radius at most this
     bounds: list = field(default_factory=list)   # [(column, lo, hi)]: every row within
     line: int = 0
+    e_in: float = float("nan")   # the energy put in, when the first row cannot give it (nan: first row)
 
 
 def load_probes(path):
@@ -481,7 +482,7 @@ def load_probes(path):
         probes.append(Probe(sec.name, sec.require("group"), sec.require("what"),
                             Path(path).parent / sec.require("scene"), [e.value for e in sec.all("set")],
                             expect, sec.number("energy_ratio", float("nan")), sec.number("overlap_max", 0.1),
-                            bounds, sec.line))
+                            bounds, sec.line, sec.number("e_in", float("nan"))))
     return probes
 
 
@@ -542,6 +543,8 @@ def run_probe(binary, probe, workdir):
     try:
         t = run(binary, probe.scene, probe.sets, folder)
         e_in, e_out = energy_in_out(folder / "series.tsv")
+        if not math.isnan(probe.e_in):
+            e_in = probe.e_in
     finally:
         shutil.rmtree(folder, ignore_errors=True)
     outcome, ok = judge(probe, t, e_in, e_out)

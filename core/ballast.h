@@ -300,7 +300,9 @@ struct bal_dt_detail {
     double single_spring;     /* C&S p. 53, 2 sqrt(m/k) of the stiffest single spring */
     long contacts;            /* contacts at the start (gap <= 1 % of the smaller radius) */
     int coordination_discs;   /* free discs without any, bounded by their coordination */
-    int binding_disc;         /* scene-order index of the disc that sets the estimate */
+    int binding_disc;         /* scene-order index of the disc that sets the estimate (-1:
+                               * the network's spectral bound sets it) */
+    int spectral;             /* 1: the spectral bound of the start network was the better */
     double omega, zeta;       /* its frequency bound and damping ratio */
 };
 void bal_sim_dt_detail(const struct bal_sim *sim, struct bal_dt_detail *d);

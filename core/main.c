@@ -141,8 +141,8 @@ static int cmd_info(const struct args *a)
            in.n_candidates);
     struct bal_dt_detail dd;
     bal_sim_dt_detail(sim, &dd);
-    printf("dt estimate    %.17g   (contact-network bound 2/(omega (sqrt(1+zeta^2)+zeta)), disc %d)\n",
-           in.dt_estimate, dd.binding_disc);
+    printf("dt estimate    %.17g   (contact-network bound 2/(omega (sqrt(1+zeta^2)+zeta)), %s %d)\n",
+           in.dt_estimate, dd.spectral ? "spectral bound; disc" : "block bound; disc", dd.binding_disc);
     printf("dt single      %.17g   (min over discs of 2 sqrt(m/k), C&S p. 53; ratio %.4g)\n",
            dd.single_spring, dd.single_spring / in.dt_estimate);
     printf("dt contacts    %ld at the start; %d free discs bounded by coordination; omega %.6g, zeta %.4g\n",

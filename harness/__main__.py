@@ -8,6 +8,7 @@ import argparse
 import os
 import shutil
 import sys
+import tempfile
 from pathlib import Path
 
 from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_root
@@ -109,7 +110,8 @@ def cmd_sweep(args):
 def cmd_stability(args):
     """Stability limits per variant and the extreme probes (harness/stability.py)."""
     from . import stability
-    work = reports_root() / "stability-runs"
+    reports_root().mkdir(parents=True, exist_ok=True)
+    work = Path(tempfile.mkdtemp(prefix="stability-runs.", dir=reports_root()))
     status = 0
     if not args.extremes_only:
         cases = selected(args, load_cases())
@@ -117,14 +119,14 @@ def cmd_stability(args):
         print(f"stability: bisecting {len(targets)} variant(s)")
         limits = stability.measure_all(args.bin, targets, work, args.jobs, args.cap, args.tolerance, sys.stdout)
         rows = stability.limit_rows(limits)
-        stability.write_tsv(rows, stability.LIMIT_COLUMNS, reports_root() / "stability.tsv")
+        stability.merge_tsv(rows, stability.LIMIT_COLUMNS, reports_root() / "stability.tsv", ("case", "variant"))
         print(f"wrote {reports_root() / 'stability.tsv'}")
         status = 0 if all(r["in_target"] == "yes" for r in rows) else 1
     if not args.no_extremes:
         probes = stability.load_probes(cases_root() / "extremes" / "extremes.txt")
         print(f"stability: {len(probes)} extreme probe(s)")
         rows = stability.run_probes(args.bin, probes, work, args.jobs)
-        stability.write_tsv(rows, stability.EXTREME_COLUMNS, reports_root() / "extremes.tsv")
+        stability.merge_tsv(rows, stability.EXTREME_COLUMNS, reports_root() / "extremes.tsv", ("probe",))
         for r in rows:
             print(f"  {r['group']}/{r['probe']}: {r['outcome']}{'' if r['as_expected'] == 'yes' else '  UNEXPECTED'}")
         print(f"wrote {reports_root() / 'extremes.tsv'}")

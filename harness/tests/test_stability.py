@@ -197,3 +197,10 @@ def test_ballast_info_prints_both_estimates():
     # value (k_s = k_n by default) is 2 sqrt(m/(2k)): sqrt(3/2) larger
     assert v["single"] / v["estimate"] == pytest.approx(math.sqrt(1.5), rel=1e-12)
     assert v["dt"] == 0.01
+
+
+def test_merge_tsv_replaces_rows_in_place(tmp_path):
+    path = tmp_path / "t.tsv"
+    st.merge_tsv([{"k": "a", "v": "1"}, {"k": "b", "v": "2"}], ("k", "v"), path, ("k",))
+    st.merge_tsv([{"k": "c", "v": "3"}, {"k": "a", "v": "9"}], ("k", "v"), path, ("k",))
+    assert st.read_tsv(path) == [{"k": "a", "v": "9"}, {"k": "b", "v": "2"}, {"k": "c", "v": "3"}]

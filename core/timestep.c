@@ -396,8 +396,13 @@ static void contact_blocks(const struct bal_sim *s, const struct dt_contact *c, 
     cab[8] = ks * ra * rb;
 }
 
-/* Steps of the power iteration for the spectral radius of |A|. */
+/* Steps of the power iteration for the spectral radius of |A|: at most
+ * BAL_DT_POWER_STEPS, and fewer for a large network so that the work stays
+ * about BAL_DT_POWER_WORK block products (every step's bound is valid; a
+ * million-disc network gets BAL_DT_POWER_MIN steps, about a second). */
 #define BAL_DT_POWER_STEPS 400
+#define BAL_DT_POWER_MIN 10
+#define BAL_DT_POWER_WORK 4e7
 
 /* An upper bound on λ_max(A) of the start network: ρ(|A|) ≥ ρ(A) (|A|
  * dominates A entrywise), and for any positive d the Collatz–Wielandt bound
@@ -443,7 +448,9 @@ static double network_rho(const struct bal_sim *s, const struct dt_list *l)
     for (int k = 0; k < 3 * n; k++)
         d[k] = 1;
     double sigma = -1;
-    for (int it = 0; it < BAL_DT_POWER_STEPS; it++) {
+    const double work = 3.0 * n + 2.0 * (double)l->n;
+    const int steps = (int)fmax(BAL_DT_POWER_MIN, fmin(BAL_DT_POWER_STEPS, BAL_DT_POWER_WORK / work));
+    for (int it = 0; it < steps; it++) {
         for (int i = 0; i < n; i++)
             for (int p = 0; p < 3; p++) {
                 double v = 0;

@@ -325,6 +325,19 @@ enum bal_status bal_sim_run(struct bal_sim *sim, FILE *series,
 
 void bal_sim_info(const struct bal_sim *sim, struct bal_run_info *info);
 
+/* The critical-step estimate and how it was reached (timestep.c). */
+struct bal_dt_detail {
+    double estimate;          /* contact-network bound: the step dt_fraction scales */
+    double single_spring;     /* C&S p. 53, 2 sqrt(m/k) of the stiffest single spring */
+    long contacts;            /* contacts at the start (gap <= 1 % of the smaller radius) */
+    int coordination_discs;   /* free discs without any, bounded by their coordination */
+    int binding_disc;         /* scene-order index of the disc that sets the estimate (-1:
+                               * the network's spectral bound sets it) */
+    int spectral;             /* 1: the spectral bound of the start network was the better */
+    double omega, zeta;       /* its frequency bound and damping ratio */
+};
+void bal_sim_dt_detail(const struct bal_sim *sim, struct bal_dt_detail *d);
+
 /* ------------------------------------------------------------------ */
 /* Measurements                                                        */
 /* ------------------------------------------------------------------ */

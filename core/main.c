@@ -139,7 +139,14 @@ static int cmd_info(const struct args *a)
     printf("normal law     %s\n", sc.settings.normal_law == BAL_NORMAL_POWER ? "power" : "incremental");
     printf("neighbours     %s (%ld candidate pairs)\n", in.grid_used ? "cell grid" : "all pairs",
            in.n_candidates);
-    printf("dt estimate    %.17g   (min over discs of 2 sqrt(m/k), C&S p. 53)\n", in.dt_estimate);
+    struct bal_dt_detail dd;
+    bal_sim_dt_detail(sim, &dd);
+    printf("dt estimate    %.17g   (contact-network bound 2/(omega (sqrt(1+zeta^2)+zeta)), %s %d)\n",
+           in.dt_estimate, dd.spectral ? "spectral bound; disc" : "block bound; disc", dd.binding_disc);
+    printf("dt single      %.17g   (min over discs of 2 sqrt(m/k), C&S p. 53; ratio %.4g)\n",
+           dd.single_spring, dd.single_spring / in.dt_estimate);
+    printf("dt contacts    %ld at the start; %d free discs bounded by coordination; omega %.6g, zeta %.4g\n",
+           dd.contacts, dd.coordination_discs, dd.omega, dd.zeta);
     printf("dt fraction    %.17g\n", in.dt_fraction);
     printf("dt used        %.17g\n", in.dt);
     printf("stages         %d (%ld cycles)\n", sc.n_stages, cycles);

@@ -344,6 +344,8 @@ enum bal_status bal_energy_guard(const struct bal_sim *s, struct bal_error *err)
 
 /* timestep.c */
 double bal_timestep_estimate(const struct bal_sim *s);
+double bal_timestep_single_spring(const struct bal_sim *s);
+void bal_timestep_detail(const struct bal_sim *s, struct bal_dt_detail *d);
 
 /* measure.c */
 /* Velocities of disc i at t_N (eq. 31), recovered after a cycle. */

@@ -6,7 +6,9 @@ files (named file:line) and unknown case names end the command with status 2.
 """
 import argparse
 import os
+import shutil
 import sys
+import tempfile
 from pathlib import Path
 
 from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_root
@@ -116,6 +118,31 @@ def cmd_cost(args):
     sweeps.run_declared(selected(args, all_cases), checks, args.bin, args.jobs, runs_root(),
                         reports_root() / "sweeps", sys.stdout, run_all)
     return 0
+def cmd_stability(args):
+    """Stability limits per variant and the extreme probes (harness/stability.py)."""
+    from . import stability
+    reports_root().mkdir(parents=True, exist_ok=True)
+    work = Path(tempfile.mkdtemp(prefix="stability-runs.", dir=reports_root()))
+    status = 0
+    if not args.extremes_only:
+        cases = selected(args, load_cases())
+        targets = stability.targets_for(cases)
+        print(f"stability: bisecting {len(targets)} variant(s)")
+        limits = stability.measure_all(args.bin, targets, work, args.jobs, args.cap, args.tolerance, sys.stdout)
+        rows = stability.limit_rows(limits)
+        stability.merge_tsv(rows, stability.LIMIT_COLUMNS, reports_root() / "stability.tsv", ("case", "variant"))
+        print(f"wrote {reports_root() / 'stability.tsv'}")
+        status = 0 if all(r["in_target"] == "yes" for r in rows) else 1
+    if not args.no_extremes:
+        probes = stability.load_probes(cases_root() / "extremes" / "extremes.txt")
+        print(f"stability: {len(probes)} extreme probe(s)")
+        rows = stability.run_probes(args.bin, probes, work, args.jobs)
+        stability.merge_tsv(rows, stability.EXTREME_COLUMNS, reports_root() / "extremes.tsv", ("probe",))
+        for r in rows:
+            print(f"  {r['group']}/{r['probe']}: {r['outcome']}{'' if r['as_expected'] == 'yes' else '  UNEXPECTED'}")
+        print(f"wrote {reports_root() / 'extremes.tsv'}")
+    shutil.rmtree(work, ignore_errors=True)
+    return status
 
 
 def sweep_variant(case, name):
@@ -174,6 +201,14 @@ def parser():
     _runs(_selection(_command(sub, "cost", cmd_cost,
                               "run every declared [sweep] of the selected cases (error against cost); "
                               "needs their default runs; writes reports/sweeps/<case>/cost.tsv")))
+    stab = _command(sub, "stability", cmd_stability,
+                    "bisect the largest stable dt fraction of every DEM variant; run the extreme probes "
+                    "(writes reports/stability.tsv and reports/extremes.tsv)")
+    _runs(_selection(stab))
+    stab.add_argument("--cap", type=int, default=20000, help="most cycles per stage of a trial (default 20000)")
+    stab.add_argument("--tolerance", type=float, default=0.01, help="bisect until hi/lo <= 1 + this (default 0.01)")
+    stab.add_argument("--extremes-only", action="store_true", help="only the probes of cases/extremes")
+    stab.add_argument("--no-extremes", action="store_true", help="only the catalogue's limits")
     return p
 
 

@@ -567,9 +567,11 @@ def write_report(cases, checks, store, runs_root, reports_dir, out=None):
     reports_dir = Path(reports_dir)
     reports = gather(cases, checks, store, runs_root, reports_dir)
     revision, date = git_revision(), now_text()
-    (reports_dir / "summary.md").write_text(markdown(reports, revision, date), encoding="utf-8")
+    (reports_dir / "summary.md").write_text(markdown(reports, revision, date) + stability_markdown(reports_dir),
+                                            encoding="utf-8")
     index = reports_dir / "index.html"
-    index.write_text(page(reports, revision, date), encoding="utf-8")
+    index.write_text(page(reports, revision, date).replace("</body></html>", stability_html(reports_dir) + "</body></html>"),
+                     encoding="utf-8")
     if out:
         print(f"wrote {reports_dir / 'summary.md'} and {index}", file=out)
     return index
@@ -781,3 +783,61 @@ def _cost_markdown(cost):
         if bad:
             lines += ["", f"- {UNSTABLE} (run failed, no error): {_md(', '.join(bad))}"]
     return lines + [""]
+# ---------------------------------------------------------------- stability (harness/stability.py)
+
+STABILITY_LIMIT_HEADERS = [("case", "case"), ("variant", "variant"), ("estimate", "bound (dt)"),
+                           ("single_spring", "2 sqrt(m/k)"), ("single_over_estimate", "old / bound"),
+                           ("case_fraction", "case dt / bound"), ("limit_fraction", "limit / bound"),
+                           ("limit_over_single", "limit / old"), ("in_target", "in [1, 1.25]"), ("cause", "first unstable trial")]
+STABILITY_EXTREME_HEADERS = [("group", "group"), ("probe", "probe"), ("what", "what"), ("expect", "expect"),
+                             ("exit", "exit"), ("steps", "steps"), ("e_out_over_in", "E_out/E_in"),
+                             ("overlap_max", "overlap/r"), ("outcome", "outcome"), ("as_expected", "as expected")]
+STABILITY_NOTE = ("Written by `python3 -m harness stability` (not by validate: it bisects every DEM variant, "
+                  "about 10 runs each). *limit / bound* is the largest stable dt over ballast's estimate (the "
+                  "contact-network bound of core/timestep.c); a safe and tight estimate has it in [1, 1.25]. "
+                  "*old* is C&S's single-spring 2 sqrt(m/k). The criteria are in harness/stability.py.")
+EXTREMES_NOTE = ("Extreme probes (cases/extremes/extremes.txt): each row a scene pushed to a limit of the physics; "
+                 "*expect* says what is acceptable: a stable run within the stated criteria, or a stop with exit 1 "
+                 "and a message.  A later model adds rows under its own group.")
+
+
+def _stability_tables(reports_dir):
+    """[(title, note, headers, rows)] of the stability files that exist."""
+    from .stability import read_tsv
+    out = []
+    for name, title, note, headers in (("stability.tsv", "Stability limits", STABILITY_NOTE, STABILITY_LIMIT_HEADERS),
+                                       ("extremes.tsv", "Extreme probes", EXTREMES_NOTE, STABILITY_EXTREME_HEADERS)):
+        path = Path(reports_dir) / name
+        if path.exists():
+            out.append((title, note, headers, read_tsv(path)))
+    return out
+
+
+def stability_markdown(reports_dir):
+    lines = []
+    for title, note, headers, rows in _stability_tables(reports_dir):
+        lines += [f"## {title}", "", note, "", "| " + " | ".join(h for _, h in headers) + " |",
+                  "|" + "---|" * len(headers)]
+        lines += ["| " + " | ".join(_md(r.get(k, "")) for k, _ in headers) + " |" for r in rows]
+        lines.append("")
+    return "\n".join(lines) + ("\n" if lines else "")
+
+
+def stability_html(reports_dir):
+    parts = []
+    for title, note, headers, rows in _stability_tables(reports_dir):
+        body = []
+        for r in rows:
+            cells = []
+            for k, _ in headers:
+                v = r.get(k, "")
+                cls = ""
+                if k in ("in_target", "as_expected"):
+                    cls = "PASS" if v == "yes" else "FAIL"
+                elif k not in ("case", "variant", "group", "probe", "what", "expect", "cause", "outcome"):
+                    cls = "num"
+                cells.append(cell(v, cls))
+            body.append(cells)
+        parts.append(f"<section id=\"{esc(title.lower().replace(' ', '-'))}\"><h2>{esc(title)}</h2>"
+                     f"<p>{esc(note)}</p>" + table_html([h for _, h in headers], body) + "</section>")
+    return "\n".join(parts)

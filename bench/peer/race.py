@@ -280,7 +280,10 @@ def ballast_scene(state, box, dt, steps, title, kn=KN, kt=KT, mu=MU, g=G, densit
            "# walls, F_n = k_n overlap, no damping (the physics of bench/peer/in.peer)",
            "", "[settings]", f"dt = {fmt(dt)}", f"gravity = 0 {fmt(-g)}",
            "normal_law = power", "nu = 1", "delta0 = 1", "beta = 0", "alpha = 0",
-           "gamma_n = 0", f"output_every = {max(1, int(steps))}", "",
+           "gamma_n = 0", f"output_every = {max(1, int(steps))}",
+           "# the step and the state are LAMMPS's: a settled packing (discs in contact) and",
+           "# the peer's dt, which ballast's contact-network bound may call too large",
+           "allow_overlap = 1", "force_dt = 1", "",
            "[material grain]", f"kn = {fmt(kn)}", f"ks = {fmt(kt)}", f"friction = {fmt(mu)}",
            f"density = {fmt(density)}", "",
            "[material box]", f"kn = {fmt(kn)}", f"ks = {fmt(kt)}", f"friction = {fmt(mu)}", ""]

@@ -1,0 +1,582 @@
+"""Stability limits (issue 6, item 3): the largest stable time step of every catalogue
+variant, found by bisection, against ballast's critical-step estimate; and the extreme
+probe scenes of cases/extremes/.
+
+Limit of one variant.  Every trial runs the variant's scene with its `set =` overrides,
+`settings.dt = f x estimate` (the estimate that `bin/ballast info` prints for that
+variant; an explicit dt of the case is replaced the same way) and every stage's cycles
+scaled by dt_case / dt_trial, so that each trial covers the same physical time as the
+case, with at most CYCLE_CAP cycles per stage (the bounded run).  A trial is unstable
+when any of these holds:
+
+  - ballast exits non-zero (1 = unstable: today a non-finite state; later also the
+    overlap and runaway-energy guards of core/sim.c);
+  - a series value is not finite;
+  - the largest E_k + E_el of the series falls below the baseline's over ENERGY_LOSS
+    (spurious sliding has dissipated what the case stores: a stable step resolves the
+    same loading), or it, or the largest E_k alone, exceeds ENERGY_GROWTH times that of
+    the baseline (the variant at its own dt, with the same
+    cycle cap).  E_k alone catches an oscillation that Coulomb sliding keeps bounded
+    (a shear-rotation mode past its limit in a frictional quasi-static test, where E_k
+    is a small part of the energy); or
+  - the range (min, max over the run) of some probe of the series moves by more than
+    DEVIATION of the baseline's largest magnitude of that probe: a stable run covers
+    the same physical time with O((omega dt)^2) errors in its slow motions, while an
+    instability that sliding or a stop rule keeps finite still shows in the forces or
+    in the number of sliding contacts (phases are not compared: the leapfrog's
+    frequency error shifts them legitimately); or
+  - the largest overlap / smaller radius of the final contacts exceeds
+    max(OVERLAP_GROWTH x baseline, baseline + OVERLAP_SLACK).
+
+An unstable leapfrog grows geometrically (by 1.3 per step at 1 % past the limit), so
+these bounds are not fine-tuned: the energy of a stable run near the limit differs from
+the baseline's by O((omega dt)^2) < 4x only through the staggered velocities.
+
+The bisection brackets [stable, unstable] starting at f = 1, moving by STEP, then
+halves the bracket until hi/lo <= 1 + TOLERANCE.  The limit reported is the largest
+stable f: the measured limit over the estimate.  A safe and tight estimate has it in
+[1, 1.25].
+"""
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .ini import parse_file
+
+ENERGY_GROWTH = 4.0
+ENERGY_LOSS = 1.5
+STEP = 1.25              # the bracket search moves by this factor (not 2: an unstable band
+                         # that friction or a stop rule ends can lie between stable steps)
+DEVIATION = 1.0
+OVERLAP_GROWTH = 2.0
+OVERLAP_SLACK = 0.05
+TOLERANCE = 0.01
+CYCLE_CAP = 20000
+F_MIN, F_MAX = 1 / 64, 64
+
+
+# ---------------------------------------------------------------- targets
+
+@dataclass
+class Target:
+    """One scene with its overrides: a catalogue variant or an extreme probe."""
+    case: str
+    variant: str
+    scene: Path
+    sets: list
+
+
+def targets_for(cases):
+    """Every DEM variant (command = run) of the cases."""
+    return [Target(c.name, v.name, v.scene, list(v.sets)) for c in cases for v in c.variants
+            if v.command == "run"]
+
+
+# ---------------------------------------------------------------- ballast
+
+def info(binary, scene, sets):
+    """`ballast info` of a scene: estimate (the bound), single (C&S 2 sqrt(m/k)), dt."""
+    cmd = [str(binary), "info", str(scene)] + [a for s in sets for a in ("--set", s)]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)}: exit {proc.returncode}: {proc.stderr.strip()}")
+    return parse_info(proc.stdout)
+
+
+def parse_info(text):
+    values = {}
+    for key, name in (("estimate", "dt estimate"), ("single", "dt single"), ("dt", "dt used")):
+        m = re.search(rf"^{name}\s+(\S+)", text, re.M)
+        if m:
+            values[key] = float(m.group(1))
+    if "estimate" not in values or "dt" not in values:
+        raise RuntimeError(f"cannot read the estimate from ballast info:\n{text}")
+    values.setdefault("single", float("nan"))
+    return values
+
+
+def stage_cycles(scene, sets):
+    """[(stage name, cycles)] of the scene in file order, after the overrides."""
+    stages, current = [], None
+    for raw in Path(scene).read_text(encoding="utf-8").splitlines():
+        line = raw.split("#", 1)[0].strip()
+        m = re.match(r"^\[\s*(\w+)\s*([^\]]*?)\s*\]$", line)
+        if m:
+            current = m.group(2) if m.group(1) == "stage" else None
+            if current is not None:
+                stages.append([current, 0])
+            continue
+        if current is not None and "=" in line:
+            key, value = (x.strip() for x in line.split("=", 1))
+            if key == "cycles":
+                stages[-1][1] = int(float(value))
+    for s in sets:
+        m = re.match(r"^stage\.([^.]+)\.cycles=(.+)$", s.strip())
+        if m:
+            for st in stages:
+                if st[0] == m.group(1):
+                    st[1] = int(float(m.group(2)))
+    return [tuple(s) for s in stages]
+
+
+def scaled_cycles(stages, dt_case, dt_trial, cap=CYCLE_CAP):
+    """Overrides giving each stage the same physical time at dt_trial (at least one cycle
+    for a stage that had any; at most cap)."""
+    out = []
+    for name, cycles in stages:
+        n = 0 if cycles == 0 else max(1, min(cap, int(round(cycles * dt_case / dt_trial))))
+        out.append(f"stage.{name}.cycles={n}")
+    return out
+
+
+@dataclass
+class Trial:
+    exit: int
+    message: str = ""
+    steps: int = 0
+    energy_max: float = float("nan")   # largest E_k + E_el of the series
+    kinetic_max: float = float("nan")  # largest E_k of the series
+    overlap_max: float = float("nan")   # largest overlap / smaller radius, final contacts
+    nonfinite: str = ""                 # first non-finite series value: 'cycle C column K'
+    envelope: dict = field(default_factory=dict)   # column -> (min, max) over the series
+
+
+def run(binary, scene, sets, folder):
+    """Run ballast once and read what the criteria need."""
+    cmd = [str(binary), "run", str(scene), "--out", str(folder)] + [a for s in sets for a in ("--set", s)]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    t = Trial(proc.returncode, proc.stderr.strip())
+    folder = Path(folder)
+    try:
+        meta = json.loads((folder / "run.json").read_text())
+        t.steps = int(meta.get("steps", 0))
+        t.message = meta.get("message", "") or t.message
+    except (OSError, ValueError):
+        pass
+    t.energy_max, t.kinetic_max, t.nonfinite = series_energy(folder / "series.tsv")
+    t.envelope = series_envelope(folder / "series.tsv")
+    t.overlap_max = largest_overlap(folder / "discs.tsv", folder / "contacts.tsv")
+    return t
+
+
+def series_energy(path):
+    """(largest E_k + E_el, largest E_k, first non-finite value) of a series.tsv."""
+    nan = float("nan")
+    try:
+        lines = Path(path).read_text().splitlines()
+    except OSError:
+        return nan, nan, ""
+    if not lines:
+        return nan, nan, ""
+    head = lines[0].split("\t")
+    cols = [head.index(c) for c in ("Ek", "Ee") if c in head]
+    ek = head.index("Ek") if "Ek" in head else None
+    best, kin, bad = nan, nan, ""
+    for line in lines[1:]:
+        row = line.split("\t")
+        try:
+            vals = [float(x) for x in row]
+        except ValueError:
+            vals = [nan] * len(row)
+        if not bad:
+            for k, v in enumerate(vals):
+                if not math.isfinite(v):
+                    bad = f"cycle {row[0]} column {head[k] if k < len(head) else k}"
+                    break
+        if cols:
+            e = sum(vals[c] for c in cols)
+            if math.isfinite(e):
+                best = e if math.isnan(best) else max(best, e)
+        if ek is not None and math.isfinite(vals[ek]):
+            kin = vals[ek] if math.isnan(kin) else max(kin, vals[ek])
+    return best, kin, bad
+
+
+def series_envelope(path):
+    """{column: (min, max)} over the finite values of every probe column of a series.tsv."""
+    try:
+        lines = Path(path).read_text().splitlines()
+    except OSError:
+        return {}
+    if not lines:
+        return {}
+    head = lines[0].split("\t")
+    env = {}
+    for line in lines[1:]:
+        for name, x in zip(head[2:], line.split("\t")[2:]):
+            try:
+                v = float(x)
+            except ValueError:
+                continue
+            if math.isfinite(v):
+                lo, hi = env.get(name, (v, v))
+                env[name] = (min(lo, v), max(hi, v))
+    return env
+
+
+def envelope_deviation(trial, base):
+    """(column, deviation) of the probe whose range moved most: max(|min_t - min_b|,
+    |max_t - max_b|) / its scale, the scale being max(|min_b|, |max_b|) but at least
+    1e-9 of the largest scale of the series (so a column that is zero to round-off in
+    the baseline does not divide by nothing)."""
+    scales = {c: max(abs(lo), abs(hi)) for c, (lo, hi) in base.items()}
+    floor = 1e-9 * max(scales.values(), default=0)
+    worst = ("", 0.0)
+    for c, (lo, hi) in base.items():
+        if c not in trial:
+            continue
+        tlo, thi = trial[c]
+        scale = max(scales[c], floor)
+        if scale <= 0:
+            continue
+        dev = max(abs(tlo - lo), abs(thi - hi)) / scale
+        if dev > worst[1]:
+            worst = (c, dev)
+    return worst
+
+
+def largest_overlap(discs, contacts):
+    """Largest overlap / smaller radius over the final contacts.  The contact point of
+    contacts.tsv lies R_a - delta/2 from the centre of a (C&S; halfway between the
+    surfaces), so delta = 2 (R_a - |p - x_a|)."""
+    try:
+        dl = Path(discs).read_text().splitlines()
+        cl = Path(contacts).read_text().splitlines()
+    except OSError:
+        return float("nan")
+    if not dl or not cl:
+        return float("nan")
+    dh = dl[0].split("\t")
+    ix, iy, ir, iname = dh.index("x"), dh.index("y"), dh.index("r"), dh.index("name")
+    disc = {}
+    for line in dl[1:]:
+        f = line.split("\t")
+        disc[f[iname]] = (float(f[ix]), float(f[iy]), float(f[ir]))
+    ch = cl[0].split("\t")
+    ca, cb, cx, cy = ch.index("a"), ch.index("b"), ch.index("x"), ch.index("y")
+    best = 0.0
+    for line in cl[1:]:
+        f = line.split("\t")
+        if f[ca] not in disc:
+            continue
+        xa, ya, ra = disc[f[ca]]
+        delta = 2 * (ra - math.hypot(float(f[cx]) - xa, float(f[cy]) - ya))
+        r = min(ra, disc[f[cb]][2]) if f[cb] in disc else ra
+        if math.isfinite(delta):
+            best = max(best, delta / r)
+        else:
+            return float("inf")
+    return best
+
+
+def verdict(trial, base):
+    """'' if the trial is stable against the baseline, else why not."""
+    if trial.exit != 0:
+        return f"exit {trial.exit}: {trial.message}"[:200]
+    if trial.nonfinite:
+        return f"non-finite series value at {trial.nonfinite}"
+    if math.isfinite(base.energy_max) and base.energy_max > 0:
+        if not math.isfinite(trial.energy_max) or trial.energy_max > ENERGY_GROWTH * base.energy_max:
+            return f"energy {trial.energy_max:.4g} > {ENERGY_GROWTH:g} x baseline {base.energy_max:.4g}"
+        if trial.energy_max < base.energy_max / ENERGY_LOSS:
+            return f"energy {trial.energy_max:.4g} < baseline {base.energy_max:.4g} / {ENERGY_LOSS:g}"
+    if math.isfinite(base.kinetic_max) and base.kinetic_max > 0:
+        if not math.isfinite(trial.kinetic_max) or trial.kinetic_max > ENERGY_GROWTH * base.kinetic_max:
+            return f"E_k {trial.kinetic_max:.4g} > {ENERGY_GROWTH:g} x baseline {base.kinetic_max:.4g}"
+    col, dev = envelope_deviation(trial.envelope, base.envelope)
+    if dev > DEVIATION:
+        lo, hi = trial.envelope[col]
+        blo, bhi = base.envelope[col]
+        return f"probe {col} range [{lo:.4g}, {hi:.4g}], baseline [{blo:.4g}, {bhi:.4g}]"
+    if math.isfinite(base.overlap_max):
+        bound = max(OVERLAP_GROWTH * base.overlap_max, base.overlap_max + OVERLAP_SLACK)
+        if not trial.overlap_max <= bound:
+            return f"overlap/r {trial.overlap_max:.4g} > {bound:.4g}"
+    return ""
+
+
+# ---------------------------------------------------------------- bisection
+
+@dataclass
+class Limit:
+    case: str
+    variant: str
+    estimate: float          # the bound ballast uses
+    single: float            # C&S 2 sqrt(m/k)
+    dt_case: float
+    limit: float = float("nan")      # largest stable f (x estimate)
+    unstable: float = float("nan")   # smallest unstable f seen
+    cause: str = ""          # why the first unstable trial above the limit failed
+    trials: int = 0
+    note: str = ""
+    log: list = field(default_factory=list)
+
+    @property
+    def case_fraction(self):
+        return self.dt_case / self.estimate
+
+    @property
+    def single_ratio(self):
+        """measured limit over the single-spring estimate."""
+        return self.limit * self.estimate / self.single
+
+
+def measure(binary, target, workdir, cap=CYCLE_CAP, tolerance=TOLERANCE):
+    """The largest stable dt fraction of one target."""
+    est = info(binary, target.scene, target.sets)
+    lim = Limit(target.case, target.variant, est["estimate"], est["single"], est["dt"])
+    stages = stage_cycles(target.scene, target.sets)
+    work = Path(tempfile.mkdtemp(prefix=f"{target.case}.{target.variant}.", dir=workdir))
+    try:
+        base_sets = target.sets + scaled_cycles(stages, 1, 1, cap)
+        base = run(binary, target.scene, base_sets, work / "base")
+        if base.exit != 0:
+            lim.note = f"baseline (its own dt) fails: exit {base.exit}: {base.message}"
+            return lim
+
+        def stable(f):
+            dt = f * lim.estimate
+            # force_dt: a trial above the estimate is the point of the bisection (ballast refuses
+            # such a step otherwise)
+            sets = target.sets + [f"settings.dt={dt!r}", "settings.force_dt=1"] + \
+                scaled_cycles(stages, lim.dt_case, dt, cap)
+            t = run(binary, target.scene, sets, work / "trial")
+            why = verdict(t, base)
+            lim.trials += 1
+            lim.log.append((f, why or "stable"))
+            return why
+
+        f = 1.0
+        why = stable(f)
+        if not why:
+            lo, hi, cause = f, None, ""
+            while f < F_MAX:
+                f *= STEP
+                why = stable(f)
+                if why:
+                    hi, cause = f, why
+                    break
+                lo = f
+        else:
+            hi, lo, cause = f, None, why
+            while f > F_MIN:
+                f /= STEP
+                why = stable(f)
+                if not why:
+                    lo = f
+                    break
+                hi, cause = f, why
+        if lo is None or hi is None:
+            lim.limit = lo if lo is not None else float("nan")
+            lim.note = "no unstable step up to f = %g" % F_MAX if hi is None else "unstable down to f = %g" % F_MIN
+            return lim
+        while hi / lo > 1 + tolerance:
+            mid = math.sqrt(lo * hi)
+            why = stable(mid)
+            if why:
+                hi, cause = mid, why
+            else:
+                lo = mid
+        lim.limit, lim.unstable, lim.cause = lo, hi, cause
+        return lim
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+def measure_all(binary, targets, workdir, jobs=None, cap=CYCLE_CAP, tolerance=TOLERANCE, out=None):
+    jobs = jobs or os.cpu_count() or 1
+    Path(workdir).mkdir(parents=True, exist_ok=True)
+
+    def one(t):
+        lim = measure(binary, t, workdir, cap, tolerance)
+        if out:
+            print(f"  {t.case}/{t.variant}: limit {lim.limit:.4g} x estimate "
+                  f"({lim.trials} trials){' ' + lim.note if lim.note else ''}", file=out, flush=True)
+        return lim
+
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        return list(pool.map(one, targets))
+
+
+LIMIT_COLUMNS = ("case", "variant", "dt_case", "estimate", "single_spring", "single_over_estimate",
+                 "case_fraction", "limit_fraction", "limit_over_single", "unstable_fraction",
+                 "in_target", "trials", "cause", "note")
+
+
+def in_target(f):
+    """The estimate is safe (f >= 1) and tight (f <= 1.25)."""
+    return math.isfinite(f) and 1.0 <= f <= 1.25
+
+
+def limit_rows(limits):
+    rows = []
+    for L in limits:
+        rows.append({
+            "case": L.case, "variant": L.variant, "dt_case": f"{L.dt_case:.6g}",
+            "estimate": f"{L.estimate:.6g}", "single_spring": f"{L.single:.6g}",
+            "single_over_estimate": f"{L.single / L.estimate:.4g}",
+            "case_fraction": f"{L.case_fraction:.4g}", "limit_fraction": f"{L.limit:.4g}",
+            "limit_over_single": f"{L.single_ratio:.4g}", "unstable_fraction": f"{L.unstable:.4g}",
+            "in_target": "yes" if in_target(L.limit) else "no", "trials": str(L.trials),
+            "cause": L.cause.replace("\t", " ").replace("\n", " "),
+            "note": L.note.replace("\t", " ").replace("\n", " ")})
+    return rows
+
+
+def write_tsv(rows, columns, path):
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    with open(tmp, "w", encoding="utf-8") as f:
+        f.write("\t".join(columns) + "\n")
+        for r in rows:
+            f.write("\t".join(str(r.get(c, "")) for c in columns) + "\n")
+    os.replace(tmp, path)
+
+
+def merge_tsv(rows, columns, path, key):
+    """Write rows into the table at path: a row replaces the one with the same key
+    columns, in place; new keys are appended.  So `stability CASE` updates one case."""
+    path = Path(path)
+    old = read_tsv(path) if path.exists() else []
+    new = {tuple(r[k] for k in key): r for r in rows}
+    merged = [new.pop(tuple(r.get(k) for k in key), r) for r in old]
+    merged += [r for r in rows if tuple(r[k] for k in key) in new]
+    write_tsv(merged, columns, path)
+
+
+def read_tsv(path):
+    lines = Path(path).read_text(encoding="utf-8").splitlines()
+    if not lines:
+        return []
+    head = lines[0].split("\t")
+    return [dict(zip(head, line.split("\t"))) for line in lines[1:]]
+
+
+# ---------------------------------------------------------------- extremes
+
+EXTREME_KEYS = {"scene", "set", "group", "what", "expect", "energy_ratio", "e_in", "overlap_max", "bound"}
+EXPECTS = ("stable", "stop")
+
+
+@dataclass
+class Probe:
+    name: str
+    group: str               # which physics the row probes (rows of later physics add groups)
+    what: str
+    scene: Path
+    sets: list
+    expect: str              # stable: runs through and passes its criteria;
+                             # stop: ballast ends it with exit 1 and says why
+    energy_ratio: float      # stable: E_out/E_in (last over first row of E_k + E_el) at most this
+                             # (nan: not a criterion, e.g. under gravity)
+    overlap_max: float       # stable: largest final overlap / smaller radius at most this
+    bounds: list = field(default_factory=list)   # [(column, lo, hi)]: every row within
+    line: int = 0
+    e_in: float = float("nan")   # the energy put in, when the first row cannot give it (nan: first row)
+
+
+def load_probes(path):
+    """The probes of cases/extremes/extremes.txt ([probe NAME] sections)."""
+    probes = []
+    for sec in parse_file(path):
+        if sec.kind != "probe":
+            raise sec.error(f"unknown section kind '{sec.kind}' (known: probe)")
+        sec.check_keys(EXTREME_KEYS)
+        expect = sec.get("expect", "stable")
+        if expect not in EXPECTS:
+            raise sec.error(f"expect must be one of {', '.join(EXPECTS)}, not '{expect}'")
+        bounds = []
+        for e in sec.all("bound"):
+            parts = e.value.split()
+            try:
+                bounds.append((parts[0], float(parts[1]), float(parts[2])))
+            except (IndexError, ValueError):
+                raise sec.error(f"bound needs 'COLUMN LO HI', got '{e.value}'", e.line) from None
+        probes.append(Probe(sec.name, sec.require("group"), sec.require("what"),
+                            Path(path).parent / sec.require("scene"), [e.value for e in sec.all("set")],
+                            expect, sec.number("energy_ratio", float("nan")), sec.number("overlap_max", 0.1),
+                            bounds, sec.line, sec.number("e_in", float("nan"))))
+    return probes
+
+
+def energy_in_out(path):
+    """(E at the first row, E at the last row) of E_k + E_el in a series."""
+    nan = float("nan")
+    try:
+        lines = Path(path).read_text().splitlines()
+    except OSError:
+        return nan, nan
+    if len(lines) < 2:
+        return nan, nan
+    head = lines[0].split("\t")
+    cols = [head.index(c) for c in ("Ek", "Ee") if c in head]
+    if not cols:
+        return nan, nan
+
+    def energy(line):
+        row = line.split("\t")
+        try:
+            return sum(float(row[c]) for c in cols)
+        except (ValueError, IndexError):
+            return nan
+    return energy(lines[1]), energy(lines[-1])
+
+
+def judge(probe, trial, e_in, e_out):
+    """(outcome, ok): what happened, and whether it is what the probe accepts."""
+    if trial.exit != 0:
+        msg = trial.message or "(no message)"
+        return f"stopped, exit {trial.exit}: {msg}", probe.expect == "stop" and trial.exit == 1 and bool(trial.message)
+    if trial.nonfinite:
+        return f"NON-FINITE output with exit 0 at {trial.nonfinite}", False
+    problems = []
+    ratio = e_out / e_in if e_in > 0 else float("nan")
+    if not math.isnan(probe.energy_ratio) and not ratio <= probe.energy_ratio:
+        problems.append(f"E_out/E_in {ratio:.4g} > {probe.energy_ratio:g}")
+    if not trial.overlap_max <= probe.overlap_max and not math.isnan(trial.overlap_max):
+        problems.append(f"overlap/r {trial.overlap_max:.3g} > {probe.overlap_max:g}")
+    for col, lo, hi in probe.bounds:
+        if col not in trial.envelope:
+            problems.append(f"no column {col}")
+            continue
+        tlo, thi = trial.envelope[col]
+        if tlo < lo or thi > hi:
+            problems.append(f"{col} in [{tlo:.4g}, {thi:.4g}], outside [{lo:g}, {hi:g}]")
+    if problems:
+        return "ran through: " + "; ".join(problems), False
+    return "ran through, within its criteria", probe.expect == "stable"
+
+
+EXTREME_COLUMNS = ("group", "probe", "what", "expect", "exit", "steps", "e_in", "e_out", "e_out_over_in",
+                   "overlap_max", "outcome", "as_expected")
+
+
+def run_probe(binary, probe, workdir):
+    folder = Path(tempfile.mkdtemp(prefix=f"extreme.{probe.name}.", dir=workdir))
+    try:
+        t = run(binary, probe.scene, probe.sets, folder)
+        e_in, e_out = energy_in_out(folder / "series.tsv")
+        if not math.isnan(probe.e_in):
+            e_in = probe.e_in
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+    outcome, ok = judge(probe, t, e_in, e_out)
+    ratio = e_out / e_in if e_in and e_in > 0 else float("nan")
+    return {"group": probe.group, "probe": probe.name, "what": probe.what, "expect": probe.expect,
+            "exit": str(t.exit), "steps": str(t.steps), "e_in": f"{e_in:.6g}", "e_out": f"{e_out:.6g}",
+            "e_out_over_in": f"{ratio:.6g}", "overlap_max": f"{t.overlap_max:.4g}",
+            "outcome": outcome.replace("\t", " ").replace("\n", " "), "as_expected": "yes" if ok else "no"}
+
+
+def run_probes(binary, probes, workdir, jobs=None):
+    Path(workdir).mkdir(parents=True, exist_ok=True)
+    with ThreadPoolExecutor(max_workers=jobs or os.cpu_count() or 1) as pool:
+        return list(pool.map(lambda p: run_probe(binary, p, workdir), probes))

@@ -2,7 +2,7 @@
  * energy.c — the energy audit of a run, and the guards that stop a run
  * whose energy runs away or whose overlaps exceed the budget.
  *
- * Balance, from the first cycle (t_1, the first time forces exist) to now:
+ * Balance, from the start (t_0, before the first cycle) to now:
  *
  *   W_walls + W_gravity = ΔE_k + ΔE_el + D_dashpot + D_friction + D_global
  *                         + imbalance
@@ -18,12 +18,12 @@
  *              g_fac as g_fac m g·Δ(centre of mass)
  *   D_dashpot  Σ_cycles (D_n ṅ_N + D_s ṡ_N) Δt (C&S eqs 26–28, MLH eq. 3):
  *              the work of the dashpot forces on the motion at t_N, from
- *              their per-disc sums; first and latest cycle count half
+ *              their per-disc sums; the latest cycle counts half
  *   D_friction Σ_cycles F_max |slip|, slip = (|F_s trial| − F_max)/k_s, where
  *              the Coulomb limit (eq. 19) cuts the shear force
  *   D_global   Σ_cycles α (m v_N² + I ω_N²) Δt: eqs (35)–(36) are
- *              m (v_{N+1/2} − v_{N−1/2})/Δt = F − α m v_N; the first and
- *              the latest cycle count half (each is centred on an end)
+ *              m (v_{N+1/2} − v_{N−1/2})/Δt = F − α m v_N; the latest
+ *              cycle counts half (it is centred on the end)
  *
  * The imbalance is what the time discretisation creates or destroys (the
  * centred scheme conserves a shadow energy, not E_k + E_el), plus what the
@@ -51,26 +51,67 @@ static double gravity_potential(const struct bal_sim *s)
 static double global_loss(const struct bal_sim *s);
 static double dashpot_loss(const struct bal_sim *s);
 
+/* The kinetic energy at t_0.  The centred scheme holds v_{1/2}: before any
+ * contact force exists v_0 = v_{1/2} − g_fac g Δt/2 (exact in free flight);
+ * the other integrators hold v_0 itself. */
+static double start_kinetic(const struct bal_sim *s)
+{
+    const double half = s->integ->staggered ? 0.5 * s->gfac * s->dt : 0;
+    double e = 0;
+    for (int i = 0; i < s->n; i++) {
+        const double h = s->fixed[i] ? 0 : half;
+        const double vx = s->vx[i] - h * s->g[0], vy = s->vy[i] - h * s->g[1];
+        e += 0.5 * bal_mass(s, i) * (vx * vx + vy * vy) + 0.5 * bal_inertia(s, i) * s->w[i] * s->w[i];
+    }
+    return e;
+}
+
+/* The elastic energy at t_0: the power law's force is a function of the
+ * overlap, so overlapping bodies (allowed by the scene) hold it already; the
+ * incremental law starts every contact from F_n = 0 (no history): none. */
+static double start_elastic(const struct bal_sim *s)
+{
+    if (s->normal_law != BAL_NORMAL_POWER)
+        return 0;
+    double e = 0;
+    for (int list = 0; list < 2; list++) {
+        const struct bal_pairs *p = list ? &s->pw : &s->pp;
+        for (long c = 0; c < p->n; c++) {
+            const int i = p->i[c], j = p->j[c];
+            double delta;
+            const struct bal_pair_law *L;
+            if (list) {
+                double cx, cy;
+                delta = s->r[i] - sqrt(bal_walls_closest(&s->walls[j], s->x[i], s->y[i], &cx, &cy));
+                L = &s->law[s->mat[i] * s->n_mat + s->walls[j].material];
+            } else {
+                delta = s->r[i] + s->r[j] - hypot(s->x[j] - s->x[i], s->y[j] - s->y[i]);
+                L = &s->law[s->mat[i] * s->n_mat + s->mat[j]];
+            }
+            if (delta > 0)
+                e += L->kn * s->delta0 * s->delta0 * pow(delta / s->delta0, s->nu + 1) / (s->nu + 1);
+        }
+    }
+    return e;
+}
+
+/* The baseline at t_0, before the first cycle moves anything: every cycle
+ * is then counted, the first included (where an impact that starts in
+ * contact gains or loses most). */
 void bal_energy_begin(struct bal_sim *s)
 {
     struct bal_audit *a = &s->audit;
     *a = (struct bal_audit){0};
     a->started = 1;
     a->start_step = s->step;
-    a->ek0 = bal_measure_kinetic(s);
-    a->ee0 = bal_measure_elastic(s);
+    a->ek0 = start_kinetic(s);
+    a->ee0 = start_elastic(s);
     a->gravity = s->g[0] != 0 || s->g[1] != 0;
     a->g_last = a->gravity ? gravity_potential(s) : 0;
     a->gfac_last = s->gfac;
-    if (s->alpha != 0)
-        a->d_global = 0.5 * global_loss(s);
-    if (s->dash_fx)
-        a->d_dashpot = 0.5 * dashpot_loss(s);
     for (int k = 0; k < s->n_walls; k++) {
         struct bal_wall *W = &s->walls[k];
-        W->f_prev[0] = W->f[0];
-        W->f_prev[1] = W->f[1];
-        W->moment_prev = W->moment;
+        W->f_prev[0] = W->f_prev[1] = W->moment_prev = 0; /* no force before the first cycle */
     }
 }
 

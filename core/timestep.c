@@ -55,7 +55,8 @@
  *    touching a disc of radius R without overlapping each other, N =
  *    ⌊π / asin(r/(R + r))⌋, each with the stiffest material, the lightest
  *    partner, and normals packed as closely as they can around one direction
- *    (λ_max(Σ n nᵀ) ≤ Λ, computed in coordination_lambda).  Since t tᵀ =
+ *    (λ_max(Σ n nᵀ) ≤ Λ, computed in coordination_lambda), and never more
+ *    than the scene's other bodies (n − 1 discs + walls).  Since t tᵀ =
  *    I − n nᵀ, λ_max(T) ≤ B N + (A − B) Λ for A ≥ B, B N − (B − A)(N − Λ)
  *    otherwise, and Θ ≤ N B.  Six equal discs: Λ = 3.  A disc that starts
  *    with few contacts and gains many is not covered (the limitation of an
@@ -336,7 +337,14 @@ static double coordination_omega2(const struct bal_sim *s, int i, double r_min, 
                                   double gamma, double *beta)
 {
     double lambda;
-    const int n = coordination(s->r[i], r_min, &lambda);
+    int n = coordination(s->r[i], r_min, &lambda);
+    /* ... and no more contacts than the scene has other bodies (two discs
+     * colliding: one partner, so the bound is that of one spring) */
+    const int others = s->n - 1 + s->n_walls;
+    if (n > others) {
+        n = others;
+        lambda = fmin(lambda, (double)others);
+    }
     double ia, ra;
     disc_inv(s, i, &ia, &ra);
     double A = 0, B = 0;

@@ -122,9 +122,9 @@ END_TEST
 /* A disc thrown along a frictional floor, resting on it at its static
  * overlap m g/k, slides until it rolls (a disc cannot stop sliding without
  * spinning up: then it keeps 1/3 of its kinetic energy).  The slip under
- * F_max each cycle is exactly (|F_s trial| - F_max)/k_s = u Δt, so the
- * audit closes to the scheme's O(Δt²) in E_k: bound 1e-6 of the energy
- * through the run. */
+ * F_max each cycle is exactly (|F_s trial| - F_max)/k_s = u Δt once the
+ * shear spring is at the limit, so the audit closes to the scheme's O(Δt²)
+ * after the first cycle (bound at the test). */
 static struct bal_energy slide(double dt, double y, long cycles)
 {
     struct tfx *f = tfx_newf("slide", "[settings]\ndt = %.17g\ngravity = 0 -9.81\nnormal_law = power\n"
@@ -143,7 +143,11 @@ START_TEST(energy_friction_sliding)
     const double m = 2 * BAL_PI * 0.25, y = 0.5 - m * 9.81 / 1e5;
     const struct bal_energy e = slide(2e-4, y, 4000);
     ck_assert_double_gt(e.dissipated_friction, 0.3 * e.kinetic0);
-    ck_assert_double_le(fabs(e.imbalance), 1e-6 * e.throughput);
+    /* The audit starts at t_0: in the first cycle the shear spring goes from
+     * zero to the Coulomb limit within one step of sliding at u = 3, which
+     * the discrete slip accounts to within F_max u Δt; the rest is O(Δt²). */
+    const double fmax = 0.4 * m * 9.81;
+    ck_assert_double_le(fabs(e.imbalance), fmax * 3 * 2e-4 + 1e-6 * e.throughput);
 }
 END_TEST
 

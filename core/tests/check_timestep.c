@@ -363,32 +363,60 @@ static double fan_lambda(double a, int n)
     }
     return fmin(2 * best, n);
 }
+/* Twelve far-away discs of radius RR: the scene has enough bodies that the
+ * cap "no more contacts than other bodies" does not bind. */
+static const char *far_discs(void)
+{
+    static char text[2048];
+    int len = 0;
+    for (int k = 0; k < 12; k++)
+        len += snprintf(text + len, sizeof text - (size_t)len,
+                        "[disc far%d]\nx = %d 100\nr = %.17g\nmaterial = m\n", k, 20 + 3 * k, RR);
+    return text;
+}
+
 START_TEST(network_coordination)
+{
+    struct tfx *f = tfx_newf("ts",
+                             "[material m]\nkn = %.17g\ndensity = %.17g\n"
+                             "[disc a]\nx = 0 0\nr = %.17g\nmaterial = m\n"
+                             "[disc b]\nx = 10 0\nr = %.17g\nmaterial = m\n%s"
+                             "[stage s]\ncycles = 1\n",
+                             KN, RHO, RR, RR, far_discs());
+    ASSERT_REL(info_of(f).estimate, 2 / sqrt(3 * KN * 2 / disc_mass(RR)));
+    struct bal_dt_detail d;
+    bal_sim_dt_detail(f->sim, &d);
+    ck_assert_int_eq(d.contacts, 0);
+    ck_assert_int_eq(d.coordination_discs, 14);
+    tfx_release(f);
+
+    f = tfx_newf("ts",
+                 "[material m]\nkn = %.17g\ndensity = %.17g\n"
+                 "[disc a]\nx = 0 0\nr = %.17g\nmaterial = m\n"
+                 "[disc b]\nx = 10 0\nr = %.17g\nmaterial = m\n%s"
+                 "[stage s]\ncycles = 1\n",
+                 KN, RHO, 3 * RR, RR, far_discs());
+    const double a = asin(0.25), lambda = fan_lambda(a, 12);
+    ck_assert_int_eq((int)floor(BAL_PI / a), 12);
+    ck_assert_double_eq_tol(lambda, 6.23, 0.01);
+    const double w2 = KN * (1 / disc_mass(3 * RR) + 1 / disc_mass(RR)) * lambda;
+    ck_assert_double_eq_tol(info_of(f).estimate, 2 / sqrt(w2), 1e-3 * 2 / sqrt(w2));
+}
+END_TEST
+
+/* Two discs apart and nothing else: each can touch only one body, so the
+ * bound is that of one spring, however many discs of their size could fit
+ * around them.  The partner is taken as the lightest free disc (the bound
+ * does not pair discs): for the small disc ω² = k (1/m_s + 1/m_s). */
+START_TEST(network_coordination_capped_by_bodies)
 {
     struct tfx *f = tfx_newf("ts",
                              "[material m]\nkn = %.17g\ndensity = %.17g\n"
                              "[disc a]\nx = 0 0\nr = %.17g\nmaterial = m\n"
                              "[disc b]\nx = 10 0\nr = %.17g\nmaterial = m\n"
                              "[stage s]\ncycles = 1\n",
-                             KN, RHO, RR, RR);
-    ASSERT_REL(info_of(f).estimate, 2 / sqrt(3 * KN * 2 / disc_mass(RR)));
-    struct bal_dt_detail d;
-    bal_sim_dt_detail(f->sim, &d);
-    ck_assert_int_eq(d.contacts, 0);
-    ck_assert_int_eq(d.coordination_discs, 2);
-    tfx_release(f);
-
-    f = tfx_newf("ts",
-                 "[material m]\nkn = %.17g\ndensity = %.17g\n"
-                 "[disc a]\nx = 0 0\nr = %.17g\nmaterial = m\n"
-                 "[disc b]\nx = 10 0\nr = %.17g\nmaterial = m\n"
-                 "[stage s]\ncycles = 1\n",
-                 KN, RHO, 3 * RR, RR);
-    const double a = asin(0.25), lambda = fan_lambda(a, 12);
-    ck_assert_int_eq((int)floor(BAL_PI / a), 12);
-    ck_assert_double_eq_tol(lambda, 6.23, 0.01);
-    const double w2 = KN * (1 / disc_mass(3 * RR) + 1 / disc_mass(RR)) * lambda;
-    ck_assert_double_eq_tol(info_of(f).estimate, 2 / sqrt(w2), 1e-3 * 2 / sqrt(w2));
+                             KN, RHO, RR, 3 * RR);
+    ASSERT_REL(info_of(f).estimate, 2 / sqrt(KN * 2 / disc_mass(RR)));
 }
 END_TEST
 
@@ -425,6 +453,7 @@ Suite *suite_timestep(void)
     tcase_add_test(net, network_hexagon);
     tcase_add_test(net, network_nine_discs_spectral);
     tcase_add_test(net, network_coordination);
+    tcase_add_test(net, network_coordination_capped_by_bodies);
     tcase_add_test(net, network_all_held);
     suite_add_tcase(s, net);
     return s;

@@ -81,13 +81,23 @@
  *    network's step is the larger of the two limits (the spectral one with
  *    the network's largest damping ratio).
  *
- *    The estimate is the smallest over free discs of 2/(ω (√(1+ζ²) + ζ)),
- *    with the network's part the better of the two bounds.
+ *    The estimate is BAL_DT_MARGIN = 0.95 times the smallest over free discs
+ *    of 2/(ω (√(1+ζ²) + ζ)), with the network's part the better of the two
+ *    bounds.
  */
 #include <math.h>
 #include <stdlib.h>
 
 #include "sim.h"
+
+/* The estimate is this share of the bound 2/(ω (√(1+ζ²) + ζ)).  At the
+ * bound itself the centred scheme is only marginally stable: its conserved
+ * (shadow) energy ½ m v² + ½ k x² (1 − ω²Δt²/4) degenerates, so the energy
+ * it shows can grow without limit in a short contact.  Measured: a linear
+ * collision created as much energy as it had at 0.993 of the bound, a
+ * damped one changed its rebound at 0.952 (harness stability).  5 % below
+ * the bound, every case of the catalogue is stable. */
+#define BAL_DT_MARGIN 0.95
 
 /* A pair whose gap is at most this share of the smaller radius is a contact
  * at the start.  The catalogue's scenes place touching bodies at gap 0 (to
@@ -577,7 +587,7 @@ void bal_timestep_detail(const struct bal_sim *s, struct bal_dt_detail *d)
     const struct part *use = coord.est < net.est ? &coord : &net;
     if (use == &coord)
         d->spectral = 0;
-    d->estimate = use->est;
+    d->estimate = BAL_DT_MARGIN * use->est;
     d->omega = use->omega;
     d->zeta = use->zeta;
     d->binding_disc = use->binding;

@@ -89,6 +89,13 @@ def cmd_validate(args):
     check_status = cmd_check(args)
     if not args.no_sweeps:
         cmd_cost(args)
+    if not args.no_stability:
+        # the first DEM variant of each case and the extreme probes (all variants:
+        # `harness stability`); a measurement shown in the report, not a gate
+        stab = argparse.Namespace(**vars(args))
+        stab.one_per_case, stab.extremes_only, stab.no_extremes = True, False, False
+        stab.cap, stab.tolerance = 20000, 0.01
+        cmd_stability(stab)
     cmd_report(args)
     return run_status or check_status
 
@@ -126,7 +133,7 @@ def cmd_stability(args):
     status = 0
     if not args.extremes_only:
         cases = selected(args, load_cases())
-        targets = stability.targets_for(cases)
+        targets = stability.targets_for(cases, getattr(args, "one_per_case", False))
         print(f"stability: bisecting {len(targets)} variant(s)")
         limits = stability.measure_all(args.bin, targets, work, args.jobs, args.cap, args.tolerance, sys.stdout)
         rows = stability.limit_rows(limits)
@@ -191,6 +198,8 @@ def parser():
     _selection(_command(sub, "report", cmd_report, "render figures, write reports/summary.md and reports/index.html"))
     validate = _runs(_selection(_command(sub, "validate", cmd_validate, "run + check + cost + report")))
     validate.add_argument("--no-sweeps", action="store_true", help="skip the declared sweeps (cost)")
+    validate.add_argument("--no-stability", action="store_true",
+                          help="skip the stability limits (first variant of each case) and extreme probes")
     rebase = _command(sub, "rebaseline", cmd_rebaseline, "rewrite the regression values of CASE from its current outputs")
     rebase.add_argument("case", metavar="CASE")
     sweep = _command(sub, "sweep", cmd_sweep, "run one variant once per value of a --set key and tabulate its checks")
@@ -209,6 +218,7 @@ def parser():
     stab.add_argument("--tolerance", type=float, default=0.01, help="bisect until hi/lo <= 1 + this (default 0.01)")
     stab.add_argument("--extremes-only", action="store_true", help="only the probes of cases/extremes")
     stab.add_argument("--no-extremes", action="store_true", help="only the catalogue's limits")
+    stab.add_argument("--one-per-case", action="store_true", help="only the first DEM variant of each case")
     return p
 
 

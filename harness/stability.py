@@ -73,10 +73,13 @@ class Target:
     sets: list
 
 
-def targets_for(cases):
-    """Every DEM variant (command = run) of the cases."""
-    return [Target(c.name, v.name, v.scene, list(v.sets)) for c in cases for v in c.variants
-            if v.command == "run"]
+def targets_for(cases, one_per_case=False):
+    """Every DEM variant (command = run) of the cases; or only the first of each case."""
+    out = []
+    for c in cases:
+        runs = [Target(c.name, v.name, v.scene, list(v.sets)) for v in c.variants if v.command == "run"]
+        out += runs[:1] if one_per_case else runs
+    return out
 
 
 # ---------------------------------------------------------------- ballast

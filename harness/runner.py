@@ -25,7 +25,7 @@ import subprocess
 import sys
 import threading
 import time
-from concurrent.futures import ThreadPoolExecutor, as_completed, wait
+from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,6 +34,8 @@ from .tables import RunProblem, read_harness_record, read_run_json, run_failure,
 
 STDERR_TAIL = 5
 STOP_GRACE = 10.0    # seconds a terminated run has to write run.json and exit before SIGKILL
+INTERRUPTED = (130, -signal.SIGINT, -signal.SIGTERM)   # how a run that was interrupted ends
+POLL = 0.1           # seconds between the main thread's looks at the runs (see run_all)
 PEER_SCRIPT = Path(__file__).resolve().parent.parent / "bench" / "peer" / "race.py"
 
 
@@ -98,6 +100,10 @@ class Running:
         with self._lock:
             self._procs.discard(proc)
 
+    def stop_starting(self):
+        with self._lock:
+            self.stopping = True
+
     def terminate(self):
         """SIGTERM to every live run; from now on runs are stopped as they start."""
         with self._lock:
@@ -140,6 +146,8 @@ def run_one(job, binary, running=None, resume=False, binary_id=None):
     except OSError as exc:
         returncode, stdout, stderr = None, "", f"cannot start {binary}: {exc.strerror}"
     wall = time.monotonic() - start
+    if running and returncode in INTERRUPTED:
+        running.stop_starting()     # Ctrl-C reached the core's process group: start no other run
     (job.out / "ballast.stdout").write_text(stdout, encoding="utf-8")
     (job.out / "ballast.stderr").write_text(stderr, encoding="utf-8")
     cause = _cause(job, returncode, stderr)
@@ -329,11 +337,12 @@ def _stop(futures, pool, running, out):
     running.terminate()
     live = [f for f in futures if not f.cancelled()]     # a cancelled future never counts as done
     try:
-        _, late = wait(live, timeout=STOP_GRACE)
-        if late:
-            running.kill()
-            wait(live)
+        deadline = time.monotonic() + STOP_GRACE
+        while wait(live, timeout=POLL)[1] and time.monotonic() < deadline:
+            pass
     except KeyboardInterrupt:
+        pass
+    if wait(live, timeout=0)[1]:
         running.kill()
         wait(live)
     results = [f.result() for f in live if f.exception() is None]
@@ -357,9 +366,14 @@ def run_all(jobs, binary, workers=None, out=sys.stdout, tty=None, resume=False):
         try:
             for i, job in enumerate(jobs):
                 futures[pool.submit(run_one, job, binary, running, resume, binary_id)] = i
-            for future in as_completed(futures):
-                outcomes[futures[future]] = future.result()
-                progress.finished(outcomes[futures[future]])
+            pending = set(futures)
+            while pending:
+                # Poll, not block: Python runs a signal's handler in the main thread only, and a
+                # signal the kernel gave to a worker thread would not wake a blocked main thread.
+                done, pending = wait(pending, timeout=POLL, return_when=FIRST_COMPLETED)
+                for future in sorted(done, key=futures.get):
+                    outcomes[futures[future]] = future.result()
+                    progress.finished(outcomes[futures[future]])
         except KeyboardInterrupt:
             _stop(list(futures), pool, running, out)
             raise

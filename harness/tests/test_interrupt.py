@@ -81,6 +81,17 @@ def test_interrupted_status_is_never_a_result(project, runs, capsys):
         load_run(runs / "spring" / "soft")
 
 
+def test_a_core_that_was_interrupted_stops_the_batch(project, runs, capsys):
+    """Ctrl-C reaches the cores too: one ending with 130 means no further run should start,
+    even before the harness itself has seen the signal."""
+    add_sets(project, "soft", "fail=130")
+    assert main(["run", "spring", "-j", "1"]) == 1
+    out = capsys.readouterr().out
+    assert "FAILED spring/soft: interrupted: exit code 130" in out
+    assert out.count("interrupted before it started") == 2
+    assert not (runs / "spring" / "stiff").exists() and not (runs / "spring" / "stiffer").exists()
+
+
 # ---------------------------------------------------------------- resume (fake core)
 
 def test_resume_keeps_complete_runs_untouched(project, runs, capsys):

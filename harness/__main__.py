@@ -5,6 +5,7 @@ cases, and hands over to runner, gate, report or rebaseline.  Errors in case.txt
 files (named file:line) and unknown case names end the command with status 2.
 """
 import argparse
+import functools
 import os
 import shutil
 import sys
@@ -19,7 +20,7 @@ from .gate import gate, sweep_table
 from .ini import IniError
 from .rebaseline import rebaseline
 from .report import write_report
-from .runner import jobs_for, run_all, sweep_jobs
+from .runner import jobs_for, run_all, sigterm_as_interrupt, sweep_jobs
 
 USAGE_ERROR = 2
 
@@ -64,7 +65,7 @@ def cmd_run(args):
     if not cases:
         print("no cases selected", file=sys.stderr)
         return 1
-    outcomes = run_all(jobs_for(cases, runs_root()), args.bin, args.jobs, sys.stdout)
+    outcomes = run_all(jobs_for(cases, runs_root()), args.bin, args.jobs, sys.stdout, resume=args.resume)
     return 0 if all(o.ok for o in outcomes) else 1
 
 
@@ -112,7 +113,7 @@ def cmd_sweep(args):
     variant = sweep_variant(case, args.variant)
     key, values = parse_sweep(args.set)
     jobs = sweep_jobs(case, variant, key, values, reports_root() / "sweeps")
-    outcomes = run_all(jobs, args.bin, args.jobs, sys.stdout)
+    outcomes = run_all(jobs, args.bin, args.jobs, sys.stdout, resume=args.resume)
     checks = [c for c in load_checks(cases) if c.case == case.name and c.run_variants == [variant.name]]
     print_sweep(case, variant, checks, jobs)
     return 0 if all(o.ok for o in outcomes) else 1
@@ -123,7 +124,7 @@ def cmd_cost(args):
     all_cases = load_cases()
     checks = load_checks(all_cases)
     sweeps.run_declared(selected(args, all_cases), checks, args.bin, args.jobs, runs_root(),
-                        reports_root() / "sweeps", sys.stdout, run_all)
+                        reports_root() / "sweeps", sys.stdout, functools.partial(run_all, resume=args.resume))
     return 0
 def cmd_stability(args):
     """Stability limits per variant and the extreme probes (harness/stability.py)."""
@@ -238,6 +239,9 @@ def _selection(p, default_tier="standard", names=True):
 def _runs(p):
     p.add_argument("-j", "--jobs", type=int, default=os.cpu_count(), help="parallel runs (default: CPU count)")
     p.add_argument("--bin", type=Path, default=None, help="the core executable (default $BALLAST_BIN or bin/ballast)")
+    p.add_argument("--resume", action="store_true",
+                   help="keep every run whose folder holds a complete successful run of the same command line, "
+                        "scene text and executable; run the rest (after an interrupt)")
     return p
 
 
@@ -246,7 +250,8 @@ def main(argv=None):
     if hasattr(args, "bin") and args.bin is None:
         args.bin = bin_path()
     try:
-        return args.fn(args)
+        with sigterm_as_interrupt():          # SIGTERM stops the runs like Ctrl-C: exit 130
+            return args.fn(args)
     except (IniError, catalogue.CatalogueError) as exc:
         print(f"ballast-harness: {exc}", file=sys.stderr)
         return USAGE_ERROR

@@ -2,23 +2,41 @@
 
 Each run gets a fresh folder (the old one is removed first) that is also its working
 directory, so runs share no state and their results cannot depend on -j or on order.
-After the run the folder holds the core's outputs plus ballast.stdout, ballast.stderr and
-harness.json (the command, exit code, wall time and, on failure, the cause).
+After the run the folder holds the core's outputs plus ballast.stdout, ballast.stderr and,
+written last (tmp file + rename), harness.json: the command, exit code, wall time, on
+failure the cause, the run's identity (what made it: command, scene path and content hash,
+--set overrides, the executable's hash) and the SHA-256 of every file the run left.
+
+Interruption: SIGINT or SIGTERM stops the whole batch.  Jobs not yet started are dropped
+(their folders untouched); running ones get SIGTERM (the core traps it, writes run.json
+with status "interrupted" and exits 130), are waited for (SIGKILL after STOP_GRACE s)
+and recorded as failed; then KeyboardInterrupt goes on to the caller (exit 130).
+
+Resume (run_all(..., resume=True), `--resume` on the command line): a job whose folder
+holds a complete successful run with the same identity, its files unchanged since, is not
+run again; every other job is (see stale()).
 """
+import hashlib
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import threading
 import time
-from concurrent.futures import ThreadPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from .tables import RunProblem, read_run_json, run_failure
+from .tables import RunProblem, read_harness_record, read_run_json, run_failure, unfinished_outputs
 
 STDERR_TAIL = 5
+STOP_GRACE = 10.0    # seconds a terminated run has to write run.json and exit before SIGKILL
+INTERRUPTED = (130, -signal.SIGINT, -signal.SIGTERM)   # how a run that was interrupted ends
+POLL = 0.1           # seconds between the main thread's looks at the runs (see run_all)
+PEER_SCRIPT = Path(__file__).resolve().parent.parent / "bench" / "peer" / "race.py"
 
 
 @dataclass
@@ -43,6 +61,7 @@ class Outcome:
     returncode: object
     wall: float
     cause: str = ""
+    skipped: bool = False   # resumed: a complete run of the same identity was already there
 
 
 def jobs_for(cases, runs_root):
@@ -56,8 +75,7 @@ def command(job, binary):
     """The core's command line for a job."""
     if job.command == "peer":
         # The cross-code check against LAMMPS: a Python script, not the core.
-        race = Path(__file__).resolve().parent.parent / "bench" / "peer" / "race.py"
-        return ["/usr/bin/python3", str(race), "--check-only", "--out", str(job.out)]
+        return ["/usr/bin/python3", str(PEER_SCRIPT), "--check-only", "--out", str(job.out)]
     cmd = [str(binary), job.command, str(job.scene), "--out", str(job.out)]
     for kv in job.sets:
         cmd += ["--set", kv]
@@ -65,23 +83,38 @@ def command(job, binary):
 
 
 class Running:
-    """The live subprocesses, so an interrupt can stop them all."""
+    """The live subprocesses, so an interrupt can stop them all.  Once stopping, a process
+    registered late (started while the interrupt was being handled) is terminated at once."""
 
     def __init__(self):
         self._procs, self._lock = set(), threading.Lock()
+        self.stopping = False
 
     def add(self, proc):
         with self._lock:
             self._procs.add(proc)
+            if self.stopping:
+                proc.terminate()
 
     def remove(self, proc):
         with self._lock:
             self._procs.discard(proc)
 
-    def terminate(self):
+    def stop_starting(self):
         with self._lock:
+            self.stopping = True
+
+    def terminate(self):
+        """SIGTERM to every live run; from now on runs are stopped as they start."""
+        with self._lock:
+            self.stopping = True
             for proc in self._procs:
                 proc.terminate()
+
+    def kill(self):
+        with self._lock:
+            for proc in self._procs:
+                proc.kill()
 
 
 def fresh_folder(path):
@@ -92,8 +125,16 @@ def fresh_folder(path):
     path.mkdir(parents=True)
 
 
-def run_one(job, binary, running=None):
-    """Run one job to completion; the Outcome says whether it produced usable outputs."""
+def run_one(job, binary, running=None, resume=False, binary_id=None):
+    """Run one job to completion; the Outcome says whether it produced usable outputs.
+    With resume, a job whose folder already holds a complete run of the same identity is
+    skipped (Outcome.skipped).  binary_id: binary_identity(binary), computed when None."""
+    if running and running.stopping:
+        return Outcome(job, False, None, 0.0, "interrupted before it started")
+    ident = identity(job, binary, binary_identity(binary) if binary_id is None else binary_id)
+    if resume and not stale(job, ident):
+        record = read_harness_record(job.out)
+        return Outcome(job, True, record.get("returncode"), 0.0, skipped=True)
     try:
         fresh_folder(job.out)
     except OSError as exc:
@@ -105,12 +146,77 @@ def run_one(job, binary, running=None):
     except OSError as exc:
         returncode, stdout, stderr = None, "", f"cannot start {binary}: {exc.strerror}"
     wall = time.monotonic() - start
+    if running and returncode in INTERRUPTED:
+        running.stop_starting()     # Ctrl-C reached the core's process group: start no other run
     (job.out / "ballast.stdout").write_text(stdout, encoding="utf-8")
     (job.out / "ballast.stderr").write_text(stderr, encoding="utf-8")
     cause = _cause(job, returncode, stderr)
+    if cause and running and running.stopping:
+        cause = "interrupted: " + cause
     outcome = Outcome(job, not cause, returncode, wall, cause)
-    _record(outcome, cmd)
+    _record(outcome, cmd, ident)
     return outcome
+
+
+# ---------------------------------------------------------------- identity and resume
+
+def sha256_of(path):
+    """Hex SHA-256 of a file's bytes, or None when it cannot be read."""
+    digest = hashlib.sha256()
+    try:
+        with open(path, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                digest.update(block)
+    except OSError:
+        return None
+    return digest.hexdigest()
+
+
+def binary_identity(binary):
+    """What identifies the executable: its path and the SHA-256 of its bytes (a rebuild that
+    changes it changes the hash; `touch` or an identical relink does not)."""
+    return {"path": str(binary), "sha256": sha256_of(binary)}
+
+
+def identity(job, binary, binary_id):
+    """Everything that decides a run's outputs: the core's command, the scene (path and the
+    hash of its text: scenes include no other file), the --set overrides, the executable.
+    The peer check runs bench/peer/race.py on the repository's bin/ballast: their hashes."""
+    ident = {"command": job.command, "scene": str(job.scene), "scene_sha256": sha256_of(job.scene),
+             "sets": list(job.sets), "binary": binary_id}
+    if job.command == "peer":
+        root = PEER_SCRIPT.parent.parent.parent
+        ident["binary"] = {str(p): sha256_of(p) for p in
+                           (PEER_SCRIPT, PEER_SCRIPT.parent / "in.peer", root / "bin" / "ballast")}
+    return ident
+
+
+def output_digests(folder):
+    """{file name: SHA-256} of every file in a run folder except harness.json."""
+    folder = Path(folder)
+    return {p.name: sha256_of(p) for p in sorted(folder.iterdir())
+            if p.is_file() and p.name != "harness.json"}
+
+
+def stale(job, ident):
+    """Why job.out cannot stand for a run of ident ('' when it can): it must hold harness.json
+    saying the run succeeded with exactly this identity, every file it lists unchanged, no
+    other output file, and complete outputs (run.json status ok, the expected files, no .tmp)."""
+    record = read_harness_record(job.out)
+    if record is None:
+        return "no harness.json (never run, or stopped before it finished)"
+    if not record.get("ok"):
+        return "the last attempt failed"
+    if record.get("identity") != ident:
+        return "made by another command line, scene or executable"
+    recorded = record.get("outputs")
+    if not isinstance(recorded, dict) or output_digests(job.out) != recorded:
+        return "its files changed since the run"
+    try:
+        info = read_run_json(job.out)
+    except RunProblem as problem:
+        return str(problem)
+    return run_failure(job.out, info) or unfinished_outputs(job.out, job.command)
 
 
 def _execute(cmd, cwd, running):
@@ -134,17 +240,27 @@ def _cause(job, returncode, stderr):
         tail = stderr.strip().splitlines()[-STDERR_TAIL:]
         return how + "".join(f"\n    {line}" for line in tail)
     try:
-        return run_failure(job.out, read_run_json(job.out)) or ""
+        info = read_run_json(job.out)
     except RunProblem as problem:
         return f"exit code 0 but {problem}"
+    failure = run_failure(job.out, info)
+    if failure:
+        return failure
+    unfinished = unfinished_outputs(job.out, job.command)
+    return f"exit code 0 but {unfinished}" if unfinished else ""
 
 
-def _record(outcome, cmd):
-    """harness.json: the runner's own account of the run."""
+def _record(outcome, cmd, ident):
+    """harness.json, written last and whole (tmp file + rename): the runner's own account of
+    the run, its identity and the digests of its files (what resume compares)."""
+    folder = outcome.job.out
     record = {"case": outcome.job.case, "variant": outcome.job.variant, "command": cmd,
               "returncode": outcome.returncode, "wall_seconds": round(outcome.wall, 6),
-              "ok": outcome.ok, "cause": outcome.cause}
-    (outcome.job.out / "harness.json").write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
+              "ok": outcome.ok, "cause": outcome.cause, "kind": outcome.job.command,
+              "identity": ident, "outputs": output_digests(folder)}
+    tmp = folder / "harness.json.tmp"
+    tmp.write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
+    tmp.replace(folder / "harness.json")
 
 
 class Progress:
@@ -168,6 +284,11 @@ class Progress:
 
     def finished(self, outcome):
         self.done += 1
+        if outcome.skipped:     # took no time: leaves the ETA to the runs that do
+            self.expected_total -= outcome.job.expected
+            self._write(f"[{self.done}/{self.total}] {outcome.job.label}  done before, kept (--resume)",
+                        keep=not self.tty)
+            return
         self.expected_done += outcome.job.expected
         if not outcome.ok:
             self._write(f"FAILED {outcome.job.label}: {outcome.cause}", keep=True)
@@ -179,7 +300,10 @@ class Progress:
         if self.tty and self.total:
             self.out.write("\n")
         elapsed = time.monotonic() - self.start
-        self._write(f"{len(outcomes)} runs: {len(outcomes) - failed} ok, {failed} failed ({elapsed:.1f} s)", keep=True)
+        skipped = sum(o.skipped for o in outcomes)
+        kept = f" ({skipped} kept from before)" if skipped else ""
+        self._write(f"{len(outcomes)} runs: {len(outcomes) - failed} ok{kept}, {failed} failed ({elapsed:.1f} s)",
+                    keep=True)
 
     def _write(self, text, keep):
         prefix = "\r\x1b[K" if self.tty else ""
@@ -187,21 +311,72 @@ class Progress:
         self.out.flush()
 
 
-def run_all(jobs, binary, workers=None, out=sys.stdout, tty=None):
-    """Run jobs in parallel (workers defaults to os.cpu_count()); Outcomes in job order."""
+@contextmanager
+def sigterm_as_interrupt():
+    """Within: SIGTERM raises KeyboardInterrupt in the main thread, like SIGINT, so a
+    terminated harness stops its runs instead of leaving them orphaned.  Only when the
+    handler is still the default one and we are in the main thread (else a no-op)."""
+    if threading.current_thread() is not threading.main_thread() or \
+            signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL:
+        yield
+        return
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+    signal.signal(signal.SIGTERM, interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def _stop(futures, pool, running, out):
+    """After an interrupt: drop the jobs not started, terminate the live runs and wait for
+    their threads to record them (SIGKILL after STOP_GRACE s, or at a second interrupt)."""
+    pool.shutdown(wait=False, cancel_futures=True)
+    running.terminate()
+    live = [f for f in futures if not f.cancelled()]     # a cancelled future never counts as done
+    try:
+        deadline = time.monotonic() + STOP_GRACE
+        while wait(live, timeout=POLL)[1] and time.monotonic() < deadline:
+            pass
+    except KeyboardInterrupt:
+        pass
+    if wait(live, timeout=0)[1]:
+        running.kill()
+        wait(live)
+    results = [f.result() for f in live if f.exception() is None]
+    stopped = sum(not o.ok and o.cause.startswith("interrupted:") for o in results)
+    dropped = len(futures) - len(live) + sum(o.cause == "interrupted before it started" for o in results)
+    print(f"\ninterrupted: {stopped} run(s) stopped, {dropped} not started; their folders hold no result "
+          "(--resume redoes only these)", file=out, flush=True)
+
+
+def run_all(jobs, binary, workers=None, out=sys.stdout, tty=None, resume=False):
+    """Run jobs in parallel (workers defaults to os.cpu_count()); Outcomes in job order.
+    resume: keep the jobs whose folder already holds a complete run of the same identity.
+    SIGINT/SIGTERM: stop every run (see the module's docstring), then KeyboardInterrupt."""
     workers = max(1, workers or os.cpu_count() or 1)
     progress, running = Progress(jobs, out, tty), Running()
+    binary_id = binary_identity(binary)
     outcomes = {}
     pool = ThreadPoolExecutor(max_workers=workers)
-    try:
-        futures = {pool.submit(run_one, job, binary, running): i for i, job in enumerate(jobs)}
-        for future in as_completed(futures):
-            outcomes[futures[future]] = future.result()
-            progress.finished(outcomes[futures[future]])
-    except KeyboardInterrupt:
-        pool.shutdown(wait=False, cancel_futures=True)
-        running.terminate()
-        raise
+    futures = {}
+    with sigterm_as_interrupt():
+        try:
+            for i, job in enumerate(jobs):
+                futures[pool.submit(run_one, job, binary, running, resume, binary_id)] = i
+            pending = set(futures)
+            while pending:
+                # Poll, not block: Python runs a signal's handler in the main thread only, and a
+                # signal the kernel gave to a worker thread would not wake a blocked main thread.
+                done, pending = wait(pending, timeout=POLL, return_when=FIRST_COMPLETED)
+                for future in sorted(done, key=futures.get):
+                    outcomes[futures[future]] = future.result()
+                    progress.finished(outcomes[futures[future]])
+        except KeyboardInterrupt:
+            _stop(list(futures), pool, running, out)
+            raise
     pool.shutdown()
     ordered = [outcomes[i] for i in range(len(jobs))]
     progress.close(ordered)

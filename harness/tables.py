@@ -100,6 +100,31 @@ def run_failure(folder, info):
     return None
 
 
+# The files a complete run leaves, by the core's command (main.c, output.c, bench/peer/race.py).
+EXPECTED_OUTPUTS = {"run": ("series.tsv", "stress.tsv", "contacts.tsv", "discs.tsv", "walls.tsv", "run.json"),
+                    "exact": ("series.tsv", "contacts.tsv", "discs.tsv", "walls.tsv", "run.json"),
+                    "peer": ("series.tsv", "run.json")}
+
+
+def unfinished_outputs(folder, command=None):
+    """Why a run folder's outputs are incomplete ('' when they are not): a NAME.tmp left behind
+    (a writer stopped before its rename), or a file the command always writes missing.  Without
+    a command (no harness.json) only the leftovers are looked at (load_run reads series.tsv and
+    run.json itself)."""
+    folder = Path(folder)
+    try:
+        leftovers = sorted(p.name for p in folder.iterdir() if p.name.endswith(".tmp"))
+    except OSError as exc:
+        return f"unfinished outputs: cannot list {folder} ({exc.strerror})"
+    if leftovers:
+        return f"unfinished outputs: {', '.join(leftovers)} left behind ({folder})"
+    missing = [n for n in EXPECTED_OUTPUTS.get(command, ())
+               if not (folder / n).is_file()]
+    if missing:
+        return f"unfinished outputs: {', '.join(missing)} missing ({folder})"
+    return ""
+
+
 def load_run(folder):
     """A successful run's outputs; RunProblem says what is missing or failed."""
     folder = Path(folder)
@@ -109,7 +134,7 @@ def load_run(folder):
     if record and not record.get("ok", True):
         raise RunProblem(f"run failed: {record.get('cause') or 'no cause recorded'} ({folder})")
     info = read_run_json(folder)
-    failure = run_failure(folder, info)
+    failure = run_failure(folder, info) or unfinished_outputs(folder, record.get("kind") if record else None)
     if failure:
         raise RunProblem(failure)
     return Run(folder, info, read_series(folder / "series.tsv"))

@@ -22,7 +22,8 @@ while i < len(args):
     if args[i] == "--out": out = args[i + 1]
     elif args[i] == "--set": sets.append(args[i + 1])
     i += 2
-p = {"k": "1", "n": "10", "fail": "0", "nan": "0", "sleep": "0", "status": "ok", "omit": "", "series": "1"}
+p = {"k": "1", "n": "10", "fail": "0", "nan": "0", "sleep": "0", "status": "ok", "omit": "", "series": "1",
+     "drop": "", "tmp": ""}
 for line in open(scene):
     if "=" in line:
         key, value = line.split("=", 1); p[key.strip()] = value.strip()
@@ -49,6 +50,11 @@ if p["series"] == "1":
 info = {"version": "fake", "scene": scene, "sets": sets, "status": p["status"], "message": "",
         "steps": n, "dt": 0.1, "dt_estimate": 0.2, "dt_fraction": 0.5, "wall_seconds": 0.01,
         "n_discs": 2, "n_walls": 2, "particle_steps_per_s": 1e6}
+for name in ("stress.tsv", "contacts.tsv", "discs.tsv", "walls.tsv"):   # the final state, as the core
+    if name != p["drop"]:                                                # writes it (drop=NAME: not)
+        write(name, "id\\tname\\n")
+if p["tmp"]:                                                             # tmp=NAME: leave NAME.tmp behind
+    open(os.path.join(out, p["tmp"] + ".tmp"), "w").write("half")
 write("run.json", json.dumps(info))
 '''
 

@@ -1,0 +1,79 @@
+"""Same scene + seed = bitwise-identical outputs, whatever -j and whatever order (issue 7, item 5).
+
+Every variant of every case of the default tier (standard, as `make validate`) is run twice
+with the real bin/ballast, into two roots: once with -j 1 in catalogue order, once with -j 2
+in a shuffled order (fixed seed), both passes at the same time, so runs of one pass share the
+machine with runs of the other.  Every output file must be equal byte for byte: series.tsv,
+discs.tsv, contacts.tsv, walls.tsv, stress*.tsv, ballast.stdout/stderr, and run.json with
+its wall-clock fields (wall_seconds, timers, particle_steps_per_s) masked, as is the
+`seconds` column of the exact solver's series.tsv (its solve time, a wall-clock field too).  About 30 s of CPU
+(two passes of ~15 s); skipped when bin/ballast is not built (`make test` builds it).
+"""
+import io
+import random
+import threading
+from pathlib import Path
+
+import pytest
+
+from harness import catalogue
+from harness.runner import jobs_for, run_all
+from harness.tests.test_interrupt import BALLAST, REPO, without_wall_clock
+
+DEFAULT_TIER = "standard"
+SEED = 1979
+
+
+def without_seconds(series):
+    """The exact solver's one-row series.tsv with its `seconds` column (the solve's wall time,
+    main.c write_exact) masked; every other column kept to the byte."""
+    header, row = series.decode().splitlines()
+    names, cells = header.split("\t"), row.split("\t")
+    assert len(names) == len(cells) and "seconds" in names
+    cells[names.index("seconds")] = "-"
+    return header + "\n" + "\t".join(cells) + "\n"
+
+
+def outputs(job):
+    """{file: bytes} of a job's folder; run.json without its wall-clock fields, and for the
+    exact solver series.tsv without its `seconds`; not harness.json (the runner's record:
+    paths and wall time)."""
+    out = {}
+    for path in sorted(Path(job.out).iterdir()):
+        if path.name == "harness.json":
+            continue
+        data = path.read_bytes()
+        if path.name == "run.json":
+            data = without_wall_clock(data)
+        elif path.name == "series.tsv" and job.command == "exact":
+            data = without_seconds(data)
+        out[path.name] = data
+    return out
+
+
+@pytest.mark.skipif(not BALLAST.exists(), reason="bin/ballast not built")
+def test_default_tier_is_bitwise_identical_whatever_jobs_and_order(tmp_path):
+    cases = catalogue.select(catalogue.load(REPO / "cases"), [], DEFAULT_TIER)
+    in_order = jobs_for(cases, tmp_path / "j1")
+    shuffled = jobs_for(cases, tmp_path / "j2")
+    random.Random(SEED).shuffle(shuffled)
+    assert [j.label for j in shuffled] != [j.label for j in in_order]
+
+    result = {}
+    first = threading.Thread(target=lambda: result.update(j1=run_all(in_order, BALLAST, 1, io.StringIO())))
+    first.start()
+    result["j2"] = run_all(shuffled, BALLAST, 2, io.StringIO())
+    first.join()
+    for name in ("j1", "j2"):
+        failed = [f"{o.job.label}: {o.cause}" for o in result[name] if not o.ok]
+        assert not failed, failed
+
+    differ = []
+    by_label = {j.label: j for j in shuffled}
+    for a in in_order:
+        left, right = outputs(a), outputs(by_label[a.label])
+        assert set(left) == set(right), a.label
+        assert {"series.tsv", "run.json"} <= set(left), a.label
+        differ += [f"{a.label}/{name}" for name in left if left[name] != right[name]]
+    assert not differ, f"outputs differ between -j 1 in order and -j 2 shuffled: {differ}"
+    assert len(in_order) == sum(len(c.variants) for c in cases) >= 40

@@ -309,6 +309,10 @@ struct bal_energy {
 /* The audit now. */
 void bal_energy_report(const struct bal_sim *sim, struct bal_energy *e);
 
+/* Add wall-clock seconds spent on the simulation outside bal_sim_run (the
+ * exact solver's solve), reported as run.json's wall_seconds. */
+void bal_sim_add_seconds(struct bal_sim *sim, double seconds);
+
 /* Advance one cycle (C&S calculation cycle): move discs and walls to t_N,
  * find contacts, apply the force–displacement law at t_N, update the
  * velocities to t_{N+1/2}.  The scene must outlive the simulation. */

@@ -779,6 +779,11 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
     return status;
 }
 
+void bal_sim_add_seconds(struct bal_sim *s, double seconds)
+{
+    s->wall_seconds += seconds;
+}
+
 void bal_sim_info(const struct bal_sim *s, struct bal_run_info *info)
 {
     info->steps = s->step;

@@ -96,7 +96,11 @@ def cmd_validate(args):
         stab = argparse.Namespace(**vars(args))
         stab.one_per_case, stab.extremes_only, stab.no_extremes = True, False, False
         stab.cap, stab.tolerance = 20000, 0.01
-        cmd_stability(stab)
+        try:
+            cmd_stability(stab)
+        except (RuntimeError, OSError, ValueError, catalogue.CatalogueError) as exc:
+            # a measurement for the report: its failure is said, not fatal to the gate
+            print(f"stability: not measured: {exc}")
     cmd_report(args)
     return run_status or check_status
 

@@ -5,8 +5,8 @@ with the real bin/ballast, into two roots: once with -j 1 in catalogue order, on
 in a shuffled order (fixed seed), both passes at the same time, so runs of one pass share the
 machine with runs of the other.  Every output file must be equal byte for byte: series.tsv,
 discs.tsv, contacts.tsv, walls.tsv, stress*.tsv, ballast.stdout/stderr, and run.json with
-its wall-clock fields (wall_seconds, timers, particle_steps_per_s) masked, as is the
-`seconds` column of the exact solver's series.tsv (its solve time, a wall-clock field too).  About 30 s of CPU
+its wall-clock fields (wall_seconds, timers, particle_steps_per_s) masked (the exact solver
+writes its solve time there too, not in series.tsv).  About 30 s of CPU
 (two passes of ~15 s); skipped when bin/ballast is not built (`make test` builds it).
 """
 import io
@@ -24,20 +24,9 @@ DEFAULT_TIER = "standard"
 SEED = 1979
 
 
-def without_seconds(series):
-    """The exact solver's one-row series.tsv with its `seconds` column (the solve's wall time,
-    main.c write_exact) masked; every other column kept to the byte."""
-    header, row = series.decode().splitlines()
-    names, cells = header.split("\t"), row.split("\t")
-    assert len(names) == len(cells) and "seconds" in names
-    cells[names.index("seconds")] = "-"
-    return header + "\n" + "\t".join(cells) + "\n"
-
-
 def outputs(job):
-    """{file: bytes} of a job's folder; run.json without its wall-clock fields, and for the
-    exact solver series.tsv without its `seconds`; not harness.json (the runner's record:
-    paths and wall time)."""
+    """{file: bytes} of a job's folder; run.json without its wall-clock fields; not harness.json
+    (the runner's record: paths and wall time)."""
     out = {}
     for path in sorted(Path(job.out).iterdir()):
         if path.name == "harness.json":
@@ -45,8 +34,6 @@ def outputs(job):
         data = path.read_bytes()
         if path.name == "run.json":
             data = without_wall_clock(data)
-        elif path.name == "series.tsv" and job.command == "exact":
-            data = without_seconds(data)
         out[path.name] = data
     return out
 

@@ -488,9 +488,10 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
     s->dt_estimate = bal_timestep_estimate(s);
     s->dt = st->dt > 0 ? st->dt : st->dt_fraction * s->dt_estimate;
     if (!(s->dt > 0 && isfinite(s->dt))) {
+        const double dt = s->dt; /* read before the free (fuzzing found the use after it) */
         bal_sim_free(s);
         return bal_error(err, BAL_EINVAL, "%s: time step %g is not a positive number", sc->path,
-                         s->dt);
+                         dt);
     }
 
     /* Law of motion (integrate.c). */

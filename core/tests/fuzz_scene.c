@@ -38,6 +38,7 @@
 #define FUZZ_MAX_DISCS_ALL_PAIRS 200
 #define FUZZ_MAX_CYCLES 20      /* cycles per stage when the simulation runs */
 #define FUZZ_MAX_SETS 16
+#define FUZZ_MAX_DISCS_TWICE 100 /* run twice and compare when this small */
 
 static long count_discs(const struct bal_scene *s)
 {
@@ -56,7 +57,72 @@ static long count_discs(const struct bal_scene *s)
     return n;
 }
 
-static void simulate(struct bal_scene *sc)
+/* A failed bal_scene_set must leave the scene as it was. */
+struct snapshot {
+    struct bal_scene head;
+    void *arrays[7];
+};
+
+static void snapshot_take(struct snapshot *sn, const struct bal_scene *s)
+{
+    sn->head = *s;
+    const void *src[7] = {s->materials, s->discs, s->walls, s->fills, s->piles, s->stages,
+                          s->probes};
+    const size_t bytes[7] = {
+        (size_t)s->n_materials * sizeof *s->materials, (size_t)s->n_discs * sizeof *s->discs,
+        (size_t)s->n_walls * sizeof *s->walls,         (size_t)s->n_fills * sizeof *s->fills,
+        (size_t)s->n_piles * sizeof *s->piles,         (size_t)s->n_stages * sizeof *s->stages,
+        (size_t)s->n_probes * sizeof *s->probes};
+    for (int k = 0; k < 7; k++) {
+        sn->arrays[k] = malloc(bytes[k] + 1);
+        if (sn->arrays[k] && bytes[k])
+            memcpy(sn->arrays[k], src[k], bytes[k]);
+    }
+}
+
+static void snapshot_check_free(struct snapshot *sn, const struct bal_scene *s)
+{
+    const void *now[7] = {s->materials, s->discs, s->walls, s->fills, s->piles, s->stages,
+                          s->probes};
+    const size_t bytes[7] = {
+        (size_t)s->n_materials * sizeof *s->materials, (size_t)s->n_discs * sizeof *s->discs,
+        (size_t)s->n_walls * sizeof *s->walls,         (size_t)s->n_fills * sizeof *s->fills,
+        (size_t)s->n_piles * sizeof *s->piles,         (size_t)s->n_stages * sizeof *s->stages,
+        (size_t)s->n_probes * sizeof *s->probes};
+    if (memcmp(&sn->head, s, sizeof *s) != 0)
+        abort(); /* a failed --set changed the settings or the section counts */
+    for (int k = 0; k < 7; k++) {
+        if (sn->arrays[k] && bytes[k] && memcmp(sn->arrays[k], now[k], bytes[k]) != 0)
+            abort(); /* a failed --set changed a section */
+        free(sn->arrays[k]);
+    }
+}
+
+/* Everything a run leaves that must be the same on a second run of the
+ * same scene (same scene and seed = bitwise-identical outputs). */
+struct outcome {
+    enum bal_status create, run;
+    long steps;
+    double ek, ee, dt;
+    struct bal_energy e;
+};
+
+#define SAME(x, y) (memcmp(&(x), &(y), sizeof(x)) == 0) /* bitwise, NaN too */
+
+static int same_outcome(const struct outcome *a, const struct outcome *b)
+{
+    const struct bal_energy *p = &a->e, *q = &b->e;
+    return a->create == b->create && a->run == b->run && a->steps == b->steps &&
+           SAME(a->ek, b->ek) && SAME(a->ee, b->ee) && SAME(a->dt, b->dt) &&
+           p->started == q->started && p->from_step == q->from_step &&
+           SAME(p->kinetic, q->kinetic) && SAME(p->elastic, q->elastic) &&
+           SAME(p->work_walls, q->work_walls) && SAME(p->work_gravity, q->work_gravity) &&
+           SAME(p->dissipated_dashpot, q->dissipated_dashpot) &&
+           SAME(p->dissipated_friction, q->dissipated_friction) &&
+           SAME(p->dissipated_global, q->dissipated_global) && SAME(p->imbalance, q->imbalance);
+}
+
+static void simulate(struct bal_scene *sc, struct outcome *out)
 {
     long n = count_discs(sc);
     if (n > FUZZ_MAX_DISCS)
@@ -73,7 +139,7 @@ static void simulate(struct bal_scene *sc)
     }
     struct bal_error err = {0};
     struct bal_sim *sim = NULL;
-    if (bal_sim_create(&sim, sc, &err) != BAL_OK) {
+    if ((out->create = bal_sim_create(&sim, sc, &err)) != BAL_OK) {
         if (sim)
             abort(); /* a failed create must not hand out a simulation */
         if (!err.msg[0])
@@ -92,10 +158,14 @@ static void simulate(struct bal_scene *sc)
     for (int p = 0; p < sc->n_probes; p++)
         (void)bal_measure_probe(sim, p);
     (void)bal_measure_unbalanced(sim);
-    struct bal_energy e;
-    bal_energy_report(sim, &e);
+    bal_energy_report(sim, &out->e);
     struct bal_run_info info;
     bal_sim_info(sim, &info);
+    out->run = st;
+    out->steps = info.steps;
+    out->dt = info.dt;
+    out->ek = bal_measure_kinetic(sim);
+    out->ee = bal_measure_elastic(sim);
     char name[2 * BAL_NAME_MAX];
     for (int i = 0; i < info.n_discs && i < 4; i++)
         bal_output_disc_name(sim, i, name, sizeof name);
@@ -144,15 +214,33 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (nl)
                 *nl = '\0';
             struct bal_error serr = {0};
+            struct snapshot sn;
+            snapshot_take(&sn, &sc);
             enum bal_status ss = bal_scene_set(&sc, line, &serr);
             if (ss != BAL_OK && !serr.msg[0])
                 abort();
+            if (ss != BAL_OK)
+                snapshot_check_free(&sn, &sc);
+            else
+                for (int k = 0; k < 7; k++)
+                    free(sn.arrays[k]);
             line = nl ? nl + 1 : NULL;
         }
-        if (bal_scene_validate(&sc, &err) == BAL_OK)
-            simulate(&sc);
-        else if (!err.msg[0])
+        if (bal_scene_validate(&sc, &err) == BAL_OK) {
+            /* Twice when small: the second run must repeat the first bit
+             * for bit. */
+            struct outcome a, b;
+            memset(&a, 0, sizeof a);
+            memset(&b, 0, sizeof b);
+            simulate(&sc, &a);
+            if (count_discs(&sc) <= FUZZ_MAX_DISCS_TWICE) {
+                simulate(&sc, &b);
+                if (!same_outcome(&a, &b))
+                    abort(); /* not deterministic */
+            }
+        } else if (!err.msg[0]) {
             abort();
+        }
     }
     bal_scene_free(&sc);
     free(text);

@@ -216,7 +216,7 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
             h *= sqrt(cells / (2.0 * n + 16));
         /* A long thin sparse scene keeps too many cells along its long side
          * after that; widen further (the candidates do not depend on h; the
-         * cell counts must fit an int).  Found by fuzzing. */
+         * cell counts must fit an int).  Seen while fixing a fuzzing finding. */
         while (((x1 - x0) / h + 1) * ((y1 - y0) / h + 1) > 8.0 * n + 64 && isfinite(h))
             h *= 2;
         int nx = (int)((x1 - x0) / h) + 1, ny = (int)((y1 - y0) / h) + 1;

@@ -249,7 +249,7 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
         }
         /* The value goes in as an argument, never into a format: the list
          * of probe quantities alone is longer than half a message, and a
-         * format cut short dropped the value (found while fuzzing). */
+         * format cut short dropped the value (seen by reading, while fuzzing). */
         char msg[BAL_MSG_MAX];
         snprintf(msg, sizeof msg, "expected one of {%s}, got '%s'", key->choices, value);
         return where_error(err, w, key->name, "%s", msg);
@@ -679,7 +679,7 @@ static int body_exists(const struct bal_scene *s, const char *name, int *is_wall
 
 /* Probes and moves find bodies by name, so a disc, a wall and the walls a
  * fill box or a smooth pile makes must not share one (else the first found
- * wins silently; seen while fuzzing). */
+ * wins silently; seen by reading, while fuzzing). */
 static enum bal_status check_body_names(const struct bal_scene *s, struct bal_error *err)
 {
     static const char *const sides[] = {"_bottom", "_right", "_top", "_left"};

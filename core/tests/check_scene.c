@@ -757,7 +757,8 @@ END_TEST
 /* Fuzzing findings (make test-fuzz; README "Fuzzing")                 */
 /* ------------------------------------------------------------------ */
 
-/* Each input that made the fuzzer fail, reduced by hand to a small scene
+/* Each finding of the fuzzing work (README "Fuzzing" says which the fuzzer
+ * found and which were found by reading next to them), as a small scene
  * under fuzz/regress/ (the fuzz run replays the same files): the stage that
  * must refuse it ('p' parse, 'c' create; 'o' = accepted and runs), the status
  * and a part of the message.  Under `make test-sanitize` these also prove

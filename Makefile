@@ -149,3 +149,26 @@ clean:
 	       reports/*.json reports/*.xml reports/*.html reports/summary.md
 
 -include $(LIB_OBJ:.o=.d) $(SAN_OBJ:.o=.d) $(BUILD)/main.d
+
+# ---- fuzzing (issue 7) ----------------------------------------------------
+# libFuzzer on the scene parser, --set, validate and short runs of small scenes
+# (core/tests/fuzz_scene.c), seeded at run time with every shipped scene and the
+# seeds in core/tests/fuzz/seeds; the inputs that once failed
+# (core/tests/fuzz/regress) are replayed first.  Fails on any crash, leak,
+# timeout or undefined behaviour.  FUZZ_TIME=600 make test-fuzz runs longer.
+FUZZ_CC   ?= clang
+FUZZ_TIME ?= 60
+FUZZ_SAN  := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+FUZZ_OBJ  := $(LIB_SRC:core/%.c=$(BUILD)/fuzz/%.o)
+$(BUILD)/fuzz/%.o: core/%.c $(wildcard core/*.h)
+	@mkdir -p $(BUILD)/fuzz
+	$(FUZZ_CC) $(CFLAGS_BASE) -O1 -g $(FUZZ_SAN) -fsanitize=fuzzer-no-link -c $< -o $@
+$(BUILD)/fuzz/fuzz_scene: core/tests/fuzz_scene.c $(FUZZ_OBJ)
+	$(FUZZ_CC) $(CFLAGS_BASE) -O1 -g $(FUZZ_SAN) -fsanitize=fuzzer -Icore -o $@ $^ $(LDLIBS)
+
+.PHONY: test-fuzz fuzz-deps
+fuzz-deps:
+	@sh .ci/install-fuzz-deps
+test-fuzz: fuzz-deps
+	$(MAKE) $(BUILD)/fuzz/fuzz_scene
+	sh core/tests/fuzz/run $(BUILD)/fuzz/fuzz_scene $(FUZZ_TIME)

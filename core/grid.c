@@ -203,12 +203,22 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
             return bal_error(err, BAL_EUNSTABLE,
                              "neighbour grid: a disc position is not finite at step %ld",
                              s->step);
+        if (!(isfinite(x1 - x0) && isfinite(y1 - y0)))
+            return bal_error(err, BAL_EUNSTABLE,
+                             "%s: neighbour grid: the discs spread over more than the largest "
+                             "number (x %g to %g, y %g to %g) at step %ld", s->scene->path, x0,
+                             x1, y0, y1, s->step);
         double h = 2 * s->r_max + s->skin;
         /* A sparse scene spread over a large area would need many empty
          * cells; widen the cells so there are at most about 2 per disc. */
         double cells = ((x1 - x0) / h + 1) * ((y1 - y0) / h + 1);
         if (cells > 2.0 * n + 16)
             h *= sqrt(cells / (2.0 * n + 16));
+        /* A long thin sparse scene keeps too many cells along its long side
+         * after that; widen further (the candidates do not depend on h; the
+         * cell counts must fit an int).  Seen while fixing a fuzzing finding. */
+        while (((x1 - x0) / h + 1) * ((y1 - y0) / h + 1) > 8.0 * n + 64 && isfinite(h))
+            h *= 2;
         int nx = (int)((x1 - x0) / h) + 1, ny = (int)((y1 - y0) / h) + 1;
         long nc = (long)nx * ny;
         if (nc + 1 > g->cells_cap) {
@@ -330,6 +340,16 @@ static int cell_key_cmp(const void *a, const void *b)
     return (p->slot > q->slot) - (p->slot < q->slot);
 }
 
+/* Cell index along one axis of an offset d >= 0; far (or non-finite)
+ * offsets share the last cell, so the key never overflows (found by
+ * fuzzing: a disc at x = 7e109 made the conversion undefined).  The order is
+ * only for memory locality; ordinary scenes never reach the cap. */
+static long cell_coord(double d, double h)
+{
+    const double c = d / h;
+    return c < 1e9 ? (long)c : 1000000000L;
+}
+
 void bal_grid_cell_order(const double *x, const double *y, int n, double h,
                          struct bal_cell_key *keys, int32_t *order)
 {
@@ -339,9 +359,9 @@ void bal_grid_cell_order(const double *x, const double *y, int n, double h,
         y0 = fmin(y0, y[i]);
         x1 = fmax(x1, x[i]);
     }
-    const long nx = (long)((x1 - x0) / h) + 1;
+    const long nx = cell_coord(x1 - x0, h) + 1;
     for (int i = 0; i < n; i++)
-        keys[i] = (struct bal_cell_key){(long)((y[i] - y0) / h) * nx + (long)((x[i] - x0) / h), i};
+        keys[i] = (struct bal_cell_key){cell_coord(y[i] - y0, h) * nx + cell_coord(x[i] - x0, h), i};
     qsort(keys, (size_t)n, sizeof *keys, cell_key_cmp);
     for (int i = 0; i < n; i++)
         order[i] = keys[i].slot;

@@ -129,7 +129,7 @@ static enum bal_status where_error(struct bal_error *err, struct where w,
                                    const char *key, const char *fmt,
                                    const char *detail)
 {
-    char what[BAL_MSG_MAX / 2];
+    char what[BAL_MSG_MAX];
     snprintf(what, sizeof what, fmt, detail);
     if (w.line > 0)
         return bal_error(err, BAL_EINVAL, "%s:%d: %s: %s", w.file, w.line, key, what);
@@ -247,9 +247,12 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
             idx++;
             c += len + (e ? 1 : 0);
         }
-        char msg[BAL_MSG_MAX / 2];
-        snprintf(msg, sizeof msg, "expected one of {%s}, got '%%s'", key->choices);
-        return where_error(err, w, key->name, msg, value);
+        /* The value goes in as an argument, never into a format: the list
+         * of probe quantities alone is longer than half a message, and a
+         * format cut short dropped the value (seen by reading, while fuzzing). */
+        char msg[BAL_MSG_MAX];
+        snprintf(msg, sizeof msg, "expected one of {%s}, got '%s'", key->choices, value);
+        return where_error(err, w, key->name, "%s", msg);
     }
     case BAL_KEY_MOVE: {
         struct bal_stage_def *st = item;
@@ -674,6 +677,35 @@ static int body_exists(const struct bal_scene *s, const char *name, int *is_wall
     return 0;
 }
 
+/* Probes and moves find bodies by name, so a disc, a wall and the walls a
+ * fill box or a smooth pile makes must not share one (else the first found
+ * wins silently; seen by reading, while fuzzing). */
+static enum bal_status check_body_names(const struct bal_scene *s, struct bal_error *err)
+{
+    static const char *const sides[] = {"_bottom", "_right", "_top", "_left"};
+    for (int i = 0; i < s->n_walls; i++)
+        if (bal_scene_find(s, BAL_SEC_DISC, s->walls[i].name) >= 0)
+            return bal_error(err, BAL_EINVAL, "%s:%d: [wall %s]: a disc has this name too; "
+                             "probes and moves need one body per name",
+                             s->path, s->walls[i].line, s->walls[i].name);
+    for (int k = 0; k < s->n_fills + s->n_piles; k++) {
+        const int fill = k < s->n_fills;
+        const char *name = fill ? s->fills[k].name : s->piles[k - s->n_fills].name;
+        const int line = fill ? s->fills[k].line : s->piles[k - s->n_fills].line;
+        if (fill ? !s->fills[k].box : s->piles[k - s->n_fills].bottom != 0)
+            continue;
+        for (int side = 0; side < (fill ? 4 : 1); side++) {
+            char nm[2 * BAL_NAME_MAX];
+            snprintf(nm, sizeof nm, "%s%s", name, fill ? sides[side] : "_floor");
+            if (bal_scene_find(s, BAL_SEC_DISC, nm) >= 0 || bal_scene_find(s, BAL_SEC_WALL, nm) >= 0)
+                return bal_error(err, BAL_EINVAL, "%s:%d: [%s %s]: makes a wall '%s', but a disc "
+                                 "or wall has that name already",
+                                 s->path, line, fill ? "fill" : "pile", name, nm);
+        }
+    }
+    return BAL_OK;
+}
+
 enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *err)
 {
     for (int k = 0; k < BAL_SEC_COUNT; k++)
@@ -744,6 +776,8 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
             return FAIL_AT(m, BAL_SEC_MATERIAL, "ks", "expected ks > 0 (or omit it for ks = kn), "
                                                       "got %g", m->ks);
     }
+    if (check_body_names(s, err))
+        return err->code;
     if (s->n_stages == 0)
         return bal_error(err, BAL_EINVAL, "%s: no [stage] section: the run would never start; "
                                           "add e.g. [stage run] with cycles = N", s->path);

@@ -17,6 +17,10 @@
 
 #define BIG DBL_MAX
 #define LBIG 2147483647.0
+/* Largest stiffness: two materials combine as 2 k_a k_b / (k_a + k_b)
+ * (sim.c), whose product overflows to inf/inf = NaN above about 9e153
+ * (found by fuzzing: kn = 1e155 gave a NaN time step). */
+#define KBIG 1e150
 
 #define S(field) offsetof(struct bal_settings, field)
 #define M(field) offsetof(struct bal_material_def, field)
@@ -76,9 +80,9 @@ const struct bal_key bal_scene_keys[] = {
      "predictor-corrector, MLH Sec. 5.3)"},
 
     /* [material NAME] */
-    {BAL_SEC_MATERIAL, "kn", BAL_KEY_DOUBLE, M(kn), NULL, 1, 1e-300, BIG, NULL,
+    {BAL_SEC_MATERIAL, "kn", BAL_KEY_DOUBLE, M(kn), NULL, 1, 1e-300, KBIG, NULL,
      "normal stiffness k_n, force/length (C&S eq. 16)"},
-    {BAL_SEC_MATERIAL, "ks", BAL_KEY_DOUBLE, M(ks), "-1", 0, -1, BIG, NULL,
+    {BAL_SEC_MATERIAL, "ks", BAL_KEY_DOUBLE, M(ks), "-1", 0, -1, KBIG, NULL,
      "shear stiffness k_s (C&S eq. 17); default: equal to kn"},
     {BAL_SEC_MATERIAL, "friction", BAL_KEY_DOUBLE, M(friction), "0", 0, 0, BIG, NULL,
      "tan(phi_mu); a contact uses the smaller of its two bodies' (C&S eq. 19)"},

@@ -547,9 +547,10 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         return BAL_EINVAL;
     }
     if (!(s->dt > 0 && isfinite(s->dt))) {
+        const double dt = s->dt; /* read before the free (fuzzing found the use after it) */
         bal_sim_free(s);
         return bal_error(err, BAL_EINVAL, "%s: time step %g is not a positive number", sc->path,
-                         s->dt);
+                         dt);
     }
 
     /* Law of motion (integrate.c). */

@@ -806,6 +806,67 @@ START_TEST(scene_pile_smallest)
 }
 END_TEST
 
+/* ------------------------------------------------------------------ */
+/* Fuzzing findings (make test-fuzz; README "Fuzzing")                 */
+/* ------------------------------------------------------------------ */
+
+/* Each finding of the fuzzing work (README "Fuzzing" says which the fuzzer
+ * found and which were found by reading next to them), as a small scene
+ * under fuzz/regress/ (the fuzz run replays the same files): the stage that
+ * must refuse it ('p' parse, 'c' create; 'o' = accepted and runs), the status
+ * and a part of the message.  Under `make test-sanitize` these also prove
+ * the undefined behaviour and the use after free are gone. */
+static const struct fuzz_case {
+    const char *file;
+    char stage;
+    enum bal_status status;
+    const char *expect;
+} fuzz_cases[] = {
+    {"fuzz/regress/far_disc.scene", 'o', BAL_OK, ""},
+    {"fuzz/regress/thin_sparse.scene", 'o', BAL_OK, ""},
+    {"fuzz/regress/extent_overflow.scene", 'c', BAL_EUNSTABLE,
+     "extent_overflow.scene: neighbour grid: the discs spread over more than the largest number"},
+    {"fuzz/regress/dt_infinite.scene", 'c', BAL_EINVAL,
+     "dt_infinite.scene: time step inf is not a positive number"},
+    {"fuzz/regress/kn_overflow.scene", 'p', BAL_EINVAL,
+     "kn_overflow.scene:4: kn: 1e+155 is out of range: expected 1e-300 <= value <= 1e+150"},
+    {"fuzz/regress/enum_long_message.scene", 'p', BAL_EINVAL,
+     "weight_x weight_y}, got 'no_such_quantity'"},
+    {"fuzz/regress/name_clash.scene", 'c', BAL_EINVAL,
+     "name_clash.scene:6: [fill f]: makes a wall 'f_top', but a disc or wall has that name"},
+    {"fuzz/regress/disc_wall_clash.scene", 'c', BAL_EINVAL,
+     "disc_wall_clash.scene:10: [wall a]: a disc has this name too"},
+};
+
+START_TEST(scene_fuzz_regression)
+{
+    const struct fuzz_case *c = &fuzz_cases[_i];
+    struct tfx *f = tfx_parse("", c->file);
+    enum bal_status st = bal_scene_load(&f->sc, c->file, &f->err);
+    char stage = 'p';
+    if (st == BAL_OK) {
+        stage = 'c';
+        st = tfx_create(f);
+    }
+    if (st == BAL_OK) {
+        stage = 'o';
+        for (int k = 0; k < 5 && st == BAL_OK; k++)
+            st = bal_sim_step(f->sim, &f->err);
+    }
+    ck_assert_msg(stage == c->stage && st == c->status,
+                  "%s: stage %c status %d (expected %c, %d): %s", c->file, stage, st, c->stage,
+                  c->status, f->err.msg);
+    ck_assert_msg(t_contains(f->err.msg, c->expect), "%s: message '%s' lacks '%s'", c->file,
+                  f->err.msg, c->expect);
+    if (st == BAL_OK && f->sim->use_grid) {
+        /* The cells stay few however far apart the discs are. */
+        const long cells = (long)f->sim->grid.nx * f->sim->grid.ny;
+        ck_assert_msg(cells <= 8L * f->sim->n + 64, "%s: %ld cells for %d discs", c->file, cells,
+                      f->sim->n);
+    }
+}
+END_TEST
+
 Suite *suite_scene(void)
 {
     Suite *s = suite_create("scene");
@@ -841,6 +902,12 @@ Suite *suite_scene(void)
     tcase_add_test(tc, scene_pile_bumpy_lattice);
     tcase_add_loop_test(tc, scene_pile_refused, 0, (int)(sizeof bad_piles / sizeof bad_piles[0]));
     tcase_add_test(tc, scene_pile_smallest);
+    suite_add_tcase(s, tc);
+
+    tc = tcase_create("fuzz");
+    tcase_add_checked_fixture(tc, NULL, tfx_teardown);
+    tcase_add_loop_test(tc, scene_fuzz_regression, 0,
+                        (int)(sizeof fuzz_cases / sizeof fuzz_cases[0]));
     suite_add_tcase(s, tc);
     return s;
 }

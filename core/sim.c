@@ -536,21 +536,24 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
     /* Time step. */
     s->dt_estimate = bal_timestep_estimate(s);
     s->dt = st->dt > 0 ? st->dt : st->dt_fraction * s->dt_estimate;
-    if (s->dt >= s->dt_estimate && !st->force_dt) {
-        const char *key = st->dt > 0 ? "dt" : "dt_fraction";
-        const int line = st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, key)];
-        bal_error(err, BAL_EINVAL,
-                  "%s:%d: %s: the time step %.6g is at or above the stability estimate %.6g "
-                  "(bin/ballast info); expected a smaller one, or settings.force_dt = 1 to run it "
-                  "anyway", sc->path, line, key, s->dt, s->dt_estimate);
-        bal_sim_free(s);
-        return BAL_EINVAL;
-    }
     if (!(s->dt > 0 && isfinite(s->dt))) {
         const double dt = s->dt; /* read before the free (fuzzing found the use after it) */
         bal_sim_free(s);
         return bal_error(err, BAL_EINVAL, "%s: time step %g is not a positive number", sc->path,
                          dt);
+    }
+    if (s->dt >= s->dt_estimate && !st->force_dt) {
+        const char *key = st->dt > 0 ? "dt" : "dt_fraction";
+        const int line = st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, key)];
+        char where[32] = ""; /* no line: the key was not given (its default) */
+        if (line > 0)
+            snprintf(where, sizeof where, ":%d", line);
+        bal_error(err, BAL_EINVAL,
+                  "%s%s: %s: the time step %.6g is at or above the stability estimate %.6g "
+                  "(bin/ballast info); expected a smaller one, or settings.force_dt = 1 to run it "
+                  "anyway", sc->path, where, key, s->dt, s->dt_estimate);
+        bal_sim_free(s);
+        return BAL_EINVAL;
     }
 
     /* Law of motion (integrate.c). */

@@ -277,6 +277,10 @@ static int start_contacts(const struct bal_sim *s, struct dt_list *l)
         x1 = fmax(x1, s->x[i]);
         y1 = fmax(y1, s->y[i]);
     }
+    /* A spread that overflows (x = ±1e308: the grid refuses the scene later)
+     * has no cells: bound every disc by its coordination instead. */
+    if (!(isfinite(x1 - x0) && isfinite(y1 - y0)) && n > 0)
+        return -1;
     double h = 2 * s->r_max * (1 + BAL_DT_GAP);
     const double cells_max = (double)BAL_DT_CELLS_PER_DISC * n + 16;
     while (((x1 - x0) / h + 1) * ((y1 - y0) / h + 1) > cells_max)

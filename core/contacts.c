@@ -166,7 +166,11 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
     const double dt = s->dt, nu = s->nu, delta0 = s->delta0;
     const int n_mat = s->n_mat;
     const struct bal_pair_law *restrict laws = s->law;
-    const double budget = s->overlap_budget;
+    /* The overlap budget is a share of the smaller radius of each pair: the
+     * loop compares with that share of the scene's smallest radius (one
+     * compare), and only if some overlap passes it are the pairs judged one
+     * by one (energy.c). */
+    const double budget = s->overlap_sieve;
     double lost_fric = 0; /* energy audit (energy.c) */
     float *restrict dfx = s->dash_fx, *restrict dfy = s->dash_fy, *restrict dtq = s->dash_tq;
     int over = 0;
@@ -190,7 +194,7 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
         const double rvx = vx[i] - vx[j], rvy = vy[i] - vy[j];
         const double ndot = rvx * ex + rvy * ey;
         const double delta = rs - dist;
-        over |= delta > budget * fmin(r[i], r[j]);
+        over |= delta > budget; /* a first sieve; bal_energy_overlap judges each pair */
 
         double fn;
         if (law == BAL_NORMAL_INCREMENTAL) {
@@ -336,7 +340,7 @@ void bal_contacts_walls(struct bal_sim *s)
         const double ndot = rvx * ex + rvy * ey;
         const double sdot = rvx * tx + rvy * ty - s->w[i] * ri;
 
-        if (ri - dist > s->overlap_budget * ri)
+        if (ri - dist > s->overlap_sieve)
             s->over_budget = 1;
         double fn;
         if (s->normal_law == BAL_NORMAL_INCREMENTAL) {

@@ -464,6 +464,10 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         s->r_max = fmax(s->r_max, d.r[i]);
     s->use_grid = st->grid == BAL_GRID_ON || (st->grid == BAL_GRID_AUTO && n >= BAL_GRID_CROSSOVER);
     s->skin = st->skin > 0 ? st->skin : SKIN_SHARE_OF_RMAX * s->r_max;
+    double r_min = INFINITY;
+    for (int i = 0; i < n; i++)
+        r_min = fmin(r_min, d.r[i]);
+    s->overlap_sieve = s->overlap_budget * r_min; /* INFINITY when the budget is off */
 
     int ok = 1;
     double **arrays[] = {&s->x, &s->y, &s->th, &s->vx, &s->vy, &s->w, &s->r,
@@ -677,8 +681,11 @@ enum bal_status bal_sim_cycle(struct bal_sim *s, struct bal_error *err)
     bal_energy_global(s);
     bal_energy_dashpots(s);
     bal_energy_gravity(s);
-    if (s->over_budget)
-        return bal_energy_overlap(s, err);
+    if (s->over_budget) {
+        s->over_budget = 0; /* the sieve may have passed a pair within its own budget */
+        if (bal_energy_overlap(s, err) != BAL_OK)
+            return err->code;
+    }
     return BAL_OK;
 }
 

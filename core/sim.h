@@ -127,6 +127,8 @@ struct bal_audit {
     double d_dashpot;      /* dissipated by contact dashpots (disc pairs and walls) */
     double d_dashpot_last; /* ... in the latest cycle */
     double wall_dash;      /* Σ D·v_wall of the wall contacts' dashpots in this cycle */
+    double glob_sum;       /* Σ (m v_N² + I ω_N²) of this cycle (centred integrator) */
+    double dash_sum;       /* Σ (F^D·v_N + M^D ω_N) of this cycle (centred integrator) */
     double d_friction;     /* dissipated by sliding at the Coulomb limit */
     double d_global;       /* dissipated by global damping */
     double d_global_last;  /* ... in the latest cycle */
@@ -234,6 +236,7 @@ struct bal_sim {
     /* energy audit and guards */
     struct bal_audit audit;
     double overlap_budget;       /* share of the smaller radius; INFINITY = off */
+    double overlap_sieve;        /* overlap_budget x the smallest radius of the scene */
     int over_budget;             /* a contact loop saw an overlap beyond the budget */
 
     /* progress */

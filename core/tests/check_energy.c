@@ -221,6 +221,23 @@ START_TEST(energy_overlap_budget_off)
 }
 END_TEST
 
+/* The loop's sieve compares overlaps with the budget times the scene's
+ * smallest radius; two large discs pressed together by 0.3 of their radius
+ * pass it (a small disc far away sets the sieve at 0.05) but are within
+ * their own budget (0.5 r): the run must go on. */
+START_TEST(energy_overlap_sieve_false_alarm)
+{
+    struct tfx *f = tfx_newf("sieve", "[settings]\ndt = 1e-4\nnormal_law = power\n"
+                                      "[material m]\nkn = 1e4\ndensity = 1\n"
+                                      "[disc a]\nx = 0 0\nr = 1\nmaterial = m\n"
+                                      "[disc b]\nx = 1.7 0\nr = 1\nmaterial = m\n"
+                                      "[disc tiny]\nx = 10 10\nr = 0.1\nmaterial = m\n"
+                                      "[stage s]\ncycles = 50\n");
+    ck_assert_int_eq(bal_sim_run(f->sim, NULL, NULL, &f->err), BAL_OK);
+    ck_assert_int_eq(f->sim->over_budget, 0);
+}
+END_TEST
+
 /* Energy runaway: a chain of discs pressed between walls with a time step
  * above the critical one (2 sqrt(m/k) of one spring, here 1.3 times it)
  * gains energy geometrically; the guard stops it with its cause before a
@@ -269,6 +286,7 @@ Suite *suite_energy(void)
     tcase_add_checked_fixture(tc, NULL, tfx_teardown);
     tcase_add_test(tc, energy_overlap_budget);
     tcase_add_test(tc, energy_overlap_budget_off);
+    tcase_add_test(tc, energy_overlap_sieve_false_alarm);
     tcase_add_test(tc, energy_runaway_guard);
     suite_add_tcase(s, tc);
     return s;

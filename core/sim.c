@@ -314,6 +314,39 @@ static enum bal_status resolve_body(const struct bal_sim *s, const struct bal_sc
     return BAL_EINVAL;
 }
 
+/* The kinetic energy at the start when nothing can feed the scene more
+ * (no gravity, no wall moved in any stage, no overlap allowed at the
+ * start), else 0 (no bound). */
+static double start_energy(const struct bal_sim *s, const struct bal_scene *sc)
+{
+    if (s->g[0] != 0 || s->g[1] != 0 || sc->settings.allow_overlap)
+        return 0;
+    for (int g = 0; g < sc->n_stages; g++)
+        for (int m = 0; m < sc->stages[g].n_moves; m++) {
+            const struct bal_move_def *mv = &sc->stages[g].moves[m];
+            if (mv->v[0] != 0 || mv->v[1] != 0 || mv->omega != 0)
+                return 0;
+        }
+    double e = 0, px = 0, py = 0, m = 0;
+    int held = 0;
+    for (int i = 0; i < s->n; i++) {
+        held |= s->fixed[i];
+        if (s->fixed[i])
+            continue;
+        const double mi = bal_mass(s, i);
+        e += 0.5 * mi * (s->vx[i] * s->vx[i] + s->vy[i] * s->vy[i]) +
+             0.5 * bal_inertia(s, i) * s->w[i] * s->w[i];
+        px += mi * s->vx[i];
+        py += mi * s->vy[i];
+        m += mi;
+    }
+    /* Without walls or held discs the momentum is conserved: the motion of
+     * the centre of mass can never go into a contact. */
+    if (!held && s->n_walls == 0 && m > 0)
+        e -= 0.5 * (px * px + py * py) / m;
+    return e > 0 ? e : 0;
+}
+
 /* Bodies that overlap at the start are refused unless the scene allows it:
  * an overlap nobody meant is a typo, and it starts the run with energy the
  * scene never declared.  Two held discs may overlap (they never move: MLH's
@@ -538,6 +571,7 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
     free_init(&d);
 
     /* Time step. */
+    s->start_energy = start_energy(s, sc);
     s->dt_estimate = bal_timestep_estimate(s);
     s->dt = st->dt > 0 ? st->dt : st->dt_fraction * s->dt_estimate;
     if (!(s->dt > 0 && isfinite(s->dt))) {

@@ -195,6 +195,9 @@ struct bal_sim {
 
     /* settings */
     double dt, dt_estimate;
+    double start_energy;         /* E_k at the start of a scene nothing feeds (no gravity,
+                                  * no moving wall, no allowed overlap), else 0: bounds the
+                                  * power law's overlap for the estimate (timestep.c) */
     double alpha, beta;
     double g[2];
     int normal_law;

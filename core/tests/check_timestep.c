@@ -429,6 +429,38 @@ START_TEST(network_coordination_capped_by_bodies)
 }
 END_TEST
 
+/* The power law's stiffness ν k_n (δ/δ0)^(ν−1) is taken at the largest
+ * overlap the scene's energy allows when nothing feeds it: with ν = 3/2 the
+ * energy bound gives δ ∝ E^(1/(ν+1)), so the estimate ∝ k_eff^(-1/2) ∝
+ * E^(-(ν−1)/(2(ν+1))) ∝ v^(-1/5) for the same collision at speed v.  With
+ * gravity the overlap has no bound and δ0 is used, whatever the speed. */
+static double hertz_estimate(double v, int gravity)
+{
+    char text[T_TEXT_MAX];
+    snprintf(text, sizeof text,
+             "[settings]\nnormal_law = power\nnu = 1.5\ndelta0 = 0.1\n%s"
+             "[material m]\nkn = %.17g\ndensity = %.17g\n"
+             "[disc a]\nx = 0 0\nr = %.17g\nv = %.17g 0\nmaterial = m\n"
+             "[disc b]\nx = 10 0\nr = %.17g\nmaterial = m\n"
+             "[stage s]\ncycles = 1\n",
+             gravity ? "gravity = 0 -9.81\n" : "", KN, RHO, RR, v, RR);
+    /* not tfx_new: it allows overlaps, which lifts the energy bound */
+    struct tfx *f = tfx_parse(text, "hertz");
+    ck_assert_int_eq(tfx_create(f), BAL_OK);
+    const double e = info_of(f).estimate;
+    tfx_release(f);
+    return e;
+}
+
+START_TEST(network_hertz_energy_bound)
+{
+    ASSERT_REL(hertz_estimate(2, 0) / hertz_estimate(1, 0), pow(2, -0.2));
+    ASSERT_REL(hertz_estimate(2, 1), hertz_estimate(1, 1));
+    /* fast enough to press beyond δ0: stiffer than at δ0, a smaller step */
+    ck_assert_double_lt(hertz_estimate(1e4, 0), hertz_estimate(1e4, 1));
+}
+END_TEST
+
 /* A scene whose discs are all held: nothing moves, and the estimate falls
  * back to the single-spring value. */
 START_TEST(network_all_held)
@@ -463,6 +495,7 @@ Suite *suite_timestep(void)
     tcase_add_test(net, network_nine_discs_spectral);
     tcase_add_test(net, network_coordination);
     tcase_add_test(net, network_coordination_capped_by_bodies);
+    tcase_add_test(net, network_hertz_energy_bound);
     tcase_add_test(net, network_all_held);
     suite_add_tcase(s, net);
     return s;

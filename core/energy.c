@@ -74,22 +74,14 @@ static double start_elastic(const struct bal_sim *s)
     if (s->normal_law != BAL_NORMAL_POWER)
         return 0;
     double e = 0;
-    for (int list = 0; list < 2; list++) {
-        const struct bal_pairs *p = list ? &s->pw : &s->pp;
+    for (int walls = 0; walls < 2; walls++) {
+        const struct bal_pairs *p = walls ? &s->pw : &s->pp;
         for (long c = 0; c < p->n; c++) {
-            const int i = p->i[c], j = p->j[c];
-            double delta;
-            const struct bal_pair_law *L;
-            if (list) {
-                double cx, cy;
-                delta = s->r[i] - sqrt(bal_walls_closest(&s->walls[j], s->x[i], s->y[i], &cx, &cy));
-                L = &s->law[s->mat[i] * s->n_mat + s->walls[j].material];
-            } else {
-                delta = s->r[i] + s->r[j] - hypot(s->x[j] - s->x[i], s->y[j] - s->y[i]);
-                L = &s->law[s->mat[i] * s->n_mat + s->mat[j]];
-            }
+            double rmin;
+            const struct bal_pair_law *law;
+            const double delta = bal_sim_overlap(s, walls, c, &rmin, &law);
             if (delta > 0)
-                e += L->kn * s->delta0 * s->delta0 * pow(delta / s->delta0, s->nu + 1) / (s->nu + 1);
+                e += bal_measure_normal_energy(s, law, 0, delta);
         }
     }
     return e;
@@ -272,39 +264,24 @@ enum bal_status bal_energy_overlap(const struct bal_sim *s, struct bal_error *er
     double worst = -1, share = 0;
     long wc = -1;
     int wall = 0;
-    for (int list = 0; list < 2; list++) {
-        const struct bal_pairs *p = list ? &s->pw : &s->pp;
+    for (int walls = 0; walls < 2; walls++) {
+        const struct bal_pairs *p = walls ? &s->pw : &s->pp;
         for (long c = 0; c < p->n; c++) {
-            const int i = p->i[c], j = p->j[c];
-            double delta, rmin;
-            if (list) {
-                double cx, cy;
-                delta = s->r[i] - sqrt(bal_walls_closest(&s->walls[j], s->x[i], s->y[i], &cx, &cy));
-                rmin = s->r[i];
-            } else {
-                delta = s->r[i] + s->r[j] - hypot(s->x[j] - s->x[i], s->y[j] - s->y[i]);
-                rmin = fmin(s->r[i], s->r[j]);
-            }
+            double rmin;
+            const struct bal_pair_law *law;
+            const double delta = bal_sim_overlap(s, walls, c, &rmin, &law);
             if (delta / rmin > worst) {
                 worst = delta / rmin;
                 share = delta;
                 wc = c;
-                wall = list;
+                wall = walls;
             }
         }
     }
     if (wc < 0 || worst <= budget)
         return BAL_OK; /* only the sieve was passed: no pair is beyond its own budget */
-    const struct bal_pairs *p = wall ? &s->pw : &s->pp;
     char a[2 * BAL_NAME_MAX], b[3 * BAL_NAME_MAX];
-    bal_output_disc_name(s, s->id[p->i[wc]], a, sizeof a);
-    if (wall)
-        snprintf(b, sizeof b, "wall %s", s->walls[p->j[wc]].name);
-    else {
-        char d[2 * BAL_NAME_MAX];
-        bal_output_disc_name(s, s->id[p->j[wc]], d, sizeof d);
-        snprintf(b, sizeof b, "disc %s", d);
-    }
+    bal_sim_pair_names(s, wall, wc, a, sizeof a, b, sizeof b);
     return bal_error(err, BAL_EUNSTABLE,
                      "%s: overlap beyond the budget at step %ld: disc %s and %s overlap by %.6g, "
                      "%.3g of the smaller radius (limit %g, settings.overlap_budget) "

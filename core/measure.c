@@ -60,8 +60,8 @@ double bal_measure_kinetic(const struct bal_sim *s)
     return e;
 }
 
-static double normal_energy(const struct bal_sim *s, const struct bal_pair_law *L, double fn,
-                            double delta)
+double bal_measure_normal_energy(const struct bal_sim *s, const struct bal_pair_law *L, double fn,
+                                 double delta)
 {
     if (s->normal_law == BAL_NORMAL_INCREMENTAL)
         return fn * fn / (2 * L->kn);
@@ -77,25 +77,17 @@ static double shear_energy(const struct bal_pair_law *L, double fs)
 double bal_measure_elastic(const struct bal_sim *s)
 {
     double e = 0;
-    for (long c = 0; c < s->pp.n; c++) {
-        if (!(s->pp.flags[c] & BAL_PAIR_TOUCHING))
-            continue;
-        const int i = s->pp.i[c], j = s->pp.j[c];
-        const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + s->mat[j]];
-        const double delta = s->r[i] + s->r[j] - hypot(s->x[j] - s->x[i], s->y[j] - s->y[i]);
-        e += normal_energy(s, L, s->pp.fn[c], delta);
-        e += shear_energy(L, pair_fs(&s->pp, c));
-    }
-    for (long c = 0; c < s->pw.n; c++) {
-        if (!(s->pw.flags[c] & BAL_PAIR_TOUCHING))
-            continue;
-        const int i = s->pw.i[c];
-        const struct bal_wall *W = &s->walls[s->pw.j[c]];
-        const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + W->material];
-        double cx, cy;
-        const double delta = s->r[i] - sqrt(bal_walls_closest(W, s->x[i], s->y[i], &cx, &cy));
-        e += normal_energy(s, L, s->pw.fn[c], delta);
-        e += shear_energy(L, s->pw.fs[c]);
+    for (int walls = 0; walls < 2; walls++) {
+        const struct bal_pairs *p = walls ? &s->pw : &s->pp;
+        for (long c = 0; c < p->n; c++) {
+            if (!(p->flags[c] & BAL_PAIR_TOUCHING))
+                continue;
+            double rmin;
+            const struct bal_pair_law *L;
+            const double delta = bal_sim_overlap(s, walls, c, &rmin, &L);
+            e += bal_measure_normal_energy(s, L, p->fn[c], delta);
+            e += shear_energy(L, pair_fs(p, c));
+        }
     }
     return e;
 }

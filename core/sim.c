@@ -356,34 +356,19 @@ static enum bal_status check_overlaps(const struct bal_sim *s, struct bal_error 
     const struct bal_settings *st = &s->scene->settings;
     if (st->allow_overlap)
         return BAL_OK;
-    for (int list = 0; list < 2; list++) {
-        const struct bal_pairs *p = list ? &s->pw : &s->pp;
+    for (int walls = 0; walls < 2; walls++) {
+        const struct bal_pairs *p = walls ? &s->pw : &s->pp;
         for (long c = 0; c < p->n; c++) {
             const int i = p->i[c], j = p->j[c];
-            double delta, rmin;
-            if (list) {
-                double cx, cy;
-                delta = s->r[i] - sqrt(bal_walls_closest(&s->walls[j], s->x[i], s->y[i], &cx, &cy));
-                rmin = s->r[i];
-                if (s->fixed[i])
-                    continue;
-            } else {
-                delta = s->r[i] + s->r[j] - hypot(s->x[j] - s->x[i], s->y[j] - s->y[i]);
-                rmin = fmin(s->r[i], s->r[j]);
-                if (s->fixed[i] && s->fixed[j])
-                    continue;
-            }
+            if (s->fixed[i] && (walls || s->fixed[j]))
+                continue;
+            double rmin;
+            const struct bal_pair_law *law;
+            const double delta = bal_sim_overlap(s, walls, c, &rmin, &law);
             if (delta <= 1e-9 * rmin)
                 continue;
             char a[2 * BAL_NAME_MAX], b[3 * BAL_NAME_MAX];
-            bal_output_disc_name(s, s->id[i], a, sizeof a);
-            if (list) {
-                snprintf(b, sizeof b, "wall %s", s->walls[j].name);
-            } else {
-                char d[2 * BAL_NAME_MAX];
-                bal_output_disc_name(s, s->id[j], d, sizeof d);
-                snprintf(b, sizeof b, "disc %s", d);
-            }
+            bal_sim_pair_names(s, walls, c, a, sizeof a, b, sizeof b);
             const int line = st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "allow_overlap")];
             return bal_error(err, BAL_EINVAL,
                              "%s:%d: allow_overlap: disc %s and %s overlap by %.6g (%.3g of the "
@@ -867,6 +852,36 @@ int bal_sim_disc_id(const struct bal_sim *s, int i)
 const char *bal_sim_wall_name(const struct bal_sim *s, int k)
 {
     return s->walls[k].name;
+}
+
+double bal_sim_overlap(const struct bal_sim *s, int walls, long c, double *rmin,
+                       const struct bal_pair_law **law)
+{
+    const struct bal_pairs *p = walls ? &s->pw : &s->pp;
+    const int i = p->i[c], j = p->j[c];
+    if (walls) {
+        double cx, cy;
+        *rmin = s->r[i];
+        *law = &s->law[s->mat[i] * s->n_mat + s->walls[j].material];
+        return s->r[i] - sqrt(bal_walls_closest(&s->walls[j], s->x[i], s->y[i], &cx, &cy));
+    }
+    *rmin = fmin(s->r[i], s->r[j]);
+    *law = &s->law[s->mat[i] * s->n_mat + s->mat[j]];
+    return s->r[i] + s->r[j] - hypot(s->x[j] - s->x[i], s->y[j] - s->y[i]);
+}
+
+void bal_sim_pair_names(const struct bal_sim *s, int walls, long c, char *a, size_t na, char *b,
+                        size_t nb)
+{
+    const struct bal_pairs *p = walls ? &s->pw : &s->pp;
+    bal_output_disc_name(s, s->id[p->i[c]], a, na);
+    if (walls) {
+        snprintf(b, nb, "wall %s", s->walls[p->j[c]].name);
+        return;
+    }
+    char d[2 * BAL_NAME_MAX];
+    bal_output_disc_name(s, s->id[p->j[c]], d, sizeof d);
+    snprintf(b, nb, "disc %s", d);
 }
 
 void bal_sim_contact_point(const struct bal_sim *s, int i, int is_wall, int j, double *px,

@@ -362,12 +362,24 @@ void bal_measure_moments(const struct bal_sim *s, double *m);
 /* The volume V_i of MLH eq. (8) for one disc: the hexagonal cell of a disc of
  * its size in a triangular packing, 2 sqrt(3) r^2. */
 double bal_measure_disc_volume(double r);
+/* The energy stored by the normal spring of a contact with pair law L:
+ * F_n²/(2 k_n) for the incremental law, ∫ F_n dδ at overlap δ for the power law. */
+double bal_measure_normal_energy(const struct bal_sim *s, const struct bal_pair_law *L, double fn,
+                                 double delta);
 
 /* sim.c */
 /* Scene-order index of the disc in slot i; name of wall k; the C&S contact
  * point of disc i with disc or wall j (as in contacts.tsv). */
 int bal_sim_disc_id(const struct bal_sim *s, int i);
 const char *bal_sim_wall_name(const struct bal_sim *s, int k);
+/* Candidate c of the disc–disc list (walls = 0) or of the disc–wall list
+ * (walls = 1): its overlap δ (negative: a gap), the smaller radius of its
+ * bodies and their pair law; and the names of its bodies for messages,
+ * "A" and "disc B" or "wall W". */
+double bal_sim_overlap(const struct bal_sim *s, int walls, long c, double *rmin,
+                       const struct bal_pair_law **law);
+void bal_sim_pair_names(const struct bal_sim *s, int walls, long c, char *a, size_t na, char *b,
+                        size_t nb);
 void bal_sim_contact_point(const struct bal_sim *s, int i, int is_wall, int j, double *px,
                            double *py);
 /* Bytes the simulation holds while it steps (every array at its allocated

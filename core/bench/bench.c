@@ -76,25 +76,33 @@ struct options {
     double median;
 };
 
+/* The benchmark scene with N discs (fill.pack.n, and a square-ish lattice of
+ * columns) and the `max` overrides of `sets` (NULL entries skipped), then its
+ * simulation.  Returns 0, or 1 with err set. */
+static int load_scene(const char *path, long n, const char *const *sets, int max,
+                      struct bal_scene *sc, struct bal_sim **sim, struct bal_error *err)
+{
+    char set[128];
+    bal_scene_default(sc);
+    int ok = bal_scene_load(sc, path, err) == BAL_OK;
+    snprintf(set, sizeof set, "fill.pack.n=%ld", n);
+    ok = ok && bal_scene_set(sc, set, err) == BAL_OK;
+    snprintf(set, sizeof set, "fill.pack.columns=%ld", lround(sqrt(2.0 * (double)n)));
+    ok = ok && bal_scene_set(sc, set, err) == BAL_OK;
+    for (int k = 0; k < max; k++)
+        if (sets[k])
+            ok = ok && bal_scene_set(sc, sets[k], err) == BAL_OK;
+    ok = ok && bal_sim_create(sim, sc, err) == BAL_OK;
+    return ok ? 0 : 1;
+}
+
 static int run_one(const char *path, long n, FILE *csv, struct options *o)
 {
     struct bal_scene sc;
     struct bal_error err = {0};
     struct bal_sim *sim = NULL;
-    char set[128];
-    const long columns = lround(sqrt(2.0 * (double)n));
-    bal_scene_default(&sc);
-    int ok = bal_scene_load(&sc, path, &err) == BAL_OK;
-    snprintf(set, sizeof set, "fill.pack.n=%ld", n);
-    ok = ok && bal_scene_set(&sc, set, &err) == BAL_OK;
-    snprintf(set, sizeof set, "fill.pack.columns=%ld", columns);
-    ok = ok && bal_scene_set(&sc, set, &err) == BAL_OK;
-    if (o->extra)
-        ok = ok && bal_scene_set(&sc, o->extra, &err) == BAL_OK;
-    if (o->extra2)
-        ok = ok && bal_scene_set(&sc, o->extra2, &err) == BAL_OK;
-    ok = ok && bal_sim_create(&sim, &sc, &err) == BAL_OK;
-    if (!ok) {
+    const char *const sets[] = {o->extra, o->extra2};
+    if (load_scene(path, n, sets, 2, &sc, &sim, &err)) {
         fprintf(stderr, "bench: %s\n", err.msg);
         bal_scene_free(&sc);
         return 1;
@@ -303,21 +311,15 @@ static const struct module_config module_configs[] = {
 static int load_config(const char *path, long n, const struct module_config *c, int nonlinear,
                        struct bal_scene *sc, struct bal_sim **sim, struct bal_error *err)
 {
-    char set[128];
-    bal_scene_default(sc);
-    int ok = bal_scene_load(sc, path, err) == BAL_OK;
-    snprintf(set, sizeof set, "fill.pack.n=%ld", n);
-    ok = ok && bal_scene_set(sc, set, err) == BAL_OK;
-    snprintf(set, sizeof set, "fill.pack.columns=%ld", lround(sqrt(2.0 * (double)n)));
-    ok = ok && bal_scene_set(sc, set, err) == BAL_OK;
-    ok = ok && bal_scene_set(sc, "settings.normal_law=power", err) == BAL_OK;
-    if (nonlinear)
-        ok = ok && bal_scene_set(sc, "settings.nu=1.5", err) == BAL_OK &&
-             bal_scene_set(sc, "settings.delta0=1", err) == BAL_OK;
-    for (int k = 0; c && k < 4 && c->sets[k]; k++)
-        ok = ok && bal_scene_set(sc, c->sets[k], err) == BAL_OK;
-    ok = ok && bal_sim_create(sim, sc, err) == BAL_OK;
-    return ok ? 0 : 1;
+    const char *sets[8] = {"settings.normal_law=power"};
+    int k = 1;
+    if (nonlinear) {
+        sets[k++] = "settings.nu=1.5";
+        sets[k++] = "settings.delta0=1";
+    }
+    for (int q = 0; c && q < 4 && c->sets[q]; q++)
+        sets[k++] = c->sets[q];
+    return load_scene(path, n, sets, k, sc, sim, err);
 }
 
 static int modules_bench(const char *path, long n, int base_only)

@@ -5,8 +5,9 @@
  *
  * With the cell grid, disc–disc candidates are the pairs whose gap is below
  * the Verlet skin at the last rebuild, disc–wall candidates likewise; the
- * lists are rebuilt when a disc (or wall) may have closed the skin
- * (2 max|Δx| ≥ skin, or max|Δx| + wall displacement ≥ skin).  Without the
+ * lists are rebuilt when two discs (or a disc and a wall) may have closed
+ * the skin (d_1 + d_2 ≥ skin, the two largest displacements since the
+ * rebuild, or d_1 + wall displacement ≥ skin).  Without the
  * grid every pair is a candidate.  History (F_n, F_s, flags) follows a
  * contact through rebuilds, so results must not depend on the mode.
  */
@@ -170,27 +171,36 @@ START_TEST(grid_candidates_sparse_scene)
 }
 END_TEST
 
-/* When the lists are rebuilt.  skin = 0.2; `mover` runs at 0.7 with
- * Δt = 1e-3: 2 · 0.7 · N Δt ≥ 0.2 first at N = ⌈142.86⌉ = 143, then every
- * 143 cycles: 300 cycles → rebuilds at 143 and 286, plus the one at
- * creation: 3.  A wall moving at 0.3 with the discs at rest: 0.3 N Δt ≥ 0.2
- * at N = ⌈666.7⌉ = 667: 700 cycles → 1 + 1 = 2. */
+/* When the lists are rebuilt.  skin = 0.2, Δt = 1e-3.  `mover` alone runs
+ * at 0.7, the others rest: d_1 + d_2 = 0.7 N Δt ≥ 0.2 first at
+ * N = ⌈285.7⌉ = 286, then every 286 cycles: 600 cycles → rebuilds at 286
+ * and 572, plus the one at creation: 3.  With a second mover at 0.4:
+ * 1.1 N Δt ≥ 0.2 at N = ⌈181.8⌉ = 182.  A wall moving at 0.3 with the
+ * discs at rest: 0.3 N Δt ≥ 0.2 at N = ⌈666.7⌉ = 667: 700 cycles → 2. */
 START_TEST(grid_rebuild_when_skin_used_up)
 {
-    struct tfx *f = tfx_new("[settings]\ngrid = on\nskin = 0.2\ndt = 1e-3\n"
-                            "[material g]\nkn = 1e5\ndensity = 1\n"
-                            "[disc mover]\nx = 0 0\nr = 0.5\nv = 0.7 0\nmaterial = g\n"
-                            "[disc a]\nx = 0 5\nr = 0.5\nmaterial = g\n"
-                            "[disc b]\nx = 5 5\nr = 0.5\nmaterial = g\n"
-                            "[stage s]\ncycles = 1\n",
-                            "mover");
+    static const char *const movers =
+        "[settings]\ngrid = on\nskin = 0.2\ndt = 1e-3\n"
+        "[material g]\nkn = 1e5\ndensity = 1\n"
+        "[disc mover]\nx = 0 0\nr = 0.5\nv = 0.7 0\nmaterial = g\n"
+        "[disc a]\nx = 0 5\nr = 0.5\nv = %s\nmaterial = g\n"
+        "[disc b]\nx = 5 5\nr = 0.5\nmaterial = g\n"
+        "[stage s]\ncycles = 1\n";
+    struct tfx *f = tfx_newf("one mover", movers, "0 0");
     ck_assert_int_eq(info_of(f).rebuilds, 1);
-    t_steps(f, 142);
+    t_steps(f, 285);
     ck_assert_int_eq(info_of(f).rebuilds, 1);
     t_steps(f, 1);
     ck_assert_int_eq(info_of(f).rebuilds, 2);
-    t_steps(f, 300 - 143);
+    t_steps(f, 600 - 286);
     ck_assert_int_eq(info_of(f).rebuilds, 3);
+    tfx_release(f);
+
+    f = tfx_newf("two movers", movers, "0 -0.4");
+    t_steps(f, 181);
+    ck_assert_int_eq(info_of(f).rebuilds, 1);
+    t_steps(f, 1);
+    ck_assert_int_eq(info_of(f).rebuilds, 2);
     tfx_release(f);
 
     f = tfx_new("[settings]\ngrid = on\nskin = 0.2\ndt = 1e-3\n"
@@ -206,6 +216,52 @@ START_TEST(grid_rebuild_when_skin_used_up)
     ck_assert_int_eq(info_of(f).rebuilds, 2);
     t_steps(f, 700 - 667);
     ck_assert_int_eq(info_of(f).rebuilds, 2);
+}
+END_TEST
+
+/* The tight case of d_1 + d_2: two discs flying head-on at each other, with
+ * the gap at the rebuild just above the skin (so they are not candidates)
+ * and no other disc moving.  Their first contact must be seen in the same
+ * cycle as with every pair a candidate, for several skins and speeds. */
+START_TEST(grid_head_on_contact_not_missed)
+{
+    static const char *const fmt =
+        "[settings]\ngrid = %s\nskin = %g\ndt = 1e-4\n"
+        "[material g]\nkn = 1e5\ndensity = 1\n"
+        "[disc p]\nx = 0 0\nr = 0.5\nv = %g 0\nmaterial = g\n"
+        "[disc q]\nx = %.17g 0\nr = 0.5\nv = %g 0\nmaterial = g\n"
+        "[disc c]\nx = 0 9\nr = 0.5\nmaterial = g\n"
+        "[disc d]\nx = 9 9\nr = 0.5\nmaterial = g\n"
+        "[stage s]\ncycles = 1\n"
+        "[probe fn]\nquantity = contact_fn\na = p\nb = q\n";
+    const double skins[] = {0.05, 0.2, 0.3};
+    const double speeds[][2] = {{1.0, -1.0}, {1.5, -0.25}, {0.1, -2.0}};
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++) {
+            const double skin = skins[a], gap = skin * 1.0001;
+            char on_txt[1024], off_txt[1024];
+            snprintf(on_txt, sizeof on_txt, fmt, "on", skin, speeds[b][0], 1.0 + gap,
+                     speeds[b][1]);
+            snprintf(off_txt, sizeof off_txt, fmt, "off", skin, speeds[b][0], 1.0 + gap,
+                     speeds[b][1]);
+            struct tfx *on = tfx_new(on_txt, "on"), *off = tfx_new(off_txt, "off");
+            ck_assert_int_eq(on->sim->pp.n < off->sim->pp.n, 1); /* p-q not a candidate */
+            const double closing = speeds[b][0] - speeds[b][1];
+            const long until = (long)(3 * gap / closing / 1e-4) + 10;
+            long first_on = -1, first_off = -1;
+            for (long k = 1; k <= until && (first_on < 0 || first_off < 0); k++) {
+                t_steps(on, 1);
+                t_steps(off, 1);
+                if (first_on < 0 && t_probe_value(on, "fn") > 0)
+                    first_on = k;
+                if (first_off < 0 && t_probe_value(off, "fn") > 0)
+                    first_off = k;
+            }
+            ck_assert_int_gt(first_off, 0);
+            ck_assert_int_eq(first_on, first_off);
+            tfx_release(on);
+            tfx_release(off);
+        }
 }
 END_TEST
 
@@ -435,6 +491,7 @@ Suite *suite_grid(void)
     tcase_add_test(tc, grid_candidates_match_brute_force);
     tcase_add_test(tc, grid_candidates_sparse_scene);
     tcase_add_test(tc, grid_rebuild_when_skin_used_up);
+    tcase_add_test(tc, grid_head_on_contact_not_missed);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("history");

@@ -62,8 +62,7 @@ enum bal_status bal_pairs_reserve(struct bal_pairs *p, long cap)
     if (cap <= p->cap)
         return BAL_OK;
     const size_t c = (size_t)cap;
-    int ok = grow_array((void **)&p->key, c, sizeof *p->key) &&
-             grow_array((void **)&p->i, c, sizeof *p->i) &&
+    int ok = grow_array((void **)&p->i, c, sizeof *p->i) &&
              grow_array((void **)&p->j, c, sizeof *p->j) &&
              grow_array((void **)&p->fn, c, sizeof *p->fn) &&
              grow_array((void **)&p->flags, c, sizeof *p->flags);
@@ -81,7 +80,6 @@ enum bal_status bal_pairs_reserve(struct bal_pairs *p, long cap)
 void bal_pairs_free(struct bal_pairs *p)
 {
     const uint8_t shear = p->shear, damping = p->damping;
-    free(p->key);
     free(p->i);
     free(p->j);
     free(p->fn);
@@ -99,12 +97,12 @@ long bal_pairs_find(const struct bal_pairs *p, uint64_t key)
     long lo = 0, hi = p->n;
     while (lo < hi) {
         const long mid = lo + (hi - lo) / 2;
-        if (p->key[mid] < key)
+        if (pair_key(p, mid) < key)
             lo = mid + 1;
         else
             hi = mid;
     }
-    return lo < p->n && p->key[lo] == key ? lo : -1;
+    return lo < p->n && pair_key(p, lo) == key ? lo : -1;
 }
 
 /* Copy the history of every contact of `old` whose key is also in `fresh`.
@@ -114,10 +112,10 @@ void bal_pairs_merge_history(struct bal_pairs *fresh, const struct bal_pairs *ol
 {
     long a = 0;
     for (long c = 0; c < fresh->n; c++) {
-        uint64_t k = fresh->key[c];
-        while (a < old->n && old->key[a] < k)
+        const uint64_t k = pair_key(fresh, c);
+        while (a < old->n && pair_key(old, a) < k)
             a++;
-        const int same = a < old->n && old->key[a] == k;
+        const int same = a < old->n && pair_key(old, a) == k;
         fresh->fn[c] = same ? old->fn[a] : 0;
         fresh->flags[c] = same ? old->flags[a] : 0;
         if (fresh->shear)

@@ -120,9 +120,9 @@ static void match_old(const struct bal_sim *s, const struct bal_pairs *old,
         long a = 0;
         for (long c = 0; c < n; c++) {
             const uint64_t k = rs->key[c];
-            while (a < old->n && old->key[a] < k)
+            while (a < old->n && pair_key(old, a) < k)
                 a++;
-            rs->map[c] = (int32_t)(a < old->n && old->key[a] == k ? a : -1);
+            rs->map[c] = (int32_t)(a < old->n && pair_key(old, a) == k ? a : -1);
         }
         return;
     }
@@ -167,7 +167,6 @@ static enum bal_status install(const struct bal_sim *s, struct bal_pairs *p,
     for (long c = 0; c < n; c++)
         rs->bytes[c] = rs->map[c] >= 0 ? p->flags[rs->map[c]] : 0;
     memcpy(p->flags, rs->bytes, (size_t)n * sizeof *p->flags);
-    memcpy(p->key, rs->key, (size_t)n * sizeof *p->key);
     for (long c = 0; c < n; c++) {
         p->i[c] = (int32_t)(rs->key[c] >> 32);
         p->j[c] = (int32_t)(rs->key[c] & 0xffffffffu);
@@ -303,10 +302,14 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
     for (int i = 0; i < n; i++) {
         for (int k = 0; k < s->n_walls; k++) {
             if (s->use_grid) {
-                double cx, cy;
-                const double d2 = bal_walls_closest(&s->walls[k], s->x[i], s->y[i], &cx, &cy);
+                const struct bal_wall *W = &s->walls[k];
                 const double reach = s->r[i] + s->skin;
-                if (d2 >= reach * reach)
+                /* The distance to the wall's line first: most discs are far
+                 * from most walls, and the segment is no closer than its line. */
+                if (fabs((s->y[i] - W->p[1]) * W->e[0] - (s->x[i] - W->p[0]) * W->e[1]) >= reach)
+                    continue;
+                double cx, cy;
+                if (bal_walls_closest(W, s->x[i], s->y[i], &cx, &cy) >= reach * reach)
                     continue;
             }
             if (push(rs, &count, i, k, err))

@@ -904,7 +904,7 @@ void bal_sim_contact_point(const struct bal_sim *s, int i, int is_wall, int j, d
 
 static double list_bytes(const struct bal_pairs *p)
 {
-    double per = sizeof *p->key + sizeof *p->i + sizeof *p->j + sizeof *p->fn + sizeof *p->flags;
+    double per = sizeof *p->i + sizeof *p->j + sizeof *p->fn + sizeof *p->flags;
     if (p->shear)
         per += sizeof *p->fs;
     if (p->damping)

@@ -10,7 +10,7 @@
  * so contact keys built from indices are stable too.
  *
  * Contacts.  Two flat candidate lists, disc–disc and disc–wall, each sorted
- * by key = (lo << 32) | hi.  A candidate carries the contact's history
+ * by key = (lo << 32) | hi (pair_key(); not stored: it is i and j).  A candidate carries the contact's history
  * (F_n for the incremental law, F_s) in parallel arrays; a candidate whose
  * bodies do not overlap has zero history.  When the neighbour list is
  * rebuilt, the new candidate list is merged with the old one in one linear
@@ -44,14 +44,20 @@ struct bal_pair_law {
 struct bal_pairs {
     long n, cap;
     uint8_t shear, damping; /* which optional columns exist */
-    uint64_t *key;         /* (lo << 32) | hi, sorted ascending */
-    int32_t *i, *j;        /* disc index; j: disc index or wall index */
+    int32_t *i, *j;        /* disc index; j: disc index or wall index; sorted by
+                            * pair_key() ascending */
     double *fn, *fs;       /* F_n (history of the incremental law), F_s */
     double *dn, *ds;       /* dashpot forces D_n, D_s of the last cycle */
     uint8_t *flags;
 };
 
 static inline double pair_fs(const struct bal_pairs *p, long c) { return p->fs ? p->fs[c] : 0.0; }
+
+/* The sort key of candidate c, (i << 32) | j. */
+static inline uint64_t pair_key(const struct bal_pairs *p, long c)
+{
+    return ((uint64_t)(uint32_t)p->i[c] << 32) | (uint32_t)p->j[c];
+}
 
 #define BAL_PAIR_TOUCHING 1u
 #define BAL_PAIR_SLIDING 2u
@@ -265,7 +271,6 @@ static inline double bal_inertia(const struct bal_sim *s, int i)
 /* contacts.c */
 enum bal_status bal_pairs_reserve(struct bal_pairs *p, long cap);
 void bal_pairs_free(struct bal_pairs *p);
-void bal_pairs_sort(struct bal_pairs *p);
 void bal_pairs_merge_history(struct bal_pairs *fresh, const struct bal_pairs *old);
 /* Position of `key` in the sorted list p, or -1 (binary search). */
 long bal_pairs_find(const struct bal_pairs *p, uint64_t key);

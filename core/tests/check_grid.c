@@ -86,7 +86,7 @@ static int candidates_are_exact(const struct bal_sim *s, double skin, long *n_pa
     qsort(expect, (size_t)n_exp, sizeof *expect, cmp_u64);
     int ok = s->pp.n == n_exp;
     for (long c = 0; ok && c < n_exp; c++)
-        ok = s->pp.key[c] == expect[c] && s->pp.i[c] < s->pp.j[c];
+        ok = pair_key(&s->pp, c) == expect[c] && s->pp.i[c] < s->pp.j[c];
     free(expect);
     long nw = 0;
     for (int i = 0; i < s->n; i++) {
@@ -96,7 +96,7 @@ static int candidates_are_exact(const struct bal_sim *s, double skin, long *n_pa
             const double reach = s->r[i] + skin;
             if (d2 < reach * reach) {
                 const uint64_t key = ((uint64_t)(uint32_t)i << 32) | (uint32_t)k;
-                ok &= nw < s->pw.n && s->pw.key[nw] == key;
+                ok &= nw < s->pw.n && pair_key(&s->pw, nw) == key;
                 nw++;
             }
         }
@@ -280,7 +280,8 @@ START_TEST(grid_merge_history)
     if (ok) {
         old.n = 3;
         for (int c = 0; c < 3; c++) {
-            old.key[c] = ko[c];
+            old.i[c] = (int32_t)(ko[c] >> 32);
+            old.j[c] = (int32_t)(ko[c] & 0xffffffffu);
             old.fn[c] = 1.25 + c;
             old.fs[c] = -0.375 - c;
             old.dn[c] = 0.0625 * c;
@@ -289,7 +290,8 @@ START_TEST(grid_merge_history)
         }
         fresh.n = 4;
         for (int c = 0; c < 4; c++) {
-            fresh.key[c] = kf[c];
+            fresh.i[c] = (int32_t)(kf[c] >> 32);
+            fresh.j[c] = (int32_t)(kf[c] & 0xffffffffu);
             fresh.fn[c] = fresh.fs[c] = fresh.dn[c] = fresh.ds[c] = 99; /* garbage */
             fresh.flags[c] = 7;
         }

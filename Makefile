@@ -31,7 +31,7 @@ TEST_SRC := $(wildcard core/tests/check_*.c)
 BENCH_SRC := core/bench/bench.c
 
 .PHONY: all deps test test-c test-prefix test-py test-sanitize validate bench bench-scaling \
-        bench-peer bench-modules clean keys sweep test-valgrind
+        bench-peer bench-modules bench-modules-count clean keys sweep test-valgrind
 
 all: deps bin/ballast
 
@@ -128,8 +128,47 @@ $(BUILD)/bench-bare: $(BENCH_SRC) $(BARE_OBJ)
 
 bench-modules: deps $(BUILD)/bench $(BUILD)/bench-bare
 	$(BUILD)/bench --modules cases/bench/dense.scene 20000
-	for k in 1 2 3; do $(BUILD)/bench --modules-base cases/bench/dense.scene 20000 | grep '^bench'; \
-	  $(BUILD)/bench-bare --modules-base cases/bench/dense.scene 20000 | grep '^bench'; done
+	$(MAKE) --no-print-directory bench-modules-count
+
+# The all-off scene in the normal and the bare build, compared by what the machine's
+# load does not change (about 4 minutes; wall-clock repeats of one binary spread by
+# +-25 % on a shared VM, and it has no hardware counters):
+# 1. instructions and simulated cache misses per particle-step of the timed cycles
+#    alone, counted by callgrind (the packing is read from a file, so only scene load
+#    and creation run uninstrumented under valgrind: COUNT_N discs keeps that short);
+# 2. wall clock pinned to one core: WALL_PAIRS alternating pairs of processes, each
+#    WALL_RUNS runs of WALL_STEPS cycles.  The settled packings are cached in $(BUILD).
+COUNT_N     ?= 5000
+COUNT_STEPS ?= 100
+WALL_N      ?= 20000
+WALL_PAIRS  ?= 15
+WALL_STEPS  ?= 250
+WALL_RUNS   ?= 5
+WALL_CPU    ?= 1
+# Fixed simulated caches (this VM's L1s; the 512 MB L3 it reports is not a real one), so
+# the counts do not depend on the machine.
+CALLGRIND   := valgrind --tool=callgrind --instr-atstart=no --collect-atstart=no --cache-sim=yes \
+               --I1=32768,8,64 --D1=49152,12,64 --LL=8388608,16,64
+STEP        := --modules-step cases/bench/dense.scene
+
+$(BUILD)/modules-%.pack: $(BUILD)/bench cases/bench/dense.scene
+	$(BUILD)/bench --modules-pack cases/bench/dense.scene $* $@
+
+bench-modules-count: deps $(BUILD)/bench $(BUILD)/bench-bare $(BUILD)/modules-$(COUNT_N).pack \
+                     $(BUILD)/modules-$(WALL_N).pack
+	for b in bench bench-bare; do \
+	  $(CALLGRIND) --callgrind-out-file=$(BUILD)/$$b.callgrind $(BUILD)/$$b $(STEP) \
+	    $(BUILD)/modules-$(COUNT_N).pack $(COUNT_STEPS) 1 >$(BUILD)/$$b.count \
+	    2>$(BUILD)/$$b.callgrind.log || exit 1; done
+	rm -f $(BUILD)/modules-wall.txt; for k in $$(seq $(WALL_PAIRS)); do for b in bench bench-bare; do \
+	  taskset -c $(WALL_CPU) $(BUILD)/$$b $(STEP) $(BUILD)/modules-$(WALL_N).pack $(WALL_STEPS) \
+	    $(WALL_RUNS) >>$(BUILD)/modules-wall.txt || exit 1; done; done
+	@for b in bench bench-bare; do echo "# $$b: Ir per particle-step of the timed cycles, by function"; \
+	  callgrind_annotate --inclusive=no --show=Ir $(BUILD)/$$b.callgrind 2>/dev/null | grep -E ' \[.*\]$$' | \
+	    head -7 | awk '{ gsub(",", "", $$1); printf "%10.2f  %s\n", $$1 / ($(COUNT_N) * $(COUNT_STEPS)), $$(NF - 1) }'; \
+	done
+	$(BUILD)/bench --modules-summary $(BUILD)/bench.callgrind $(BUILD)/bench.count \
+	  $(BUILD)/bench-bare.callgrind $(BUILD)/bench-bare.count $(BUILD)/modules-wall.txt
 
 # ballast against LAMMPS (installed with apt-get when missing; not a build or test
 # dependency): a cross-check of the same physics, then 5 alternating repeats per

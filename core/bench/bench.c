@@ -24,6 +24,12 @@
  *        bench --modules-base SCENE [N]  (only the configuration with every
  *                                         module off: run by bench-bare, the
  *                                         build without them, to compare)
+ *        bench --modules-pack SCENE N FILE    (settle that packing once, save it)
+ *        bench --modules-step SCENE FILE STEPS RUNS  (the all-off configuration
+ *                                         from the saved packing, RUNS timed runs
+ *                                         of STEPS cycles, bracketed for callgrind)
+ *        bench --modules-summary CG_NORMAL COUNT_NORMAL CG_BARE COUNT_BARE WALL
+ *                                        (what `make bench-modules-count` prints)
  */
 #include <math.h>
 #include <stdio.h>
@@ -325,40 +331,132 @@ static int load_config(const char *path, long n, const struct module_config *c, 
     return load_scene(path, n, sets, k, sc, sim, err);
 }
 
-static int modules_bench(const char *path, long n, int base_only)
+/* The reference packing: frictionless and without dashpots, settled by
+ * global damping alone, so that the bare build (which has only that pair
+ * loop) settles exactly the same packing.  Returned in scene order: x, y
+ * and θ of disc id k at xyt[3k], xyt[3k + 1], xyt[3k + 2] (malloc'd). */
+static int settle_packing(const char *path, long n, double **xyt, int *n_out)
 {
-    struct bal_scene ref_sc;
+    struct bal_scene sc;
     struct bal_sim *ref = NULL;
     struct bal_error err = {0};
-    /* The reference packing: frictionless and without dashpots, settled by
-     * global damping alone, so that the bare build (which has only that
-     * pair loop) settles exactly the same packing. */
     static const struct module_config settled = {
         "settled", {"material.grain.friction=0", "material.box.friction=0", "settings.beta=0", NULL}};
-    if (load_config(path, n, &settled, 0, &ref_sc, &ref, &err)) {
-        fprintf(stderr, "bench: %s\n", err.msg);
-        bal_scene_free(&ref_sc);
+    int rc = load_config(path, n, &settled, 0, &sc, &ref, &err);
+    long settle = 0;
+    for (int g = 0; rc == 0 && g + 1 < sc.n_stages; g++) {
+        bal_sim_set_stage(ref, g);
+        for (long c = 0; rc == 0 && c < sc.stages[g].cycles; c++, settle++)
+            rc = bal_sim_cycle(ref, &err) != BAL_OK;
+    }
+    while (rc == 0 && bal_measure_kinetic(ref) > SETTLED_EK_OVER_EE * bal_measure_elastic(ref) &&
+           settle < (MAX_SETTLE_BLOCKS + 1) * sc.stages[0].cycles)
+        for (long c = 0; rc == 0 && c < sc.stages[0].cycles; c++, settle++)
+            rc = bal_sim_cycle(ref, &err) != BAL_OK;
+    *xyt = rc ? NULL : malloc(3 * sizeof **xyt * (size_t)ref->n);
+    if (rc == 0 && *xyt == NULL) {
+        snprintf(err.msg, sizeof err.msg, "out of memory");
+        rc = 1;
+    }
+    if (rc) {
+        fprintf(stderr, "bench: settling: %s\n", err.msg);
+    } else {
+        printf("# module costs: N=%d packing settled for %ld cycles (frictionless, global damping) "
+               "(E_k/E_el = %.2g); each configuration starts from it at rest\n",
+               ref->n, settle, bal_measure_kinetic(ref) / bal_measure_elastic(ref));
+        for (int i = 0; i < ref->n; i++) {
+            double *p = *xyt + 3 * (size_t)ref->id[i];
+            p[0] = ref->x[i], p[1] = ref->y[i], p[2] = ref->th[i];
+        }
+        *n_out = ref->n;
+    }
+    bal_sim_free(ref);
+    bal_scene_free(&sc);
+    return rc;
+}
+
+/* The settled packing saved by `--modules-pack`, so that the short runs of
+ * bench-modules-count do not each settle it again: a header line with N,
+ * then the 3N doubles of settle_packing, in this machine's byte order. */
+#define PACK_MAGIC "ballast-packing-1"
+
+static int write_packing(const char *file, const double *xyt, int n)
+{
+    FILE *f = fopen(file, "wb");
+    int ok = f && fprintf(f, "%s %d\n", PACK_MAGIC, n) > 0 &&
+             fwrite(xyt, sizeof *xyt, 3 * (size_t)n, f) == 3 * (size_t)n;
+    ok = f && fclose(f) == 0 && ok;
+    if (!ok)
+        fprintf(stderr, "bench: %s: cannot write the packing\n", file);
+    return !ok;
+}
+
+static int read_packing(const char *file, double **xyt, int *n)
+{
+    char magic[32] = "";
+    FILE *f = fopen(file, "rb");
+    int ok = f && fscanf(f, "%31s %d", magic, n) == 2 && strcmp(magic, PACK_MAGIC) == 0 &&
+             *n > 0 && fgetc(f) == '\n';
+    *xyt = ok ? malloc(3 * sizeof **xyt * (size_t)*n) : NULL;
+    ok = ok && *xyt && fread(*xyt, sizeof **xyt, 3 * (size_t)*n, f) == 3 * (size_t)*n;
+    if (f)
+        fclose(f);
+    if (!ok) {
+        fprintf(stderr, "bench: %s: not a packing written by bench --modules-pack\n", file);
+        free(*xyt);
+        *xyt = NULL;
+    }
+    return !ok;
+}
+
+/* Configuration c of the N-disc scene, started from the packing at rest
+ * with a time step 1e-4 of the scene's, in its last stage. */
+static int start_config(const char *path, long n, const struct module_config *c, int nonlinear,
+                        const double *xyt, int nn, struct bal_scene *sc, struct bal_sim **sim,
+                        struct bal_error *err)
+{
+    if (load_config(path, n, c, nonlinear, sc, sim, err))
+        return 1;
+    if ((*sim)->n != nn) {
+        snprintf(err->msg, sizeof err->msg, "the packing has %d discs, the scene %d", nn,
+                 (*sim)->n);
         return 1;
     }
-    long settle = 0;
-    for (int g = 0; g + 1 < ref_sc.n_stages; g++) {
-        bal_sim_set_stage(ref, g);
-        for (long c = 0; c < ref_sc.stages[g].cycles; c++, settle++)
-            if (bal_sim_cycle(ref, &err)) {
-                fprintf(stderr, "bench: settling: %s\n", err.msg);
-                return 1;
-            }
+    struct bal_sim *s = *sim;
+    for (int k = 0; k < nn; k++) {
+        const int to = s->slot[k];
+        s->x[to] = xyt[3 * (size_t)k];
+        s->y[to] = xyt[3 * (size_t)k + 1];
+        s->th[to] = xyt[3 * (size_t)k + 2];
+        s->vx[to] = s->vy[to] = s->w[to] = 0;
     }
-    while (bal_measure_kinetic(ref) > SETTLED_EK_OVER_EE * bal_measure_elastic(ref) &&
-           settle < (MAX_SETTLE_BLOCKS + 1) * ref_sc.stages[0].cycles)
-        for (long c = 0; c < ref_sc.stages[0].cycles; c++, settle++)
-            if (bal_sim_cycle(ref, &err)) {
-                fprintf(stderr, "bench: settling: %s\n", err.msg);
-                return 1;
-            }
-    printf("# module costs: N=%d packing settled for %ld cycles (frictionless, global damping) "
-           "(E_k/E_el = %.2g); each configuration starts from it at rest\n",
-           ref->n, settle, bal_measure_kinetic(ref) / bal_measure_elastic(ref));
+    s->need_rebuild = 1;
+    s->dt *= 1e-4;
+    bal_sim_set_stage(s, sc->n_stages - 1);
+    return 0;
+}
+
+static long count_contacts(const struct bal_sim *sim)
+{
+    long contacts = 0;
+    for (long q = 0; q < sim->pp.n; q++)
+        contacts += (sim->pp.flags[q] & BAL_PAIR_TOUCHING) != 0;
+    return contacts;
+}
+
+#ifdef BAL_BARE
+#define BUILD_NAME "bare"
+#else
+#define BUILD_NAME "normal"
+#endif
+
+static int modules_bench(const char *path, long n, int base_only)
+{
+    double *xyt = NULL;
+    int nn = 0;
+    if (settle_packing(path, n, &xyt, &nn))
+        return 1;
+    struct bal_error err = {0};
     const size_t n_cfg = base_only ? 1 : sizeof module_configs / sizeof module_configs[0];
     for (size_t k = 0; k < n_cfg; k++) {
         if (getenv("BAL_BENCH_ONLY") && (int)k != atoi(getenv("BAL_BENCH_ONLY")))
@@ -366,22 +464,13 @@ static int modules_bench(const char *path, long n, int base_only)
         const struct module_config *c = &module_configs[k];
         struct bal_scene sc;
         struct bal_sim *sim = NULL;
-        if (load_config(path, n, c, k == 4, &sc, &sim, &err) || sim->n != ref->n) {
+        if (start_config(path, n, c, k == 4, xyt, nn, &sc, &sim, &err)) {
             fprintf(stderr, "bench: %s\n", err.msg);
             bal_sim_free(sim);
             bal_scene_free(&sc);
+            free(xyt);
             return 1;
         }
-        for (int i = 0; i < ref->n; i++) {
-            const int to = sim->slot[ref->id[i]];
-            sim->x[to] = ref->x[i];
-            sim->y[to] = ref->y[i];
-            sim->th[to] = ref->th[i];
-            sim->vx[to] = sim->vy[to] = sim->w[to] = 0;
-        }
-        sim->need_rebuild = 1;
-        sim->dt = ref->dt * 1e-4;
-        bal_sim_set_stage(sim, sc.n_stages - 1);
         long steps = 50;
         double t = timed_steps(sim, steps, &err);
         if (t > 0)
@@ -395,28 +484,328 @@ static int modules_bench(const char *path, long n, int base_only)
             fprintf(stderr, "bench: %s: %s\n", c->name, err.msg);
             bal_sim_free(sim);
             bal_scene_free(&sc);
+            free(xyt);
             return 1;
         }
         qsort(rate, REPEATS, sizeof rate[0], cmp_double);
-        long contacts = 0;
-        for (long q = 0; q < sim->pp.n; q++)
-            contacts += (sim->pp.flags[q] & BAL_PAIR_TOUCHING) != 0;
         printf("bench module build=%s config=\"%s\" N=%d particle_steps_per_s=%.4g min=%.4g "
                "max=%.4g contacts=%ld rebuilds=%ld\n",
-#ifdef BAL_BARE
-               "bare",
-#else
-               "full",
-#endif
-               c->name, sim->n, rate[REPEATS / 2], rate[0], rate[REPEATS - 1], contacts,
-               sim->rebuilds);
+               BUILD_NAME, c->name, sim->n, rate[REPEATS / 2], rate[0], rate[REPEATS - 1],
+               count_contacts(sim), sim->rebuilds);
         fflush(stdout);
         bal_sim_free(sim);
         bal_scene_free(&sc);
     }
-    bal_sim_free(ref);
-    bal_scene_free(&ref_sc);
+    free(xyt);
     return 0;
+}
+
+/* ------------------------------------------------------------------ */
+/* The all-off scene, counted and timed: `make bench-modules-count`     */
+/* ------------------------------------------------------------------ */
+
+/* Wall-clock repeats of one build spread by ±25 % on a shared VM, so the
+ * normal and the bare build are compared by what does not depend on the
+ * machine's load: the instructions of the timed cycles, counted by
+ * callgrind.  bench --modules-step brackets its timed cycles with
+ * callgrind's client requests (no-ops outside valgrind): run under
+ *   valgrind --tool=callgrind --instr-atstart=no --collect-atstart=no
+ * only those cycles are counted, after warm-up cycles that fill the
+ * simulated caches; the packing comes from a file (--modules-pack), so
+ * nothing is settled under valgrind. */
+#if defined(__has_include)
+#if __has_include(<valgrind/callgrind.h>)
+#include <valgrind/callgrind.h>
+#define HAVE_CALLGRIND 1
+#endif
+#endif
+#ifndef HAVE_CALLGRIND
+#define CALLGRIND_START_INSTRUMENTATION
+#define CALLGRIND_STOP_INSTRUMENTATION
+#define CALLGRIND_TOGGLE_COLLECT
+#endif
+
+#define WARMUP_STEPS 20 /* the first cycle rebuilds the pair list */
+#define MAX_STEP_REPEATS 64
+
+/* FNV-1a over the bits of every disc's position, rotation and velocities in
+ * scene order: the two builds did the same arithmetic if these agree. */
+static unsigned long long state_checksum(const struct bal_sim *s)
+{
+    unsigned long long h = 1469598103934665603ULL;
+    for (int k = 0; k < s->n; k++) {
+        const int i = s->slot[k];
+        const double v[6] = {s->x[i], s->y[i], s->th[i], s->vx[i], s->vy[i], s->w[i]};
+        const unsigned char *b = (const unsigned char *)v;
+        for (size_t q = 0; q < sizeof v; q++)
+            h = (h ^ b[q]) * 1099511628211ULL;
+    }
+    return h;
+}
+
+/* The all-off configuration from the packing in `pack`: WARMUP_STEPS
+ * cycles, then `repeats` timed runs of `steps` cycles.  One line:
+ *   bench count build=B N= steps= repeats= particle_steps= contacts= pairs=
+ *       rebuilds= timed_rebuilds= checksum= times=t1,t2,...
+ * (particle_steps counts every timed cycle, times are seconds per run). */
+static int modules_step(const char *path, const char *pack, long steps, int repeats)
+{
+    double *xyt = NULL;
+    int nn = 0;
+    if (steps < 1 || repeats < 1 || repeats > MAX_STEP_REPEATS) {
+        fprintf(stderr, "bench: --modules-step: steps >= 1, 1 <= repeats <= %d\n",
+                MAX_STEP_REPEATS);
+        return 2;
+    }
+    if (read_packing(pack, &xyt, &nn))
+        return 1;
+    struct bal_scene sc;
+    struct bal_sim *sim = NULL;
+    struct bal_error err = {0};
+    double t[MAX_STEP_REPEATS];
+    long rebuilds0 = 0;
+    int rc = start_config(path, nn, &module_configs[0], 0, xyt, nn, &sc, &sim, &err);
+    if (rc == 0) {
+        CALLGRIND_START_INSTRUMENTATION;
+        rc = timed_steps(sim, WARMUP_STEPS, &err) < 0;
+        rebuilds0 = sim->rebuilds;
+        CALLGRIND_TOGGLE_COLLECT;
+        for (int r = 0; r < repeats && rc == 0; r++)
+            rc = (t[r] = timed_steps(sim, steps, &err)) < 0;
+        CALLGRIND_TOGGLE_COLLECT;
+        CALLGRIND_STOP_INSTRUMENTATION;
+    }
+    if (rc) {
+        fprintf(stderr, "bench: %s\n", err.msg);
+    } else {
+        printf("bench count build=%s N=%d steps=%ld repeats=%d particle_steps=%.0f contacts=%ld "
+               "pairs=%ld rebuilds=%ld timed_rebuilds=%ld checksum=%016llx times=",
+               BUILD_NAME, sim->n, steps, repeats, (double)steps * repeats * sim->n,
+               count_contacts(sim), sim->pp.n, sim->rebuilds, sim->rebuilds - rebuilds0,
+               state_checksum(sim));
+        for (int r = 0; r < repeats; r++)
+            printf("%s%.6g", r ? "," : "", t[r]);
+        printf("\n");
+    }
+    bal_sim_free(sim);
+    bal_scene_free(&sc);
+    free(xyt);
+    return rc;
+}
+
+/* One `bench count` line, parsed. */
+struct count_line {
+    char build[16];
+    int n;
+    long steps;
+    int repeats;
+    double particle_steps;
+    long contacts, pairs, rebuilds, timed_rebuilds;
+    char checksum[24];
+    double times[MAX_STEP_REPEATS];
+};
+
+static const char *field(const char *line, const char *key)
+{
+    const size_t len = strlen(key);
+    for (const char *p = strstr(line, key); p; p = strstr(p + 1, key))
+        if ((p == line || p[-1] == ' ') && p[len] == '=')
+            return p + len + 1;
+    return NULL;
+}
+
+static int parse_count_line(const char *line, struct count_line *c)
+{
+    const char *f[10] = {field(line, "build"),    field(line, "N"),
+                         field(line, "steps"),    field(line, "repeats"),
+                         field(line, "particle_steps"), field(line, "contacts"),
+                         field(line, "pairs"),    field(line, "rebuilds"),
+                         field(line, "timed_rebuilds"), field(line, "checksum")};
+    const char *times = field(line, "times");
+    if (strncmp(line, "bench count ", 12) != 0 || !times)
+        return 1;
+    for (int k = 0; k < 10; k++)
+        if (!f[k])
+            return 1;
+    if (sscanf(f[0], "%15s", c->build) != 1 || sscanf(f[9], "%23s", c->checksum) != 1)
+        return 1;
+    c->n = atoi(f[1]);
+    c->steps = atol(f[2]);
+    c->repeats = atoi(f[3]);
+    c->particle_steps = atof(f[4]);
+    c->contacts = atol(f[5]);
+    c->pairs = atol(f[6]);
+    c->rebuilds = atol(f[7]);
+    c->timed_rebuilds = atol(f[8]);
+    if (c->repeats < 1 || c->repeats > MAX_STEP_REPEATS || c->n < 1 || c->steps < 1)
+        return 1;
+    for (int r = 0; r < c->repeats; r++) {
+        char *end;
+        c->times[r] = strtod(times, &end);
+        if (end == times || c->times[r] <= 0)
+            return 1;
+        times = *end == ',' ? end + 1 : end;
+    }
+    return 0;
+}
+
+/* The event totals of a callgrind output file (its `events:` line and its
+ * `totals:` line, or `summary:` without one); returns the number of events,
+ * 0 on failure. */
+#define MAX_EVENTS 16
+static int read_callgrind(const char *file, char names[][8], double *totals)
+{
+    char line[1024];
+    int n_names = 0, n_totals = 0;
+    FILE *f = fopen(file, "r");
+    while (f && fgets(line, sizeof line, f)) {
+        char *save = NULL;
+        if (strncmp(line, "events:", 7) == 0)
+            for (char *w = strtok_r(line + 7, " \n", &save); w && n_names < MAX_EVENTS;
+                 w = strtok_r(NULL, " \n", &save))
+                snprintf(names[n_names++], 8, "%s", w);
+        else if (strncmp(line, "totals:", 7) == 0 ||
+                 (strncmp(line, "summary:", 8) == 0 && n_totals == 0)) {
+            n_totals = 0; /* totals: wins over summary: */
+            for (char *w = strtok_r(strchr(line, ':') + 1, " \n", &save); w && n_totals < MAX_EVENTS;
+                 w = strtok_r(NULL, " \n", &save))
+                totals[n_totals++] = atof(w);
+        }
+    }
+    if (f)
+        fclose(f);
+    if (n_names == 0 || n_totals != n_names) {
+        fprintf(stderr, "bench: %s: no callgrind event totals\n", file);
+        return 0;
+    }
+    return n_names;
+}
+
+static double event(char names[][8], const double *totals, int n, const char *name)
+{
+    for (int k = 0; k < n; k++)
+        if (strcmp(names[k], name) == 0)
+            return totals[k];
+    return NAN;
+}
+
+static int read_count_file(const char *file, struct count_line *lines, int max)
+{
+    char line[4096];
+    int n = 0;
+    FILE *f = fopen(file, "r");
+    if (!f) {
+        fprintf(stderr, "bench: %s: cannot read\n", file);
+        return -1;
+    }
+    while (n < max && fgets(line, sizeof line, f))
+        if (parse_count_line(line, &lines[n]) == 0)
+            n++;
+    fclose(f);
+    return n;
+}
+
+static int same_work(const struct count_line *a, const struct count_line *b)
+{
+    return a->n == b->n && a->steps == b->steps && a->repeats == b->repeats &&
+           a->contacts == b->contacts && a->pairs == b->pairs && a->rebuilds == b->rebuilds &&
+           a->timed_rebuilds == b->timed_rebuilds && strcmp(a->checksum, b->checksum) == 0;
+}
+
+#define MAX_PAIRS 64
+#define WITHIN 0.03 /* "within a few percent": the bound this summary judges by */
+
+/* The summary of bench-modules-count: instructions (and simulated cache
+ * misses) per particle-step of each build from callgrind, then the pinned
+ * wall-clock pairs.  Arguments: the callgrind output and the count line of
+ * the normal build, the same of the bare build, the file of alternating
+ * wall-clock lines (normal, bare, normal, ...). */
+static int modules_summary(char **arg)
+{
+    static const char *const build[2] = {"normal", "bare"};
+    static const char *const shown[] = {"Ir", "D1mr", "D1mw", "DLmr", "DLmw"};
+    char names[2][MAX_EVENTS][8];
+    double tot[2][MAX_EVENTS];
+    struct count_line cg[2];
+    double per[2][5];
+    for (int b = 0; b < 2; b++) {
+        const int ne = read_callgrind(arg[2 * b], names[b], tot[b]);
+        if (ne == 0)
+            return 1;
+        if (read_count_file(arg[2 * b + 1], &cg[b], 1) != 1 || strcmp(cg[b].build, build[b]) != 0) {
+            fprintf(stderr, "bench: no %s-build count in %s\n", build[b], arg[2 * b + 1]);
+            return 1;
+        }
+        for (int e = 0; e < 5; e++)
+            per[b][e] = event(names[b], tot[b], ne, shown[e]) / cg[b].particle_steps;
+    }
+    const int same = same_work(&cg[0], &cg[1]);
+    printf("# callgrind, timed cycles only: N=%d, %ld cycles after %d warm-up, %ld contacts, "
+           "%ld rebuilds in the timed cycles; same work in both builds (contacts, rebuilds, "
+           "checksum %s): %s\n",
+           cg[0].n, cg[0].steps * cg[0].repeats, WARMUP_STEPS, cg[0].contacts,
+           cg[0].timed_rebuilds, cg[0].checksum, same ? "yes" : "NO");
+    printf("%-28s %12s %12s %10s\n", "per particle-step", "normal", "bare", "normal/bare");
+    for (int e = 0; e < 5; e++) {
+        printf("%-28s %12.3f %12.3f", shown[e], per[0][e], per[1][e]);
+        if (per[1][e] > 0)
+            printf(" %10.4f\n", per[0][e] / per[1][e]);
+        else
+            printf(" %10s\n", per[0][e] > 0 ? "inf" : "-");
+    }
+    const double ir_ratio = per[0][0] / per[1][0];
+    printf("bench count instructions normal/bare=%.4f within_%.0f%%=%s\n", ir_ratio, 100 * WITHIN,
+           fabs(ir_ratio - 1) <= WITHIN ? "yes" : "NO");
+
+    struct count_line *wall = malloc(2 * MAX_PAIRS * sizeof *wall);
+    const int nw = wall ? read_count_file(arg[4], wall, 2 * MAX_PAIRS) : -1;
+    if (nw < 2) {
+        fprintf(stderr, "bench: %s: no wall-clock pairs\n", arg[4]);
+        free(wall);
+        return 1;
+    }
+    const int pairs = nw / 2;
+    double all[2][MAX_PAIRS * MAX_STEP_REPEATS], ratio[MAX_PAIRS];
+    int n_all[2] = {0, 0}, ok = 1;
+    for (int p = 0; p < pairs; p++) {
+        double best[2];
+        for (int b = 0; b < 2; b++) {
+            const struct count_line *c = &wall[2 * p + b];
+            ok = ok && strcmp(c->build, build[b]) == 0 && same_work(c, &wall[0]);
+            best[b] = INFINITY;
+            for (int r = 0; r < c->repeats; r++) {
+                all[b][n_all[b]++] = c->times[r];
+                best[b] = fmin(best[b], c->times[r]);
+            }
+        }
+        ratio[p] = best[0] / best[1];
+    }
+    if (!ok)
+        printf("# WARNING: the wall-clock runs are not alternating normal/bare, or did different "
+               "work\n");
+    const double ps = (double)wall[0].n * (double)wall[0].steps; /* per run */
+    printf("# wall clock, pinned to one core: %d alternating pairs of processes, each %d runs of "
+           "%ld cycles (N=%d); particle-steps/s over all %d runs of a build:\n",
+           pairs, wall[0].repeats, wall[0].steps, wall[0].n, n_all[0]);
+    printf("%-28s %12s %12s %10s\n", "", "normal", "bare", "bare/normal");
+    double best[2], median[2];
+    for (int b = 0; b < 2; b++) {
+        qsort(all[b], (size_t)n_all[b], sizeof all[b][0], cmp_double);
+        best[b] = ps / all[b][0];
+        median[b] = ps / all[b][n_all[b] / 2];
+    }
+    printf("%-28s %12.4g %12.4g %10.4f\n", "best (least disturbed)", best[0], best[1],
+           best[1] / best[0]);
+    printf("%-28s %12.4g %12.4g %10.4f\n", "median", median[0], median[1], median[1] / median[0]);
+    qsort(ratio, (size_t)pairs, sizeof ratio[0], cmp_double);
+    printf("# per pair, time of the normal build / time of the bare build (best run of each "
+           "process): median %.4f, quartiles %.4f %.4f, range %.4f .. %.4f\n",
+           ratio[pairs / 2], ratio[pairs / 4], ratio[(3 * pairs) / 4], ratio[0], ratio[pairs - 1]);
+    const double wall_ratio = best[1] / best[0];
+    printf("bench count wall_min normal/bare=%.4f within_%.0f%%=%s\n", wall_ratio, 100 * WITHIN,
+           fabs(wall_ratio - 1) <= WITHIN ? "yes" : "NO");
+    free(wall);
+    return !same || !ok;
 }
 
 int main(int argc, char **argv)
@@ -433,6 +822,18 @@ int main(int argc, char **argv)
         return modules_bench(argv[2], argc > 3 ? atol(argv[3]) : 20000, 0);
     if (strcmp(argv[1], "--modules-base") == 0 && argc >= 3)
         return modules_bench(argv[2], argc > 3 ? atol(argv[3]) : 20000, 1);
+    if (strcmp(argv[1], "--modules-pack") == 0 && argc == 5) {
+        double *xyt = NULL;
+        int nn = 0;
+        int rc = settle_packing(argv[2], atol(argv[3]), &xyt, &nn) ||
+                 write_packing(argv[4], xyt, nn);
+        free(xyt);
+        return rc;
+    }
+    if (strcmp(argv[1], "--modules-step") == 0 && argc == 6)
+        return modules_step(argv[2], argv[3], atol(argv[4]), atoi(argv[5]));
+    if (strcmp(argv[1], "--modules-summary") == 0 && argc == 7)
+        return modules_summary(argv + 2);
     if (strcmp(argv[1], "--settling") == 0 && argc >= 3) {
         /* The same packing timed while it falls from the lattice (settle
          * stage cut to one cycle): flow, frequent rebuilds and re-sorts. */

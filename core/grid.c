@@ -192,11 +192,12 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
     } else {
         struct bal_grid *g = &s->grid;
         double x0 = s->x[0], x1 = s->x[0], y0 = s->y[0], y1 = s->y[0];
-        for (int i = 1; i < n; i++) {
-            x0 = fmin(x0, s->x[i]);
-            x1 = fmax(x1, s->x[i]);
-            y0 = fmin(y0, s->y[i]);
-            y1 = fmax(y1, s->y[i]);
+        for (int i = 1; i < n; i++) { /* comparisons: fmin/fmax are libm calls */
+            const double xi = s->x[i], yi = s->y[i];
+            x0 = xi < x0 ? xi : x0;
+            x1 = xi > x1 ? xi : x1;
+            y0 = yi < y0 ? yi : y0;
+            y1 = yi > y1 ? yi : y1;
         }
         if (!(isfinite(x0) && isfinite(x1) && isfinite(y0) && isfinite(y1)))
             return bal_error(err, BAL_EUNSTABLE,

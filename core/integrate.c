@@ -75,11 +75,13 @@
 #include "sim.h"
 
 /* The two largest squared displacements since the last rebuild, kept in
- * the position loops (branch-free, so the loops still vectorise): m1 >= m2. */
+ * the position loops: m1 >= m2.  Written as comparisons (min/max
+ * instructions), not fmin/fmax, which are calls into libm here. */
 static inline void track_moves(double d2, double *m1, double *m2)
 {
-    *m2 = fmax(*m2, fmin(*m1, d2));
-    *m1 = fmax(*m1, d2);
+    const double lo = d2 < *m1 ? d2 : *m1;
+    *m2 = lo > *m2 ? lo : *m2;
+    *m1 = d2 > *m1 ? d2 : *m1;
 }
 
 static inline double moved_sq(const struct bal_sim *s, int i)

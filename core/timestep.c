@@ -268,8 +268,10 @@ static int coordination(double R, double r, double *lambda)
         double sum = 0;
         for (int j = -n; j <= n; j++) {
             const double phi = off + 2 * a * j;
-            if (fabs(phi) <= 0.5 * BAL_PI)
-                sum += cos(phi) * cos(phi);
+            if (fabs(phi) <= 0.5 * BAL_PI) {
+                const double c = cos(phi);
+                sum += c * c;
+            }
         }
         best = fmax(best, sum);
     }
@@ -358,13 +360,21 @@ static int start_contacts(const struct bal_sim *s, struct dt_list *l)
     return status;
 }
 
+/* The coordination of a disc: N and the bound on λ_max(Σ n nᵀ), from
+ * coordination(); computed once per disc, not once per weight γ (about
+ * 8 000 cosines each). */
+struct dt_coord {
+    int n;
+    double lambda;
+};
+
 /* The coordination bound of free disc i (see the header), with the
  * rotational weight γ. */
-static double coordination_omega2(const struct bal_sim *s, int i, double r_min, double inv_m_max,
-                                  double gamma, double *beta)
+static double coordination_omega2(const struct bal_sim *s, int i, struct dt_coord co,
+                                  double inv_m_max, double gamma, double *beta)
 {
-    double lambda;
-    int n = coordination(s->r[i], r_min, &lambda);
+    double lambda = co.lambda;
+    int n = co.n;
     /* ... and no more contacts than the scene has other bodies (two discs
      * colliding: one partner, so the bound is that of one spring) */
     const int others = s->n - 1 + s->n_walls;
@@ -539,6 +549,7 @@ void bal_timestep_detail(const struct bal_sim *s, struct bal_dt_detail *d)
     d->spectral = 0;
     struct dt_list list = {0, 0, NULL};
     struct dt_acc *acc = calloc((size_t)(s->n ? s->n : 1), sizeof *acc);
+    struct dt_coord *co = calloc((size_t)(s->n ? s->n : 1), sizeof *co); /* n = 0: not yet */
     const int found = acc ? start_contacts(s, &list) : -1;
     if (found == 0)
         d->contacts = list.n;
@@ -579,7 +590,14 @@ void bal_timestep_detail(const struct bal_sim *s, struct bal_dt_detail *d)
                 beta_net = fmax(beta_net, beta);
                 p = &pn;
             } else {
-                w2 = coordination_omega2(s, i, r_min, inv_m_max, gamma, &beta);
+                if (co && co[i].n == 0)
+                    co[i].n = coordination(s->r[i], r_min, &co[i].lambda);
+                struct dt_coord ci = {0, 0};
+                if (co)
+                    ci = co[i];
+                else
+                    ci.n = coordination(s->r[i], r_min, &ci.lambda);
+                w2 = coordination_omega2(s, i, ci, inv_m_max, gamma, &beta);
                 n_coord++;
                 p = &pc;
             }
@@ -610,6 +628,7 @@ void bal_timestep_detail(const struct bal_sim *s, struct bal_dt_detail *d)
     d->binding_disc = use->binding;
     d->coordination_discs = n_coord;
     free(acc);
+    free(co);
     free(list.c);
     /* Every disc held: nothing moves; keep the single-spring value so that
      * dt_fraction still means something. */

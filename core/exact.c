@@ -751,22 +751,11 @@ enum bal_status bal_exact_solve(const struct bal_sim *s, struct bal_exact *out,
     if (st)
         goto fail;
 
-    /* Unknowns: (x, y) of the free discs in row-major cell order — the
-     * array order of a scene up to 2 BAL_STRIP_CELLS cells wide; a wider
-     * one is stored in strips (grid.c), whose neighbours a strip apart
-     * would widen the band. */
+    /* Unknowns: (x, y) of the free discs in array order. */
     int ok = 1;
     const size_t nc = (size_t)w.nc;
     w.unknown = alloc_array((size_t)s->n, sizeof *w.unknown, &ok);
     w.free_slot = alloc_array((size_t)s->n, sizeof *w.free_slot, &ok);
-    int32_t *order = alloc_array((size_t)s->n, sizeof *order, &ok);
-    struct bal_cell_key *keys = alloc_array((size_t)s->n, sizeof *keys, &ok);
-    if (ok && s->use_grid)
-        bal_grid_cell_order(s->x, s->y, s->n, 2 * s->r_max + s->skin, 0, keys, order);
-    else
-        for (int i = 0; ok && i < s->n; i++)
-            order[i] = i;
-    free(keys);
     w.ui = alloc_array(nc, sizeof *w.ui, &ok);
     w.uj = alloc_array(nc, sizeof *w.uj, &ok);
     w.closed = alloc_array(nc, sizeof *w.closed, &ok);
@@ -776,13 +765,11 @@ enum bal_status bal_exact_solve(const struct bal_sim *s, struct bal_exact *out,
     w.events = alloc_array(nc, sizeof *w.events, &ok);
     w.seen = alloc_array(MAX_ITERATIONS + 1, sizeof *w.seen, &ok);
     if (!ok) {
-        free(order);
         st = bal_error(err, BAL_ENOMEM, "%s: exact solver: out of memory", scene_path(s));
         goto fail;
     }
     double wmax = 0, wsum = 0;
-    for (int k = 0; k < s->n; k++) {
-        const int i = order[k];
+    for (int i = 0; i < s->n; i++) {
         if (s->fixed[i]) {
             w.unknown[i] = -1;
             continue;
@@ -795,7 +782,6 @@ enum bal_status bal_exact_solve(const struct bal_sim *s, struct bal_exact *out,
         wmax = fmax(wmax, hypot(gx, gy));
         wsum += hypot(gx, gy);
     }
-    free(order);
     w.nu = 2 * (size_t)w.nf;
     w.p = w.nu > 1 ? 1 : 0;
     for (long c = 0; c < w.nc; c++) {

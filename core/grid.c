@@ -354,28 +354,18 @@ static long cell_coord(double d, double h)
     return c < 1e9 ? (long)c : 1000000000L;
 }
 
-void bal_grid_cell_order(const double *x, const double *y, int n, double h, long strip,
+void bal_grid_cell_order(const double *x, const double *y, int n, double h,
                          struct bal_cell_key *keys, int32_t *order)
 {
-    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY;
     for (int i = 0; i < n; i++) {
         x0 = fmin(x0, x[i]);
         y0 = fmin(y0, y[i]);
         x1 = fmax(x1, x[i]);
-        y1 = fmax(y1, y[i]);
     }
-    const long nx = cell_coord(x1 - x0, h) + 1, ny = cell_coord(y1 - y0, h) + 1;
-    if (strip > 0 && nx > 2 * strip) {
-        /* strip number, then row, then column within the strip (< 1e18) */
-        for (int i = 0; i < n; i++) {
-            const long cx = cell_coord(x[i] - x0, h), cy = cell_coord(y[i] - y0, h);
-            keys[i] = (struct bal_cell_key){((cx / strip) * ny + cy) * strip + cx % strip, i};
-        }
-    } else {
-        for (int i = 0; i < n; i++)
-            keys[i] = (struct bal_cell_key){cell_coord(y[i] - y0, h) * nx + cell_coord(x[i] - x0, h),
-                                            i};
-    }
+    const long nx = cell_coord(x1 - x0, h) + 1;
+    for (int i = 0; i < n; i++)
+        keys[i] = (struct bal_cell_key){cell_coord(y[i] - y0, h) * nx + cell_coord(x[i] - x0, h), i};
     qsort(keys, (size_t)n, sizeof *keys, cell_key_cmp);
     for (int i = 0; i < n; i++)
         order[i] = keys[i].slot;
@@ -421,7 +411,7 @@ enum bal_status bal_grid_reorder(struct bal_sim *s, struct bal_error *err)
             s->rs.col = c;
             s->rs.col_cap = need;
         }
-        bal_grid_cell_order(s->x, s->y, n, 2 * s->r_max + s->skin, BAL_STRIP_CELLS,
+        bal_grid_cell_order(s->x, s->y, n, 2 * s->r_max + s->skin,
                             (struct bal_cell_key *)s->rs.col, s->new2old);
 
         double *columns[] = {s->x, s->y, s->th, s->vx, s->vy, s->w, s->r, s->inv_m,

@@ -530,7 +530,7 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
             bal_sim_free(s);
             return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
         }
-        bal_grid_cell_order(d.x, d.y, n, 2 * s->r_max + s->skin, BAL_STRIP_CELLS, keys, s->id);
+        bal_grid_cell_order(d.x, d.y, n, 2 * s->r_max + s->skin, keys, s->id);
         free(keys);
     } else {
         for (int i = 0; i < n; i++)

@@ -290,21 +290,11 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err);
  * history found through the permutation). */
 enum bal_status bal_grid_reorder(struct bal_sim *s, struct bal_error *err);
 void bal_grid_scratch_free(struct bal_rebuild_scratch *rs);
-/* The permutation that puts discs in order of cells of side h
+/* The permutation that puts discs in row-major order of cells of side h
  * (order[new] = old); ties keep their order, so it is deterministic.
- * `keys` is scratch of n entries.  strip = 0: row-major.  strip > 0 and
- * more than 2 strip cells in a row: vertical strips of `strip` cells, each
- * row-major, left to right — so a disc's neighbours in the row above are at
- * most a strip's row away in memory, not a whole row of the scene. */
-void bal_grid_cell_order(const double *x, const double *y, int n, double h, long strip,
+ * `keys` is scratch of n entries. */
+void bal_grid_cell_order(const double *x, const double *y, int n, double h,
                          struct bal_cell_key *keys, int32_t *order);
-/* Width of those strips, in cells.  A dense packing was as fast as it gets
- * up to about 150 cells a row (20 000 discs: a row of cells and its
- * neighbours, ~300 discs x ~280 bytes, sit in the 1 MB L2 of the machine
- * measured); wider rows slowed the pair loop down by up to ~50 %
- * (320 000 discs), when the row above no longer stayed in cache between
- * its visits as neighbour and as disc. */
-#define BAL_STRIP_CELLS 128
 /* Rebuilds between two re-sorts: the order decays only as discs flow, and a
  * re-sort costs about as much as a few rebuilds. */
 #define BAL_REORDER_EVERY 20

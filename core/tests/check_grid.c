@@ -265,52 +265,6 @@ START_TEST(grid_head_on_contact_not_missed)
 }
 END_TEST
 
-/* bal_grid_cell_order on a lattice of cell centres, nx columns by 3 rows,
- * handed over in a scrambled order: row-major when the rows are narrow (or
- * strip = 0), strips of `strip` columns when a row is wider than 2 strips. */
-static int lattice_order_ok(int nx, long strip, int expect_strips)
-{
-    const int n = 3 * nx;
-    double *x = malloc((size_t)n * sizeof *x), *y = malloc((size_t)n * sizeof *y);
-    struct bal_cell_key *keys = malloc((size_t)n * sizeof *keys);
-    int32_t *order = malloc((size_t)n * sizeof *order);
-    int ok = x && y && keys && order;
-    for (int k = 0; ok && k < n; k++) {
-        const int q = (int)(((long)k * 7919) % n); /* 7919 is prime: a permutation */
-        x[q] = 0.5 + k % nx;
-        y[q] = 0.5 + k / nx;
-    }
-    if (ok)
-        bal_grid_cell_order(x, y, n, 1.0, strip, keys, order);
-    for (int k = 0; ok && k < n; k++) {
-        int cx, cy;
-        if (expect_strips) {
-            const int per = 3 * (int)strip, st = k / per, in = k % per;
-            cy = in / (int)strip;
-            cx = st * (int)strip + in % (int)strip;
-        } else {
-            cy = k / nx;
-            cx = k % nx;
-        }
-        ok = x[order[k]] == 0.5 + cx && y[order[k]] == 0.5 + cy;
-    }
-    free(x);
-    free(y);
-    free(keys);
-    free(order);
-    return ok;
-}
-
-START_TEST(grid_cell_order_strips)
-{
-    ck_assert(lattice_order_ok(200, 0, 0));
-    ck_assert(lattice_order_ok(200, 128, 0)); /* 200 <= 256 columns: row-major */
-    ck_assert(lattice_order_ok(640, 128, 1)); /* 5 strips of 128 */
-    ck_assert(lattice_order_ok(640, 0, 0));
-    ck_assert(lattice_order_ok(96, 32, 1));
-}
-END_TEST
-
 /* bal_pairs_merge_history on hand-made lists: keys present in the old
  * list keep their history, new keys start from zero. */
 START_TEST(grid_merge_history)
@@ -540,7 +494,6 @@ Suite *suite_grid(void)
     tcase_add_test(tc, grid_candidates_sparse_scene);
     tcase_add_test(tc, grid_rebuild_when_skin_used_up);
     tcase_add_test(tc, grid_head_on_contact_not_missed);
-    tcase_add_test(tc, grid_cell_order_strips);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("history");

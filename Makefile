@@ -31,7 +31,7 @@ TEST_SRC := $(wildcard core/tests/check_*.c)
 BENCH_SRC := core/bench/bench.c
 
 .PHONY: all deps test test-c test-prefix test-py test-sanitize validate bench bench-scaling \
-        bench-peer bench-modules bench-modules-count clean keys sweep test-valgrind
+        bench-peer bench-modules bench-modules-count bench-scaling-count clean keys sweep test-valgrind
 
 all: deps bin/ballast
 
@@ -179,6 +179,24 @@ bench-peer: deps bin/ballast
 # Particle-steps per second from 1 000 to 1 000 000 discs (about 40 minutes).
 bench-scaling: deps $(BUILD)/bench
 	$(BUILD)/bench cases/bench/dense.scene 1000 5000 20000 80000 320000 1000000
+
+# Why the rate falls with N, in figures the machine's load does not change: per
+# particle-step of the timed cycles of the all-off packing (read from a file),
+# instructions and simulated misses of a 48 KB D1 and a 32 MB last level (this VM's
+# L1d and L3), for SCALING_COUNT_N (about 15 minutes, most of it settling the packs).
+SCALING_COUNT_N ?= 5000 20000 80000 320000
+CALLGRIND_L3 := valgrind --tool=callgrind --instr-atstart=no --collect-atstart=no --cache-sim=yes \
+                --I1=32768,8,64 --D1=49152,12,64 --LL=33554432,16,64
+bench-scaling-count: deps $(BUILD)/bench $(foreach n,$(SCALING_COUNT_N),$(BUILD)/modules-$(n).pack)
+	@echo "N Ir D1_read_miss D1_write_miss LL_read_miss LL_write_miss (per particle-step)"
+	@for n in $(SCALING_COUNT_N); do \
+	  $(CALLGRIND_L3) --callgrind-out-file=$(BUILD)/scaling-$$n.callgrind $(BUILD)/bench $(STEP) \
+	    $(BUILD)/modules-$$n.pack 20 1 >/dev/null 2>$(BUILD)/scaling-$$n.log || exit 1; \
+	  callgrind_annotate --inclusive=no $(BUILD)/scaling-$$n.callgrind 2>/dev/null | \
+	    grep 'PROGRAM TOTALS' | sed 's/([^)]*)//g; s/,//g' | \
+	    awk -v n=$$n '{ ps = n * 20; printf "%d %.1f %.2f %.2f %.3f %.3f\n", n, $$1 / ps, \
+	      $$5 / ps, $$6 / ps, $$8 / ps, $$9 / ps }'; \
+	done
 
 keys: bin/ballast
 	bin/ballast keys

@@ -147,8 +147,9 @@ WALL_RUNS   ?= 5
 WALL_CPU    ?= 1
 # Fixed simulated caches (this VM's L1s; the 512 MB L3 it reports is not a real one), so
 # the counts do not depend on the machine.
-CALLGRIND   := valgrind --tool=callgrind --instr-atstart=no --collect-atstart=no --cache-sim=yes \
-               --I1=32768,8,64 --D1=49152,12,64 --LL=8388608,16,64
+CALLGRIND_CACHES := valgrind --tool=callgrind --instr-atstart=no --collect-atstart=no \
+                    --cache-sim=yes --I1=32768,8,64 --D1=49152,12,64
+CALLGRIND   := $(CALLGRIND_CACHES) --LL=8388608,16,64
 STEP        := --modules-step cases/bench/dense.scene
 
 $(BUILD)/modules-%.pack: $(BUILD)/bench cases/bench/dense.scene
@@ -185,8 +186,7 @@ bench-scaling: deps $(BUILD)/bench
 # instructions and simulated misses of a 48 KB D1 and a 32 MB last level (this VM's
 # L1d and L3), for SCALING_COUNT_N (about 15 minutes, most of it settling the packs).
 SCALING_COUNT_N ?= 5000 20000 80000 320000
-CALLGRIND_L3 := valgrind --tool=callgrind --instr-atstart=no --collect-atstart=no --cache-sim=yes \
-                --I1=32768,8,64 --D1=49152,12,64 --LL=33554432,16,64
+CALLGRIND_L3 := $(CALLGRIND_CACHES) --LL=33554432,16,64
 bench-scaling-count: deps $(BUILD)/bench $(foreach n,$(SCALING_COUNT_N),$(BUILD)/modules-$(n).pack)
 	@echo "N Ir D1_read_miss D1_write_miss LL_read_miss LL_write_miss (per particle-step)"
 	@for n in $(SCALING_COUNT_N); do \

@@ -112,8 +112,8 @@ static void moved(struct bal_sim *s, double m1, double m2)
         s->need_rebuild = 1;
 }
 
-/* The two largest squared displacements, in a pass of their own (gear5,
- * whose position update runs coordinate by coordinate). */
+/* The two largest squared displacements, in a pass of their own (verlet and
+ * gear5; centred keeps them in its position loop). */
 static void moved_scan(struct bal_sim *s)
 {
     double m1 = 0, m2 = 0;

@@ -10,11 +10,12 @@
  * so contact keys built from indices are stable too.
  *
  * Contacts.  Two flat candidate lists, disc–disc and disc–wall, each sorted
- * by key = (lo << 32) | hi (pair_key(); not stored: it is i and j).  A candidate carries the contact's history
- * (F_n for the incremental law, F_s) in parallel arrays; a candidate whose
- * bodies do not overlap has zero history.  When the neighbour list is
- * rebuilt, the new candidate list is merged with the old one in one linear
- * pass, so history survives rebuilds (contacts.c).
+ * by key = (lo << 32) | hi (pair_key(); not stored: it is i and j).  A
+ * candidate carries the contact's history (F_n for the incremental law,
+ * F_s) in parallel arrays; a candidate whose bodies do not overlap has zero
+ * history.  When the neighbour list is rebuilt, the new candidate list is
+ * merged with the old one in one linear pass, so history survives rebuilds
+ * (contacts.c).
  */
 #ifndef BAL_SIM_H
 #define BAL_SIM_H

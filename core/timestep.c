@@ -163,7 +163,6 @@ static int list_add(struct dt_list *l, int a, int b, int wall_mat, double nx, do
     return 0;
 }
 
-/* The normal stiffness of a pair at δ = δ0 and its damping per stiffness. */
 /* The normal stiffness of a pair.  For the power law, dF/dδ = ν k_n (δ/δ0)^(ν−1):
  * taken at δ = δ0 unless the scene's energy bounds the overlap.  In a scene
  * that nothing feeds (no gravity, no moving wall, no overlap at the start)
@@ -590,13 +589,14 @@ void bal_timestep_detail(const struct bal_sim *s, struct bal_dt_detail *d)
                 beta_net = fmax(beta_net, beta);
                 p = &pn;
             } else {
-                if (co && co[i].n == 0)
-                    co[i].n = coordination(s->r[i], r_min, &co[i].lambda);
-                struct dt_coord ci = {0, 0};
-                if (co)
+                struct dt_coord ci;
+                if (co && co[i].n > 0) {
                     ci = co[i];
-                else
+                } else {
                     ci.n = coordination(s->r[i], r_min, &ci.lambda);
+                    if (co)
+                        co[i] = ci;
+                }
                 w2 = coordination_omega2(s, i, ci, inv_m_max, gamma, &beta);
                 n_coord++;
                 p = &pc;

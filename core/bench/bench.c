@@ -102,6 +102,15 @@ static int load_scene(const char *path, long n, const char *const *sets, int max
     return ok ? 0 : 1;
 }
 
+/* Disc–disc contacts now (touching candidates). */
+static long count_contacts(const struct bal_sim *sim)
+{
+    long contacts = 0;
+    for (long q = 0; q < sim->pp.n; q++)
+        contacts += (sim->pp.flags[q] & BAL_PAIR_TOUCHING) != 0;
+    return contacts;
+}
+
 static int run_one(const char *path, long n, FILE *csv, struct options *o)
 {
     struct bal_scene sc;
@@ -164,9 +173,7 @@ static int run_one(const char *path, long n, FILE *csv, struct options *o)
     }
     qsort(rate, REPEATS, sizeof rate[0], cmp_double);
 
-    long touching = 0;
-    for (long c = 0; c < sim->pp.n; c++)
-        touching += 2 * ((sim->pp.flags[c] & BAL_PAIR_TOUCHING) != 0);
+    long touching = 2 * count_contacts(sim);
     for (long c = 0; c < sim->pw.n; c++)
         touching += (sim->pw.flags[c] & BAL_PAIR_TOUCHING) != 0;
     const double z = (double)touching / (double)sim->n;
@@ -186,9 +193,7 @@ static int run_one(const char *path, long n, FILE *csv, struct options *o)
     if (!o->quiet) {
         struct rusage ru;
         getrusage(RUSAGE_SELF, &ru);
-        long contacts = 0;
-        for (long c = 0; c < sim->pp.n; c++)
-            contacts += (sim->pp.flags[c] & BAL_PAIR_TOUCHING) != 0;
+        const long contacts = count_contacts(sim);
         const double rss = 1024.0 * (double)ru.ru_maxrss;
         double disc_bytes, pair_bytes;
         bal_sim_memory(sim, &disc_bytes, &pair_bytes);
@@ -434,14 +439,6 @@ static int start_config(const char *path, long n, const struct module_config *c,
     s->dt *= 1e-4;
     bal_sim_set_stage(s, sc->n_stages - 1);
     return 0;
-}
-
-static long count_contacts(const struct bal_sim *sim)
-{
-    long contacts = 0;
-    for (long q = 0; q < sim->pp.n; q++)
-        contacts += (sim->pp.flags[q] & BAL_PAIR_TOUCHING) != 0;
-    return contacts;
 }
 
 #ifdef BAL_BARE

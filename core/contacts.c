@@ -152,6 +152,30 @@ static inline double viscous(const struct bal_sim *s, double delta)
     return s->gamma_n * pow(delta / s->delta0, s->psi);
 }
 
+/* Zero the force sums of discs from..to (inclusive). */
+static inline __attribute__((always_inline)) void
+clear_sums(double *restrict fx, double *restrict fy, double *restrict tq, float *restrict dfx,
+           float *restrict dfy, float *restrict dtq, int from, int to, const int damp)
+{
+    for (int k = from; k <= to; k++) {
+        fx[k] = 0;
+        fy[k] = 0;
+        tq[k] = 0;
+        if (damp) {
+            dfx[k] = 0;
+            dfy[k] = 0;
+            dtq[k] = 0;
+        }
+    }
+}
+
+/* The loop starts the cycle's force sums: a disc's are zeroed just before
+ * its first contribution (pairs are sorted by i, and j > i, so the
+ * highest j seen so far bounds the discs touched), the rest at the end.
+ * The sums' lines are fetched once, by the loop that fills them, not also
+ * by a clearing pass of their own: in a packing larger than the cache that
+ * pass cost a trip to memory per line.  The order of the additions is
+ * unchanged. */
 static inline __attribute__((always_inline)) void
 pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int damp)
 {
@@ -173,8 +197,13 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
     float *restrict dfx = s->dash_fx, *restrict dfy = s->dash_fy, *restrict dtq = s->dash_tq;
     int over = 0;
 
+    int cleared = -1; /* the sums of discs 0..cleared are started */
     for (long c = 0; c < p->n; c++) {
         const int i = p->i[c], j = p->j[c];
+        if (j > cleared) {
+            clear_sums(fx, fy, tq, dfx, dfy, dtq, cleared + 1, j, damp);
+            cleared = j;
+        }
         const double dx = x[j] - x[i], dy = y[j] - y[i];
         const double rs = r[i] + r[j];
         const double d2 = dx * dx + dy * dy;
@@ -253,6 +282,7 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
             }
         }
     }
+    clear_sums(fx, fy, tq, dfx, dfy, dtq, cleared + 1, s->n - 1, damp);
     if (shear)
         s->audit.d_friction += lost_fric;
     s->over_budget |= over;

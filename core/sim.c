@@ -673,15 +673,8 @@ enum bal_status bal_sim_cycle(struct bal_sim *s, struct bal_error *err)
     }
     t0 = seconds_now();
     s->timers.neighbours += t0 - t1;
-    /* 3. contacts: the force–displacement law at t_N */
-    memset(s->fx, 0, (size_t)s->n * sizeof *s->fx);
-    memset(s->fy, 0, (size_t)s->n * sizeof *s->fy);
-    memset(s->tq, 0, (size_t)s->n * sizeof *s->tq);
-    if (s->dash_fx) {
-        memset(s->dash_fx, 0, (size_t)s->n * sizeof *s->dash_fx);
-        memset(s->dash_fy, 0, (size_t)s->n * sizeof *s->dash_fy);
-        memset(s->dash_tq, 0, (size_t)s->n * sizeof *s->dash_tq);
-    }
+    /* 3. contacts: the force–displacement law at t_N (the pair loop starts
+     * the force sums from zero, then the walls add theirs) */
     s->pair_loop(s);
     t1 = seconds_now();
     s->timers.contacts += t1 - t0;

@@ -175,19 +175,47 @@ static void centred_previous(const struct bal_sim *s, int i, double *vx, double 
     *w = (s->w[i] * (1 + half) - aw) / (1 - half);
 }
 
-/* The velocity update (bal_kick_disc, sim.h), and in the same pass the two
- * sums the energy audit needs at t_N — in registers here, where a pass of
- * their own would recover v_{N-1/2} from the force sums again.  Compiled
- * in four variants, as the pair loops.  When the pair loop does the update
- * itself (s->fused, contacts.c) this pass is not run. */
+/* The velocity update, and in the same pass the two sums the energy audit
+ * needs at t_N, v_N = (v_{N-1/2} + v_{N+1/2})/2 (energy.c): with global
+ * damping Σ (m v_N² + I ω_N²), with dashpots Σ (F^D·v_N + M^D ω_N) — both
+ * in registers here, where a pass of their own would recover v_{N-1/2} from
+ * the force sums again.  Compiled in four variants, as the pair loops. */
 static inline __attribute__((always_inline)) void
 centred_update(struct bal_sim *s, const int damped, const int dashpots)
 {
-    struct bal_kick k;
-    bal_kick_begin(s, &k);
-    for (int i = 0; i < s->n; i++)
-        bal_kick_disc(s, &k, i, damped, dashpots);
-    bal_kick_end(s, &k);
+    const int n = s->n;
+    const double dt = s->dt;
+    const double half = s->alpha * dt / 2;
+    const double keep = 1 - half, scale = 1 / (1 + half);
+    const double gxdt = s->g[0] * s->gfac * dt, gydt = s->g[1] * s->gfac * dt;
+    double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
+    const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict tq = s->tq;
+    const double *restrict im = s->inv_m, *restrict ii = s->inv_i;
+    const float *restrict dfx = s->dash_fx, *restrict dfy = s->dash_fy, *restrict dtq = s->dash_tq;
+    const uint8_t *restrict fixed = s->fixed;
+    double glob = 0, dash = 0;
+    for (int i = 0; i < n; i++) {
+        if (fixed[i])
+            continue;
+        const double ox = vx[i], oy = vy[i], ow = w[i];
+        if (damped) {
+            vx[i] = (ox * keep + fx[i] * im[i] * dt + gxdt) * scale;
+            vy[i] = (oy * keep + fy[i] * im[i] * dt + gydt) * scale;
+            w[i] = (ow * keep + tq[i] * ii[i] * dt) * scale;
+        } else {
+            vx[i] = ox + (fx[i] * im[i] * dt + gxdt);
+            vy[i] = oy + (fy[i] * im[i] * dt + gydt);
+            w[i] = ow + tq[i] * ii[i] * dt;
+        }
+        /* twice v_N */
+        const double cx = ox + vx[i], cy = oy + vy[i], cw = ow + w[i];
+        if (damped)
+            glob += (cx * cx + cy * cy) / im[i] + cw * cw / ii[i];
+        if (dashpots)
+            dash += (double)dfx[i] * cx + (double)dfy[i] * cy + (double)dtq[i] * cw;
+    }
+    s->audit.glob_sum = 0.25 * glob;
+    s->audit.dash_sum = 0.5 * dash;
 }
 
 static void centred_velocities(struct bal_sim *s)

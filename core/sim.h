@@ -256,59 +256,6 @@ struct bal_sim {
     double wall_seconds;
 };
 
-/* The centred integrator's velocity update of one disc (C&S eqs 22–23a,
- * 35–36; integrate.c) and its terms of the two sums the energy audit needs
- * at t_N, v_N = (v_{N-1/2} + v_{N+1/2})/2 (energy.c): with global damping
- * Σ (m v_N² + I ω_N²), with dashpots Σ (F^D·v_N + M^D ω_N).  One
- * expression for the velocity pass (integrate.c) and for the pair loop
- * that updates each disc as soon as its force sums are complete
- * (contacts.c), so the two give the same bits. */
-struct bal_kick {
-    double dt, keep, scale, gxdt, gydt;
-    int damped;                  /* α > 0 */
-    double glob, dash;           /* the sums, over the discs updated so far */
-};
-
-static inline void bal_kick_begin(const struct bal_sim *s, struct bal_kick *k)
-{
-    const double dt = s->dt, half = s->alpha * dt / 2;
-    *k = (struct bal_kick){dt, 1 - half, 1 / (1 + half), s->g[0] * s->gfac * dt,
-                           s->g[1] * s->gfac * dt, s->alpha != 0, 0, 0};
-}
-
-static inline __attribute__((always_inline)) void
-bal_kick_disc(struct bal_sim *restrict s, struct bal_kick *restrict k, int i, const int damped,
-              const int dashpots)
-{
-    if (s->fixed[i])
-        return;
-    double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
-    const double *restrict im = s->inv_m, *restrict ii = s->inv_i;
-    const double ox = vx[i], oy = vy[i], ow = w[i], dt = k->dt;
-    if (damped) {
-        vx[i] = (ox * k->keep + s->fx[i] * im[i] * dt + k->gxdt) * k->scale;
-        vy[i] = (oy * k->keep + s->fy[i] * im[i] * dt + k->gydt) * k->scale;
-        w[i] = (ow * k->keep + s->tq[i] * ii[i] * dt) * k->scale;
-    } else {
-        vx[i] = ox + (s->fx[i] * im[i] * dt + k->gxdt);
-        vy[i] = oy + (s->fy[i] * im[i] * dt + k->gydt);
-        w[i] = ow + s->tq[i] * ii[i] * dt;
-    }
-    /* twice v_N */
-    const double cx = ox + vx[i], cy = oy + vy[i], cw = ow + w[i];
-    if (damped)
-        k->glob += (cx * cx + cy * cy) / im[i] + cw * cw / ii[i];
-    if (dashpots)
-        k->dash += (double)s->dash_fx[i] * cx + (double)s->dash_fy[i] * cy +
-                   (double)s->dash_tq[i] * cw;
-}
-
-static inline void bal_kick_end(struct bal_sim *s, const struct bal_kick *k)
-{
-    s->audit.glob_sum = 0.25 * k->glob;
-    s->audit.dash_sum = 0.5 * k->dash;
-}
-
 /* Mass and moment of inertia of disc i: the same expressions as at creation
  * (m = density π r², I = m r²/2), so they are bitwise the stored values of
  * old; storing them would cost 16 bytes a disc. */

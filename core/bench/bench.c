@@ -17,6 +17,8 @@
  *        bench --grid SCENE       (all pairs against the cell grid, small N:
  *                                  where BAL_GRID_CROSSOVER comes from)
  *        bench --settling SCENE [N]  (the packing timed while it falls)
+ *        bench --pair SCENE NA NB [ROUNDS]  (flat scaling in one process: timed
+ *                                  runs alternate between the two packings)
  *        bench --pile PILE_SCENE  (the L0 = 100 pile relaxed, 5 whole runs)
  *        bench --modules SCENE [N]       (what each optional module costs, one
  *                                         simulation per configuration from
@@ -111,26 +113,44 @@ static long count_contacts(const struct bal_sim *sim)
     return contacts;
 }
 
-static int run_one(const char *path, long n, FILE *csv, struct options *o)
-{
+/* A benchmark simulation made ready for timing: settled (unless the
+ * options say flowing), in its last stage, timers zeroed, step count of a
+ * timed run calibrated to o->seconds. */
+struct prepared {
     struct bal_scene sc;
+    struct bal_sim *sim;
+    long settled;            /* cycles run before timing */
+    double ek_ee;            /* E_k/E_el when the timing started */
+    long steps;              /* cycles per timed run */
+    long rebuilds0, reorders0;
+};
+
+static void prepared_free(struct prepared *p)
+{
+    bal_sim_free(p->sim);
+    bal_scene_free(&p->sc);
+    p->sim = NULL;
+}
+
+static int prepare(const char *path, long n, const struct options *o, struct prepared *p)
+{
     struct bal_error err = {0};
-    struct bal_sim *sim = NULL;
     const char *const sets[] = {o->extra, o->extra2};
-    if (load_scene(path, n, sets, 2, &sc, &sim, &err)) {
+    memset(p, 0, sizeof *p);
+    if (load_scene(path, n, sets, 2, &p->sc, &p->sim, &err)) {
         fprintf(stderr, "bench: %s\n", err.msg);
-        bal_scene_free(&sc);
+        prepared_free(p);
         return 1;
     }
-
+    struct bal_sim *sim = p->sim;
+    const struct bal_scene *sc = &p->sc;
     /* Settle: every stage but the last, untimed. */
-    for (int g = 0; g + 1 < sc.n_stages; g++) {
+    for (int g = 0; g + 1 < sc->n_stages; g++) {
         bal_sim_set_stage(sim, g);
-        for (long c = 0; c < sc.stages[g].cycles; c++)
+        for (long c = 0; c < sc->stages[g].cycles; c++, p->settled++)
             if (bal_sim_cycle(sim, &err)) {
                 fprintf(stderr, "bench: settling: %s\n", err.msg);
-                bal_sim_free(sim);
-                bal_scene_free(&sc);
+                prepared_free(p);
                 return 1;
             }
     }
@@ -140,37 +160,82 @@ static int run_one(const char *path, long n, FILE *csv, struct options *o)
      * so in the output). */
     long extra = 0;
     while (!o->flowing && bal_measure_kinetic(sim) > SETTLED_EK_OVER_EE * bal_measure_elastic(sim) &&
-           extra < MAX_SETTLE_BLOCKS * sc.stages[0].cycles) {
-        for (long c = 0; c < sc.stages[0].cycles; c++, extra++)
+           extra < MAX_SETTLE_BLOCKS * sc->stages[0].cycles) {
+        for (long c = 0; c < sc->stages[0].cycles; c++, extra++, p->settled++)
             if (bal_sim_cycle(sim, &err)) {
                 fprintf(stderr, "bench: settling: %s\n", err.msg);
-                bal_sim_free(sim);
-                bal_scene_free(&sc);
+                prepared_free(p);
                 return 1;
             }
     }
-    const double ek_ee = bal_measure_kinetic(sim) / bal_measure_elastic(sim);
-    bal_sim_set_stage(sim, sc.n_stages - 1);
-    /* The timers printed below cover the timed cycles only. */
-    const long rebuilds0 = sim->rebuilds, reorders0 = sim->reorders;
-    memset(&sim->timers, 0, sizeof sim->timers);
+    p->ek_ee = bal_measure_kinetic(sim) / bal_measure_elastic(sim);
+    bal_sim_set_stage(sim, sc->n_stages - 1);
 
-    /* Calibrate the step count, then time the repeats. */
-    long steps = 50;
-    double t = timed_steps(sim, steps, &err);
+    /* Calibrate the step count. */
+    p->steps = 50;
+    const double t = timed_steps(sim, p->steps, &err);
+    if (t < 0) {
+        fprintf(stderr, "bench: %s\n", err.msg);
+        prepared_free(p);
+        return 1;
+    }
     if (t > 0)
-        steps = (long)fmax(100, o->seconds / (t / (double)steps));
+        p->steps = (long)fmax(100, o->seconds / (t / (double)p->steps));
+    /* The timers printed cover the timed cycles only. */
+    p->rebuilds0 = sim->rebuilds;
+    p->reorders0 = sim->reorders;
+    memset(&sim->timers, 0, sizeof sim->timers);
+    return 0;
+}
+
+/* One timed run: particle-steps per second, or -1. */
+static double timed_run(struct prepared *p)
+{
+    struct bal_error err = {0};
+    const double t = timed_steps(p->sim, p->steps, &err);
+    if (t < 0) {
+        fprintf(stderr, "bench: %s\n", err.msg);
+        return -1;
+    }
+    return (double)p->steps * (double)p->sim->n / t;
+}
+
+/* The memory and profile lines of a prepared simulation (the peak RSS is
+ * the process's: with two simulations, both). */
+static void report_details(const struct prepared *p)
+{
+    const struct bal_sim *sim = p->sim;
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    const long contacts = count_contacts(sim);
+    const double rss = 1024.0 * (double)ru.ru_maxrss;
+    double disc_bytes, pair_bytes;
+    bal_sim_memory(sim, &disc_bytes, &pair_bytes);
+    printf("# N=%d memory: held while stepping %.0f bytes/disc (%.0f per disc + %.0f for its "
+           "pairs, %.1f bytes per contact); peak RSS %.1f MB = %.0f bytes/disc\n",
+           sim->n, (disc_bytes + pair_bytes) / sim->n, disc_bytes / sim->n, pair_bytes / sim->n,
+           pair_bytes / (double)(contacts > 0 ? contacts : 1), rss / 1e6, rss / sim->n);
+    const struct bal_timers *t = &sim->timers;
+    printf("# N=%d %ld candidate pairs (%.2f per disc), %ld contacts; timed cycles: "
+           "positions %.2f neighbours %.2f contacts %.2f walls %.2f velocities %.2f s, "
+           "%ld rebuilds, %ld re-sorts\n",
+           sim->n, sim->pp.n, (double)sim->pp.n / sim->n, contacts, t->positions, t->neighbours,
+           t->contacts, t->walls, t->velocities,
+           sim->rebuilds - p->rebuilds0, sim->reorders - p->reorders0);
+}
+
+static int run_one(const char *path, long n, FILE *csv, struct options *o)
+{
+    struct prepared p;
+    if (prepare(path, n, o, &p))
+        return 1;
+    struct bal_sim *sim = p.sim;
     double rate[REPEATS];
-    for (int k = 0; k < REPEATS; k++) {
-        t = timed_steps(sim, steps, &err);
-        if (t < 0) {
-            fprintf(stderr, "bench: %s\n", err.msg);
-            bal_sim_free(sim);
-            bal_scene_free(&sc);
+    for (int k = 0; k < REPEATS; k++)
+        if ((rate[k] = timed_run(&p)) < 0) {
+            prepared_free(&p);
             return 1;
         }
-        rate[k] = (double)steps * (double)sim->n / t;
-    }
     qsort(rate, REPEATS, sizeof rate[0], cmp_double);
 
     long touching = 2 * count_contacts(sim);
@@ -178,40 +243,68 @@ static int run_one(const char *path, long n, FILE *csv, struct options *o)
         touching += (sim->pw.flags[c] & BAL_PAIR_TOUCHING) != 0;
     const double z = (double)touching / (double)sim->n;
     o->median = rate[REPEATS / 2];
-    if (!o->quiet)
+    if (!o->quiet) {
         printf("# N=%d settled for %ld cycles: E_k/E_el = %.2g, %ld rebuilds so far\n", sim->n,
-               sc.stages[0].cycles + extra, ek_ee, sim->rebuilds);
-    if (!o->quiet)
+               p.settled, p.ek_ee, p.rebuilds0);
         printf("bench %s N=%d steps=%ld particle_steps_per_s=%.4g min=%.4g max=%.4g "
-           "contacts_per_disc=%.3f\n",
-           o->flowing ? "settling" : "dense", sim->n, steps, rate[REPEATS / 2], rate[0],
-           rate[REPEATS - 1], z);
+               "contacts_per_disc=%.3f\n",
+               o->flowing ? "settling" : "dense", sim->n, p.steps, rate[REPEATS / 2], rate[0],
+               rate[REPEATS - 1], z);
+    }
     fflush(stdout);
     if (csv)
-        fprintf(csv, "%ld,%d,%ld,%.6g,%.6g,%.6g,%.4f,%ld\n", (long)time(NULL), sim->n, steps,
+        fprintf(csv, "%ld,%d,%ld,%.6g,%.6g,%.6g,%.4f,%ld\n", (long)time(NULL), sim->n, p.steps,
                 rate[REPEATS / 2], rate[0], rate[REPEATS - 1], z, sim->rebuilds);
-    if (!o->quiet) {
-        struct rusage ru;
-        getrusage(RUSAGE_SELF, &ru);
-        const long contacts = count_contacts(sim);
-        const double rss = 1024.0 * (double)ru.ru_maxrss;
-        double disc_bytes, pair_bytes;
-        bal_sim_memory(sim, &disc_bytes, &pair_bytes);
-        printf("# N=%d memory: held while stepping %.0f bytes/disc (%.0f per disc + %.0f for its "
-               "pairs, %.1f bytes per contact); peak RSS %.1f MB = %.0f bytes/disc\n",
-               sim->n, (disc_bytes + pair_bytes) / sim->n, disc_bytes / sim->n,
-               pair_bytes / sim->n, pair_bytes / (double)(contacts > 0 ? contacts : 1), rss / 1e6,
-               rss / sim->n);
-        printf("# N=%d %ld candidate pairs (%.2f per disc), %ld contacts; timed cycles: "
-               "positions %.2f neighbours %.2f contacts %.2f walls %.2f velocities %.2f s, "
-               "%ld rebuilds, %ld re-sorts\n",
-               sim->n, sim->pp.n, (double)sim->pp.n / sim->n, contacts, sim->timers.positions,
-               sim->timers.neighbours, sim->timers.contacts, sim->timers.walls,
-               sim->timers.velocities, sim->rebuilds - rebuilds0, sim->reorders - reorders0);
-    }
-    bal_sim_free(sim);
-    bal_scene_free(&sc);
+    if (!o->quiet)
+        report_details(&p);
+    prepared_free(&p);
     return 0;
+}
+
+/* Flat scaling, judged in one process: the packings of N_A and N_B discs
+ * are settled, then timed runs alternate between them, `rounds` times, so
+ * that this VM's drift (10-40 % over hours) falls on both alike.  Prints
+ * each one's median, min and max, and the median of the per-round ratios
+ * B/A. */
+static int scaling_pair(const char *path, long na, long nb, int rounds)
+{
+    enum { MAX_ROUNDS = 64 };
+    if (rounds < 1 || rounds > MAX_ROUNDS) {
+        fprintf(stderr, "bench: --pair: 1 <= rounds <= %d\n", MAX_ROUNDS);
+        return 2;
+    }
+    struct options o = {NULL, NULL, 0, TARGET_SECONDS, 0, 0};
+    struct prepared p[2];
+    if (prepare(path, na, &o, &p[0]))
+        return 1;
+    if (prepare(path, nb, &o, &p[1])) {
+        prepared_free(&p[0]);
+        return 1;
+    }
+    double rate[2][MAX_ROUNDS], ratio[MAX_ROUNDS];
+    int rc = 0;
+    for (int r = 0; r < rounds && rc == 0; r++) {
+        for (int k = 0; k < 2 && rc == 0; k++)
+            rc = (rate[k][r] = timed_run(&p[k])) < 0;
+        if (rc == 0)
+            ratio[r] = rate[1][r] / rate[0][r];
+    }
+    if (rc == 0) {
+        qsort(ratio, (size_t)rounds, sizeof ratio[0], cmp_double);
+        for (int k = 0; k < 2; k++) {
+            qsort(rate[k], (size_t)rounds, sizeof rate[k][0], cmp_double);
+            printf("# N=%d settled for %ld cycles: E_k/E_el = %.2g\n", p[k].sim->n, p[k].settled,
+                   p[k].ek_ee);
+            printf("bench pair N=%d steps=%ld particle_steps_per_s=%.4g min=%.4g max=%.4g\n",
+                   p[k].sim->n, p[k].steps, rate[k][rounds / 2], rate[k][0], rate[k][rounds - 1]);
+            report_details(&p[k]);
+        }
+        printf("bench pair ratio N=%d/N=%d median=%.3f min=%.3f max=%.3f rounds=%d\n",
+               p[1].sim->n, p[0].sim->n, ratio[rounds / 2], ratio[0], ratio[rounds - 1], rounds);
+    }
+    prepared_free(&p[0]);
+    prepared_free(&p[1]);
+    return rc;
 }
 
 static FILE *open_csv(void)
@@ -829,6 +922,8 @@ int main(int argc, char **argv)
     }
     if (strcmp(argv[1], "--modules-step") == 0 && argc == 6)
         return modules_step(argv[2], argv[3], atol(argv[4]), atoi(argv[5]));
+    if (strcmp(argv[1], "--pair") == 0 && (argc == 5 || argc == 6))
+        return scaling_pair(argv[2], atol(argv[3]), atol(argv[4]), argc == 6 ? atoi(argv[5]) : 9);
     if (strcmp(argv[1], "--modules-summary") == 0 && argc == 7)
         return modules_summary(argv + 2);
     if (strcmp(argv[1], "--settling") == 0 && argc >= 3) {

@@ -868,6 +868,60 @@ START_TEST(contacts_psi_removes_force_jump)
 }
 END_TEST
 
+/* Every cycle starts the force sums from zero: the pair loop zeroes each
+ * disc's just before its first contribution and the rest at its end
+ * (contacts.c).  Sums poisoned with NaN before a cycle must come out as the
+ * law's force for the discs in contact (power law, ν = 1: F = k_n δ at
+ * rest, no dashpot force) and exactly zero for the discs without any — one
+ * before the first pair in memory, one between the pairs, one after the
+ * last (the discs lie along x, so their cell order is their x order). */
+START_TEST(contacts_sums_restart_each_cycle)
+{
+    const double kn = 2.3e4;
+    struct tfx *f = tfx_newf(
+        "restart",
+        "[settings]\ndt = 1e-4\ngrid = on\nbeta = 0.1\nnormal_law = power\nnu = 1\ndelta0 = 1\n"
+        "[material m]\nkn = %.17g\nks = 1e4\nfriction = 0.5\ndensity = 1\n"
+        "[disc a]\nx = 0 0\nr = 0.5\nmaterial = m\n"
+        "[disc p]\nx = 10 0\nr = 0.5\nmaterial = m\n"
+        "[disc q]\nx = 10.95 0\nr = 0.5\nmaterial = m\n"
+        "[disc b]\nx = 20 0\nr = 0.5\nmaterial = m\n"
+        "[disc u]\nx = 30 0\nr = 0.5\nmaterial = m\n"
+        "[disc v]\nx = 30.9 0\nr = 0.5\nmaterial = m\n"
+        "[disc c]\nx = 40 0\nr = 0.5\nmaterial = m\n[stage s]\ncycles = 1\n",
+        kn);
+    struct bal_sim *s = f->sim;
+    ck_assert_int_eq(s->use_grid, 1);
+    ck_assert_ptr_nonnull(s->dash_fx);
+    for (int i = 0; i < s->n; i++) {
+        s->fx[i] = s->fy[i] = s->tq[i] = NAN;
+        s->dash_fx[i] = s->dash_fy[i] = s->dash_tq[i] = NAN;
+    }
+    t_steps(f, 1);
+    const char *const apart[] = {"a", "b", "c"};
+    for (int k = 0; k < 3; k++) {
+        const int i = t_slot(f, apart[k]);
+        ck_assert_msg(s->fx[i] == 0 && s->fy[i] == 0 && s->tq[i] == 0, "disc %s: sums not zero",
+                      apart[k]);
+        ck_assert(s->dash_fx[i] == 0 && s->dash_fy[i] == 0 && s->dash_tq[i] == 0);
+    }
+    ck_assert_int_lt(t_slot(f, "a"), t_slot(f, "p")); /* before, between, after the pairs */
+    ck_assert_int_gt(t_slot(f, "b"), t_slot(f, "q"));
+    ck_assert_int_lt(t_slot(f, "b"), t_slot(f, "u"));
+    ck_assert_int_gt(t_slot(f, "c"), t_slot(f, "v"));
+    const char *const left[] = {"p", "u"}, *const right[] = {"q", "v"};
+    const double gap[] = {0.95, 0.9};
+    for (int k = 0; k < 2; k++) {
+        const int i = t_slot(f, left[k]), j = t_slot(f, right[k]);
+        const double fn = kn * (1.0 - gap[k]);
+        ASSERT_REL(s->fx[i], -fn);
+        ASSERT_REL(s->fx[j], fn);
+        ck_assert(s->fy[i] == 0 && s->fy[j] == 0 && s->tq[i] == 0 && s->tq[j] == 0);
+        ck_assert(s->dash_fx[i] == 0 && s->dash_fx[j] == 0);
+    }
+}
+END_TEST
+
 Suite *suite_contacts(void)
 {
     Suite *s = suite_create("contacts");
@@ -879,6 +933,7 @@ Suite *suite_contacts(void)
     tcase_add_test(tc, contacts_rotation_term);
     tcase_add_test(tc, contacts_pair_stiffness);
     tcase_add_test(tc, contacts_no_tension_and_reset);
+    tcase_add_test(tc, contacts_sums_restart_each_cycle);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("friction");

@@ -152,6 +152,9 @@ static inline double viscous(const struct bal_sim *s, double delta)
     return s->gamma_n * pow(delta / s->delta0, s->psi);
 }
 
+/* Candidates per chunk of the pair loop (below). */
+#define CLEAR_CHUNK 256
+
 /* Zero the force sums of discs from..to (inclusive). */
 static inline __attribute__((always_inline)) void
 clear_sums(double *restrict fx, double *restrict fy, double *restrict tq, float *restrict dfx,
@@ -169,13 +172,17 @@ clear_sums(double *restrict fx, double *restrict fy, double *restrict tq, float 
     }
 }
 
-/* The loop starts the cycle's force sums: a disc's are zeroed just before
- * its first contribution (pairs are sorted by i, and j > i, so the
- * highest j seen so far bounds the discs touched), the rest at the end.
- * The sums' lines are fetched once, by the loop that fills them, not also
- * by a clearing pass of their own: in a packing larger than the cache that
- * pass cost a trip to memory per line.  The order of the additions is
- * unchanged. */
+/* The loop starts the cycle's force sums.  It runs in chunks of
+ * CLEAR_CHUNK candidates; before a chunk, the sums of every disc up to the
+ * chunk's highest j are zeroed (pairs are sorted by i and j > i, so no disc
+ * above the highest j seen has been touched yet), the rest at the end.  The
+ * sums' lines are then fetched once, by the loop that fills them, and not
+ * also by a clearing pass of their own, which in a packing larger than the
+ * cache cost a trip to memory per line.  The order of the additions is
+ * unchanged.  (Clearing inside the per-pair loop, at each new highest j,
+ * made the 20 000-disc benchmark 25 % slower: the compiler turns the
+ * clearing into memset calls, and a call in the loop costs the loop its
+ * registers.) */
 static inline __attribute__((always_inline)) void
 pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int damp)
 {
@@ -198,87 +205,93 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
     int over = 0;
 
     int cleared = -1; /* the sums of discs 0..cleared are started */
-    for (long c = 0; c < p->n; c++) {
-        const int i = p->i[c], j = p->j[c];
-        if (j > cleared) {
-            clear_sums(fx, fy, tq, dfx, dfy, dtq, cleared + 1, j, damp);
-            cleared = j;
+    for (long c0 = 0; c0 < p->n; c0 += CLEAR_CHUNK) {
+        const long c1 = c0 + CLEAR_CHUNK < p->n ? c0 + CLEAR_CHUNK : p->n;
+        int top = cleared;
+        for (long c = c0; c < c1; c++)
+            top = p->j[c] > top ? p->j[c] : top;
+        if (top > cleared) {
+            clear_sums(fx, fy, tq, dfx, dfy, dtq, cleared + 1, top, damp);
+            cleared = top;
         }
-        const double dx = x[j] - x[i], dy = y[j] - y[i];
-        const double rs = r[i] + r[j];
-        const double d2 = dx * dx + dy * dy;
-        if (d2 >= rs * rs) {
-            /* Not in contact (eq. 8): history is reset. */
-            p->fn[c] = 0;
-            p->flags[c] = 0;
-            if (shear)
-                p->fs[c] = 0;
-            continue;
-        }
-        const struct bal_pair_law *L = &laws[mat[i] * n_mat + mat[j]];
-        const double dist = sqrt(d2);
-        const double ex = dx / dist, ey = dy / dist;
-        const double rvx = vx[i] - vx[j], rvy = vy[i] - vy[j];
-        const double ndot = rvx * ex + rvy * ey;
-        const double delta = rs - dist;
-        over |= delta > budget; /* a first sieve; bal_energy_overlap judges each pair */
-
-        double fn;
-        if (law == BAL_NORMAL_INCREMENTAL) {
-            fn = p->fn[c] + L->kn * ndot * dt;
-            if (fn < 0)
-                fn = 0;
-        } else {
-            fn = power_force(L->kn, delta, delta0, nu);
-        }
-        p->fn[c] = fn;
-        double ftn = fn, fts = 0, dn = 0, ds = 0;
-        uint8_t flags = BAL_PAIR_TOUCHING;
-        if (damp) {
-            dn = (L->cn + viscous(s, delta)) * ndot;
-            ftn += dn;
-        }
-        if (shear && L->shear) {
-            const double tx = ey, ty = -ex;
-            const double sdot = rvx * tx + rvy * ty - (w[i] * r[i] + w[j] * r[j]);
-            double fs = p->fs[c] + L->ks * sdot * dt;
-            const double fmax = fn * L->tan_phi + L->cohesion;
-            if (fabs(fs) > fmax) {
-                /* The spring gives up (|F_s| - F_max)/k_s of slip against F_max. */
-                lost_fric += fmax * (fabs(fs) - fmax) / L->ks;
-                fs = copysign(fmax, fs);
-                flags |= BAL_PAIR_SLIDING;
+        for (long c = c0; c < c1; c++) {
+            const int i = p->i[c], j = p->j[c];
+            const double dx = x[j] - x[i], dy = y[j] - y[i];
+            const double rs = r[i] + r[j];
+            const double d2 = dx * dx + dy * dy;
+            if (d2 >= rs * rs) {
+                /* Not in contact (eq. 8): history is reset. */
+                p->fn[c] = 0;
+                p->flags[c] = 0;
+                if (shear)
+                    p->fs[c] = 0;
+                continue;
             }
-            p->fs[c] = fs;
-            fts = fs;
-            if (damp && !(flags & BAL_PAIR_SLIDING)) {
-                ds = L->cs * sdot;
-                fts += ds;
-            }
-        }
-        p->flags[c] = flags;
+            const struct bal_pair_law *L = &laws[mat[i] * n_mat + mat[j]];
+            const double dist = sqrt(d2);
+            const double ex = dx / dist, ey = dy / dist;
+            const double rvx = vx[i] - vx[j], rvy = vy[i] - vy[j];
+            const double ndot = rvx * ex + rvy * ey;
+            const double delta = rs - dist;
+            over |= delta > budget; /* a first sieve; bal_energy_overlap judges each pair */
 
-        /* Force on y is +(ftn e + fts t); on x the opposite (Fig. 3). */
-        const double fcx = ftn * ex + fts * ey;
-        const double fcy = ftn * ey - fts * ex;
-        fx[i] -= fcx;
-        fy[i] -= fcy;
-        fx[j] += fcx;
-        fy[j] += fcy;
-        if (shear) {
-            tq[i] += fts * r[i];
-            tq[j] += fts * r[j];
-        }
-        if (damp) {
-            /* the dashpots' share, for their work at t_N (energy.c) */
-            const float dcx = (float)(dn * ex + ds * ey), dcy = (float)(dn * ey - ds * ex);
-            dfx[i] -= dcx;
-            dfy[i] -= dcy;
-            dfx[j] += dcx;
-            dfy[j] += dcy;
+            double fn;
+            if (law == BAL_NORMAL_INCREMENTAL) {
+                fn = p->fn[c] + L->kn * ndot * dt;
+                if (fn < 0)
+                    fn = 0;
+            } else {
+                fn = power_force(L->kn, delta, delta0, nu);
+            }
+            p->fn[c] = fn;
+            double ftn = fn, fts = 0, dn = 0, ds = 0;
+            uint8_t flags = BAL_PAIR_TOUCHING;
+            if (damp) {
+                dn = (L->cn + viscous(s, delta)) * ndot;
+                ftn += dn;
+            }
+            if (shear && L->shear) {
+                const double tx = ey, ty = -ex;
+                const double sdot = rvx * tx + rvy * ty - (w[i] * r[i] + w[j] * r[j]);
+                double fs = p->fs[c] + L->ks * sdot * dt;
+                const double fmax = fn * L->tan_phi + L->cohesion;
+                if (fabs(fs) > fmax) {
+                    /* The spring gives up (|F_s| - F_max)/k_s of slip against F_max. */
+                    lost_fric += fmax * (fabs(fs) - fmax) / L->ks;
+                    fs = copysign(fmax, fs);
+                    flags |= BAL_PAIR_SLIDING;
+                }
+                p->fs[c] = fs;
+                fts = fs;
+                if (damp && !(flags & BAL_PAIR_SLIDING)) {
+                    ds = L->cs * sdot;
+                    fts += ds;
+                }
+            }
+            p->flags[c] = flags;
+
+            /* Force on y is +(ftn e + fts t); on x the opposite (Fig. 3). */
+            const double fcx = ftn * ex + fts * ey;
+            const double fcy = ftn * ey - fts * ex;
+            fx[i] -= fcx;
+            fy[i] -= fcy;
+            fx[j] += fcx;
+            fy[j] += fcy;
             if (shear) {
-                dtq[i] += (float)(ds * r[i]);
-                dtq[j] += (float)(ds * r[j]);
+                tq[i] += fts * r[i];
+                tq[j] += fts * r[j];
+            }
+            if (damp) {
+                /* the dashpots' share, for their work at t_N (energy.c) */
+                const float dcx = (float)(dn * ex + ds * ey), dcy = (float)(dn * ey - ds * ex);
+                dfx[i] -= dcx;
+                dfy[i] -= dcy;
+                dfx[j] += dcx;
+                dfy[j] += dcy;
+                if (shear) {
+                    dtq[i] += (float)(ds * r[i]);
+                    dtq[j] += (float)(ds * r[j]);
+                }
             }
         }
     }

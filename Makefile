@@ -184,10 +184,10 @@ bench-scaling: deps $(BUILD)/bench
 	$(BUILD)/bench cases/bench/dense.scene 1000 5000 20000 80000 320000 1000000
 
 # The flat-scaling target judged in one process: the 20 000- and the 1 000 000-disc
-# packings settled, then 9 rounds of timed runs alternating between them, so that
-# this VM's drift falls on both alike (about 30 minutes, most of it settling).
+# packings settled, then 15 rounds of timed runs alternating between them, so that
+# this VM's drift falls on both alike (about 35 minutes, most of it settling).
 bench-flat: deps $(BUILD)/bench
-	$(BUILD)/bench --pair cases/bench/dense.scene 20000 1000000
+	$(BUILD)/bench --pair cases/bench/dense.scene 20000 1000000 15
 
 # Why the rate falls with N, in figures the machine's load does not change: per
 # particle-step of the timed cycles of the all-off packing (read from a file),

@@ -868,8 +868,8 @@ START_TEST(contacts_psi_removes_force_jump)
 }
 END_TEST
 
-/* Every cycle starts the force sums from zero: the pair loop zeroes each
- * disc's just before its first contribution and the rest at its end
+/* Every cycle starts the force sums from zero: the pair loop zeroes them
+ * chunk by chunk, up to each chunk's highest j, and the rest at its end
  * (contacts.c).  Sums poisoned with NaN before a cycle must come out as the
  * law's force for the discs in contact (power law, ν = 1: F = k_n δ at
  * rest, no dashpot force) and exactly zero for the discs without any — one

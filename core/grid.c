@@ -250,33 +250,39 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
             g->start[c] = g->start[c - 1];
         g->start[0] = 0;
 
+        /* The three cells of a row are adjacent in `list`: one range each. */
         int32_t nb[MAX_NEIGHBOURS];
+        int any_fixed = 0;
+        for (int i = 0; i < n; i++)
+            any_fixed |= s->fixed[i];
+        const double *restrict x = s->x, *restrict y = s->y, *restrict r = s->r;
+        const double skin = s->skin;
         for (int i = 0; i < n; i++) {
-            const int ci = g->cell[i], cx = ci % nx, cy = ci / nx;
+            /* the cell of the binning above, without its two divisions */
+            int cx = (int)((x[i] - x0) * inv_h), cy = (int)((y[i] - y0) * inv_h);
+            cx = cx < nx ? cx : nx - 1;
+            cy = cy < ny ? cy : ny - 1;
+            const int xlo = cx > 0 ? cx - 1 : 0, xhi = cx + 1 < nx ? cx + 1 : nx - 1;
+            const int ylo = cy > 0 ? cy - 1 : 0, yhi = cy + 1 < ny ? cy + 1 : ny - 1;
+            const double xi = x[i], yi = y[i], ri = r[i];
             int k = 0;
-            for (int yy = cy - 1; yy <= cy + 1; yy++) {
-                if (yy < 0 || yy >= ny)
-                    continue;
-                for (int xx = cx - 1; xx <= cx + 1; xx++) {
-                    if (xx < 0 || xx >= nx)
+            for (int yy = ylo; yy <= yhi; yy++) {
+                const int a1 = g->start[yy * nx + xhi + 1];
+                for (int a = g->start[yy * nx + xlo]; a < a1; a++) {
+                    const int j = g->list[a];
+                    /* Two held discs never move: their contact is no
+                     * part of the dynamics. */
+                    if (j <= i || (any_fixed && s->fixed[i] && s->fixed[j]))
                         continue;
-                    const int c = yy * nx + xx;
-                    for (int a = g->start[c]; a < g->start[c + 1]; a++) {
-                        const int j = g->list[a];
-                        /* Two held discs never move: their contact is no
-                         * part of the dynamics. */
-                        if (j <= i || (s->fixed[i] && s->fixed[j]))
-                            continue;
-                        const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
-                        const double reach = s->r[i] + s->r[j] + s->skin;
-                        if (dx * dx + dy * dy < reach * reach) {
-                            if (k == MAX_NEIGHBOURS)
-                                return bal_error(err, BAL_EUNSTABLE,
-                                                 "neighbour grid: disc %d has more than %d "
-                                                 "neighbours at step %ld (piled up?)",
-                                                 s->id[i], MAX_NEIGHBOURS, s->step);
-                            nb[k++] = j;
-                        }
+                    const double dx = x[j] - xi, dy = y[j] - yi;
+                    const double reach = ri + r[j] + skin;
+                    if (dx * dx + dy * dy < reach * reach) {
+                        if (k == MAX_NEIGHBOURS)
+                            return bal_error(err, BAL_EUNSTABLE,
+                                             "neighbour grid: disc %d has more than %d "
+                                             "neighbours at step %ld (piled up?)",
+                                             s->id[i], MAX_NEIGHBOURS, s->step);
+                        nb[k++] = j;
                     }
                 }
             }

@@ -223,6 +223,43 @@ END_TEST
  * the gap at the rebuild just above the skin (so they are not candidates)
  * and no other disc moving.  Their first contact must be seen in the same
  * cycle as with every pair a candidate, for several skins and speeds. */
+/* Two held discs are never candidates of each other (they never move); a
+ * held and a free disc are.  Held discs touch in a row, free ones sit on
+ * them: the grid's list is the brute-force list less the held-held pairs. */
+START_TEST(grid_held_pairs_left_out)
+{
+    char text[4096];
+    int len = snprintf(text, sizeof text,
+                       "[settings]\ngrid = on\nskin = 0.2\n"
+                       "[material g]\nkn = 1e5\ndensity = 1\n");
+    for (int k = 0; k < 8; k++)
+        len += snprintf(text + len, sizeof text - (size_t)len,
+                        "[disc h%d]\nx = %d 0\nr = 0.5\nmaterial = g\nfixed = 1\n"
+                        "[disc f%d]\nx = %g 0.95\nr = 0.5\nmaterial = g\n",
+                        k, k, k, k + 0.5);
+    snprintf(text + len, sizeof text - (size_t)len, "[stage s]\ncycles = 1\n");
+    struct tfx *f = tfx_new(text, "held");
+    const struct bal_sim *s = f->sim;
+    ck_assert_int_eq(s->use_grid, 1);
+    long expect = 0, held_pairs = 0;
+    for (int i = 0; i < s->n; i++)
+        for (int j = i + 1; j < s->n; j++) {
+            const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
+            const double reach = s->r[i] + s->r[j] + 0.2;
+            if (dx * dx + dy * dy < reach * reach) {
+                if (s->fixed[i] && s->fixed[j])
+                    held_pairs++;
+                else
+                    expect++;
+            }
+        }
+    ck_assert_int_eq(held_pairs, 7);
+    ck_assert_int_eq(s->pp.n, expect);
+    for (long c = 0; c < s->pp.n; c++)
+        ck_assert(!(s->fixed[s->pp.i[c]] && s->fixed[s->pp.j[c]]));
+}
+END_TEST
+
 START_TEST(grid_head_on_contact_not_missed)
 {
     static const char *const fmt =
@@ -494,6 +531,7 @@ Suite *suite_grid(void)
     tcase_add_test(tc, grid_candidates_sparse_scene);
     tcase_add_test(tc, grid_rebuild_when_skin_used_up);
     tcase_add_test(tc, grid_head_on_contact_not_missed);
+    tcase_add_test(tc, grid_held_pairs_left_out);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("history");

@@ -219,10 +219,6 @@ START_TEST(grid_rebuild_when_skin_used_up)
 }
 END_TEST
 
-/* The tight case of d_1 + d_2: two discs flying head-on at each other, with
- * the gap at the rebuild just above the skin (so they are not candidates)
- * and no other disc moving.  Their first contact must be seen in the same
- * cycle as with every pair a candidate, for several skins and speeds. */
 /* Two held discs are never candidates of each other (they never move); a
  * held and a free disc are.  Held discs touch in a row, free ones sit on
  * them: the grid's list is the brute-force list less the held-held pairs. */
@@ -260,6 +256,10 @@ START_TEST(grid_held_pairs_left_out)
 }
 END_TEST
 
+/* The tight case of d_1 + d_2: two discs flying head-on at each other, with
+ * the gap at the rebuild just above the skin (so they are not candidates)
+ * and no other disc moving.  Their first contact must be seen in the same
+ * cycle as with every pair a candidate, for several skins and speeds. */
 START_TEST(grid_head_on_contact_not_missed)
 {
     static const char *const fmt =

@@ -175,6 +175,16 @@ static enum bal_status install(const struct bal_sim *s, struct bal_pairs *p,
     return BAL_OK;
 }
 
+/* The grid cell (column cx, row cy) of the point (x, y); the last cell
+ * takes the far edge. */
+static inline void cell_of(double x, double y, const struct bal_grid *g, double inv_h, int *cx,
+                           int *cy)
+{
+    const int ix = (int)((x - g->x0) * inv_h), iy = (int)((y - g->y0) * inv_h);
+    *cx = ix < g->nx ? ix : g->nx - 1;
+    *cy = iy < g->ny ? iy : g->ny - 1;
+}
+
 enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
 {
     const int n = s->n;
@@ -236,9 +246,8 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
         memset(g->start, 0, (size_t)(nc + 1) * sizeof *g->start);
         const double inv_h = 1 / h;
         for (int i = 0; i < n; i++) {
-            int cx = (int)((s->x[i] - x0) * inv_h), cy = (int)((s->y[i] - y0) * inv_h);
-            cx = cx < nx ? cx : nx - 1;
-            cy = cy < ny ? cy : ny - 1;
+            int cx, cy;
+            cell_of(s->x[i], s->y[i], g, inv_h, &cx, &cy);
             g->cell[i] = cy * nx + cx;
             g->start[g->cell[i] + 1]++;
         }
@@ -258,10 +267,9 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
         const double *restrict x = s->x, *restrict y = s->y, *restrict r = s->r;
         const double skin = s->skin;
         for (int i = 0; i < n; i++) {
-            /* the cell of the binning above, without its two divisions */
-            int cx = (int)((x[i] - x0) * inv_h), cy = (int)((y[i] - y0) * inv_h);
-            cx = cx < nx ? cx : nx - 1;
-            cy = cy < ny ? cy : ny - 1;
+            /* its cell again, rather than two divisions of g->cell[i] */
+            int cx, cy;
+            cell_of(x[i], y[i], g, inv_h, &cx, &cy);
             const int xlo = cx > 0 ? cx - 1 : 0, xhi = cx + 1 < nx ? cx + 1 : nx - 1;
             const int ylo = cy > 0 ? cy - 1 : 0, yhi = cy + 1 < ny ? cy + 1 : ny - 1;
             const double xi = x[i], yi = y[i], ri = r[i];

@@ -47,18 +47,25 @@
 
 #define REPEATS 5
 #define TARGET_SECONDS 2.0
+
+/* Columns of the benchmark's lattice of n discs: square-ish. */
+static long pack_columns(long n)
+{
+    return lround(sqrt(2.0 * (double)n));
+}
+
 /* The packing counts as settled when E_k < 1e-3 E_el: the discs then move
  * by far less than the skin between rebuilds, as in a static packing. */
 #define SETTLED_EK_OVER_EE 1e-3
 #define MAX_SETTLE_BLOCKS 4
-/* ... per 100 rows of the packing (N/columns = sqrt(N/2) rows): a taller
+/* ... per 100 rows of the packing (N/columns, about sqrt(N/2)): a taller
  * packing falls for longer and its pressure waves take longer to die.  At
  * 4 blocks for any height the 1 000 000-disc packing (707 rows) was timed
  * at E_k/E_el = 1.6e-3 and rebuilt every 40 cycles, which the 20 000-disc
  * packing it is compared with does not. */
 static long settle_blocks_cap(long n)
 {
-    const double rows = sqrt((double)n / 2);
+    const double rows = (double)n / (double)pack_columns(n);
     return MAX_SETTLE_BLOCKS * (long)fmax(1, ceil(rows / 100 - 1e-9));
 }
 
@@ -105,7 +112,7 @@ static int load_scene(const char *path, long n, const char *const *sets, int max
     int ok = bal_scene_load(sc, path, err) == BAL_OK;
     snprintf(set, sizeof set, "fill.pack.n=%ld", n);
     ok = ok && bal_scene_set(sc, set, err) == BAL_OK;
-    snprintf(set, sizeof set, "fill.pack.columns=%ld", lround(sqrt(2.0 * (double)n)));
+    snprintf(set, sizeof set, "fill.pack.columns=%ld", pack_columns(n));
     ok = ok && bal_scene_set(sc, set, err) == BAL_OK;
     for (int k = 0; k < max; k++)
         if (sets[k])

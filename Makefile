@@ -17,7 +17,7 @@ TIER     ?= standard
 JOBS     ?= $(shell nproc 2>/dev/null || echo 2)
 OPT      ?= -O2
 WERROR   ?=
-CFLAGS_BASE := -std=c11 -Wall -Wextra -Wpedantic -ffp-contract=off \
+CFLAGS_BASE := -std=c11 -Wall -Wextra -Wpedantic -ffp-contract=off -fopenmp \
                -D_POSIX_C_SOURCE=200809L $(WERROR)
 CFLAGS   ?= $(OPT) -g
 ALL_CFLAGS = $(CFLAGS_BASE) $(CFLAGS) -DBAL_BUILD_FLAGS='"$(CC) $(CFLAGS_BASE) $(CFLAGS)"'

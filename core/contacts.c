@@ -172,19 +172,119 @@ clear_sums(double *restrict fx, double *restrict fy, double *restrict tq, float 
     }
 }
 
-/* The loop starts the cycle's force sums.  It runs in chunks of
- * CLEAR_CHUNK candidates; before a chunk, the sums of every disc up to the
- * chunk's highest j are zeroed (pairs are sorted by i and j > i, so no disc
- * above the highest j seen has been touched yet), the rest at the end.  The
- * sums' lines are then fetched once, by the loop that fills them, and not
- * also by a clearing pass of their own, which in a packing larger than the
- * cache cost a trip to memory per line.  The order of the additions is
- * unchanged.  (Clearing inside the per-pair loop, at each new highest j,
- * made the 20 000-disc benchmark 25 % slower: the compiler turns the
- * clearing into memset calls, and a call in the loop costs the loop its
- * registers.) */
-static inline __attribute__((always_inline)) void
-pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int damp)
+/* ------------------------------------------------------------------ */
+/* Threads                                                             */
+/* ------------------------------------------------------------------ */
+
+/* Ranges shorter than this many chunks are not worth a thread. */
+#define PAR_MIN_CHUNKS 16
+
+static int grow_log(struct bal_par *par, int t, long need)
+{
+    if (need <= par->log_cap[t])
+        return 1;
+    const long cap = need + need / 2 + 64;
+    struct bal_sum_log *q = realloc(par->log[t], (size_t)cap * sizeof *q);
+    if (!q)
+        return 0;
+    par->log[t] = q;
+    par->log_cap[t] = cap;
+    return 1;
+}
+
+/* Cut the disc–disc list into ranges of whole chunks with about as many
+ * candidates each, and size what they need: once per list (a rebuild).  If
+ * memory runs out, one range (the serial loop needs nothing more than the
+ * chunk sums, reserved with the list). */
+void bal_par_plan(struct bal_sim *s)
+{
+    struct bal_par *par = &s->par;
+    const struct bal_pairs *p = &s->pp;
+    const long chunks = (p->n + CLEAR_CHUNK - 1) / CLEAR_CHUNK;
+    int ranges = par->threads;
+    if (ranges > chunks / PAR_MIN_CHUNKS)
+        ranges = (int)(chunks / PAR_MIN_CHUNKS);
+    if (ranges < 1)
+        ranges = 1;
+    par->start[0] = 0;
+    for (int t = 1; t < ranges; t++)
+        par->start[t] = chunks * t / ranges * CLEAR_CHUNK;
+    par->start[ranges] = p->n;
+    int seen = -1; /* the highest j of the ranges so far */
+    for (int t = 0; t < ranges; t++) {
+        const int zone = seen;
+        par->zone[t] = zone;
+        long logged = 0;
+        for (long c = par->start[t]; c < par->start[t + 1]; c++) {
+            logged += (p->i[c] <= zone) + (p->j[c] <= zone);
+            seen = p->j[c] > seen ? p->j[c] : seen;
+        }
+        if (t > 0 && !grow_log(par, t, logged)) {
+            ranges = 1;
+            par->start[1] = p->n;
+            par->zone[0] = -1;
+            break;
+        }
+    }
+    par->ranges = ranges;
+    par->planned = s->rebuilds;
+}
+
+enum bal_status bal_par_reserve_chunks(struct bal_sim *s)
+{
+    struct bal_par *par = &s->par;
+    const long need = (s->pp.cap + CLEAR_CHUNK - 1) / CLEAR_CHUNK + 1;
+    if (need <= par->chunk_cap)
+        return BAL_OK;
+    double *q = realloc(par->chunk_sums, (size_t)need * sizeof *q);
+    if (!q)
+        return BAL_ENOMEM;
+    par->chunk_sums = q;
+    par->chunk_cap = need;
+    return BAL_OK;
+}
+
+void bal_par_free(struct bal_par *par)
+{
+    for (int t = 0; t < BAL_MAX_THREADS; t++)
+        free(par->log[t]);
+    free(par->chunk_sums);
+    free(par->block_sums);
+    memset(par, 0, sizeof *par);
+}
+
+/* The candidates c0..c1-1 of one chunk; `logged`: some of their sums go to
+ * the log (see pair_range). */
+
+/* One range of the disc–disc list (all of it on one thread; see struct
+ * bal_par in sim.h for several).  The loop starts the cycle's force sums.
+ * It runs in chunks of CLEAR_CHUNK candidates; before a chunk, the sums of
+ * every disc up to the chunk's highest j are zeroed (pairs are sorted by i
+ * and j > i, so no disc above the highest j seen has been touched yet), the
+ * rest at the end.  The sums' lines are then fetched once, by the loop that
+ * fills them, and not also by a clearing pass of their own, which in a
+ * packing larger than the cache cost a trip to memory per line.  The order
+ * of the additions is unchanged.  (Clearing inside the per-pair loop, at
+ * each new highest j, made the 20 000-disc benchmark 25 % slower: the
+ * compiler turns the clearing into memset calls, and a call in the loop
+ * costs the loop its registers.)
+ *
+ * Range t starts with the discs up to zone = par.zone[t] cleared by the
+ * ranges before it, and logs what it adds to them (`logged` chunks: those
+ * whose first i is in the zone); the last range clears the sums no
+ * candidate reached.  Each chunk's friction loss goes to par.chunk_sums. */
+/* Where a run of chunks left off. */
+struct range_state {
+    long c0;     /* the next chunk */
+    int cleared; /* the sums of discs 0..cleared are started */
+    int over;    /* an overlap past the sieve */
+};
+
+/* Chunks of range t from st.c0 on: while their first i is in the zone
+ * (`logged`), or to the end of the range. */
+static inline __attribute__((always_inline)) struct range_state
+range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int law,
+             const int shear, const int damp, const int logged)
 {
     struct bal_pairs *restrict p = &s->pp;
     const double *restrict x = s->x, *restrict y = s->y;
@@ -192,6 +292,7 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
     const double *restrict r = s->r;
     const int32_t *restrict mat = s->mat;
     double *restrict fx = s->fx, *restrict fy = s->fy, *restrict tq = s->tq;
+    float *restrict dfx = s->dash_fx, *restrict dfy = s->dash_fy, *restrict dtq = s->dash_tq;
     const double dt = s->dt, nu = s->nu, delta0 = s->delta0;
     const int n_mat = s->n_mat;
     const struct bal_pair_law *restrict laws = s->law;
@@ -200,12 +301,14 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
      * compare), and only if some overlap passes it are the pairs judged one
      * by one (energy.c). */
     const double budget = s->overlap_sieve;
-    double lost_fric = 0; /* energy audit (energy.c) */
-    float *restrict dfx = s->dash_fx, *restrict dfy = s->dash_fy, *restrict dtq = s->dash_tq;
-    int over = 0;
-
-    int cleared = -1; /* the sums of discs 0..cleared are started */
-    for (long c0 = 0; c0 < p->n; c0 += CLEAR_CHUNK) {
+    double *restrict chunk_sums = s->par.chunk_sums;
+    const long end = s->par.start[t + 1];
+    const int zone = logged ? s->par.zone[t] : -1;
+    struct bal_sum_log *restrict log = logged ? s->par.log[t] : NULL;
+    long n_log = logged ? s->par.log_n[t] : 0;
+    int cleared = st.cleared, over = st.over;
+    long c0 = st.c0;
+    for (; c0 < end && (!logged || p->i[c0] <= zone); c0 += CLEAR_CHUNK) {
         const long c1 = c0 + CLEAR_CHUNK < p->n ? c0 + CLEAR_CHUNK : p->n;
         int top = cleared;
         for (long c = c0; c < c1; c++)
@@ -214,6 +317,7 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
             clear_sums(fx, fy, tq, dfx, dfy, dtq, cleared + 1, top, damp);
             cleared = top;
         }
+        double lost_fric = 0; /* energy audit (energy.c) */
         for (long c = c0; c < c1; c++) {
             const int i = p->i[c], j = p->j[c];
             const double dx = x[j] - x[i], dy = y[j] - y[i];
@@ -273,6 +377,45 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
             /* Force on y is +(ftn e + fts t); on x the opposite (Fig. 3). */
             const double fcx = ftn * ex + fts * ey;
             const double fcy = ftn * ey - fts * ex;
+            if (logged && (i <= zone || j <= zone)) {
+                float dcx = 0, dcy = 0;
+                if (damp) {
+                    dcx = (float)(dn * ex + ds * ey);
+                    dcy = (float)(dn * ey - ds * ex);
+                }
+                /* a - b is a + (-b) exactly: the replay adds the same */
+                if (i <= zone)
+                    log[n_log++] = (struct bal_sum_log){-fcx, -fcy, fts * r[i], -dcx, -dcy,
+                                                        (float)(ds * r[i]), i};
+                else {
+                    fx[i] -= fcx;
+                    fy[i] -= fcy;
+                    if (shear)
+                        tq[i] += fts * r[i];
+                    if (damp) {
+                        dfx[i] -= dcx;
+                        dfy[i] -= dcy;
+                        if (shear)
+                            dtq[i] += (float)(ds * r[i]);
+                    }
+                }
+                if (j <= zone)
+                    log[n_log++] = (struct bal_sum_log){fcx, fcy, fts * r[j], dcx, dcy,
+                                                        (float)(ds * r[j]), j};
+                else {
+                    fx[j] += fcx;
+                    fy[j] += fcy;
+                    if (shear)
+                        tq[j] += fts * r[j];
+                    if (damp) {
+                        dfx[j] += dcx;
+                        dfy[j] += dcy;
+                        if (shear)
+                            dtq[j] += (float)(ds * r[j]);
+                    }
+                }
+                continue;
+            }
             fx[i] -= fcx;
             fy[i] -= fcy;
             fx[j] += fcx;
@@ -294,15 +437,95 @@ pair_loop(struct bal_sim *restrict s, const int law, const int shear, const int 
                 }
             }
         }
+        if (shear)
+            chunk_sums[c0 / CLEAR_CHUNK] = lost_fric;
     }
-    clear_sums(fx, fy, tq, dfx, dfy, dtq, cleared + 1, s->n - 1, damp);
-    if (shear)
-        s->audit.d_friction += lost_fric;
-    s->over_budget |= over;
+    if (logged)
+        s->par.log_n[t] = n_log;
+    return (struct range_state){c0, cleared, over};
 }
 
-#define PAIR_VARIANT(name, law, shear, damp) \
-    static void name(struct bal_sim *s) { pair_loop(s, law, shear, damp); }
+/* The chunks of a range that log (at its start; only ranges after the
+ * first have any): out of line, so that the loop of the others has no call
+ * in it and keeps its registers (with the call, the 20 000-disc benchmark
+ * lost 7 %). */
+static __attribute__((noinline)) struct range_state
+logged_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int law,
+              const int shear, const int damp)
+{
+    return range_chunks(s, t, st, law, shear, damp, 1);
+}
+
+static inline __attribute__((always_inline)) void
+pair_range(struct bal_sim *restrict s, int t, const int law, const int shear, const int damp)
+{
+    struct range_state st = {s->par.start[t], s->par.zone[t], 0};
+    s->par.log_n[t] = 0;
+    if (t > 0)
+        st = logged_chunks(s, t, st, law, shear, damp);
+    st = range_chunks(s, t, st, law, shear, damp, 0);
+    if (t == s->par.ranges - 1)
+        clear_sums(s->fx, s->fy, s->tq, s->dash_fx, s->dash_fy, s->dash_tq, st.cleared + 1,
+                   s->n - 1, damp);
+    s->par.over[t] = st.over;
+}
+
+
+/* The whole list: its ranges, on as many threads, then the logs replayed in
+ * range order and the chunks' friction losses added in order. */
+static inline __attribute__((always_inline)) void
+pair_loop(struct bal_sim *restrict s, void (*on_threads)(struct bal_sim *), const int law,
+          const int shear, const int damp)
+{
+    struct bal_par *par = &s->par;
+    if (par->planned != s->rebuilds)
+        bal_par_plan(s);
+    const int ranges = par->ranges;
+    if (ranges == 1)
+        pair_range(s, 0, law, shear, damp);
+    else
+        on_threads(s);
+    double *restrict fx = s->fx, *restrict fy = s->fy, *restrict tq = s->tq;
+    float *restrict dfx = s->dash_fx, *restrict dfy = s->dash_fy, *restrict dtq = s->dash_tq;
+    int over = par->over[0];
+    for (int t = 1; t < ranges; t++) {
+        over |= par->over[t];
+        const struct bal_sum_log *restrict log = par->log[t];
+        for (long e = 0; e < par->log_n[t]; e++) {
+            const int k = log[e].k;
+            fx[k] += log[e].fx;
+            fy[k] += log[e].fy;
+            if (shear)
+                tq[k] += log[e].tq;
+            if (damp) {
+                dfx[k] += log[e].dfx;
+                dfy[k] += log[e].dfy;
+                if (shear)
+                    dtq[k] += log[e].dtq;
+            }
+        }
+    }
+    if (shear) {
+        double lost_fric = 0;
+        const long chunks = (s->pp.n + CLEAR_CHUNK - 1) / CLEAR_CHUNK;
+        for (long k = 0; k < chunks; k++)
+            lost_fric += par->chunk_sums[k];
+        s->audit.d_friction += lost_fric;
+    }
+    s->over_budget |= over;
+}
+/* Each variant with its parallel region in a function of its own: in the
+ * same function, the region's shared variables cost the serial loop 10 %
+ * (the compiler no longer keeps them in registers). */
+#define PAIR_VARIANT(name, law, shear, damp)                                 \
+    static __attribute__((noinline)) void name##_threads(struct bal_sim *s) \
+    {                                                                        \
+        const int ranges = s->par.ranges;                                    \
+        _Pragma("omp parallel for num_threads(ranges) schedule(static, 1)") \
+        for (int t = 0; t < ranges; t++)                                     \
+            pair_range(s, t, law, shear, damp);                              \
+    }                                                                        \
+    static void name(struct bal_sim *s) { pair_loop(s, name##_threads, law, shear, damp); }
 
 /* BAL_BARE: the build without optional modules, for `make bench-modules`
  * only: every scene gets the frictionless, undamped power-law loop, so a

@@ -311,6 +311,9 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
     }
     if (install(s, &s->pp, rs, count, 0, err))
         return err->code;
+    if (bal_par_reserve_chunks(s))
+        return bal_error(err, BAL_ENOMEM, "neighbour list: out of memory for %ld pairs",
+                         s->pp.cap);
 
     /* --- disc–wall candidates ------------------------------------- */
     count = 0;

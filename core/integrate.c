@@ -127,17 +127,40 @@ static void moved_scan(struct bal_sim *s)
 /* centred: C&S eqs (22)-(23a), (35)-(36)                              */
 /* ------------------------------------------------------------------ */
 
-static void centred_positions(struct bal_sim *s)
+/* The centred passes go through the discs in blocks of this many; a block's
+ * sums are its own, added up block after block, so that they are the same
+ * on any number of threads (struct bal_par, sim.h). */
+#define BLOCK 4096
+
+static inline int blocks_of(const struct bal_sim *s) { return (s->n + BLOCK - 1) / BLOCK; }
+
+/* Run body(s, b) for every block b, on s->par.threads threads. */
+#define FOR_BLOCKS(s, b, body)                                                          \
+    do {                                                                                \
+        const int nb_ = blocks_of(s), th_ = (s)->par.threads < nb_ ? (s)->par.threads : nb_; \
+        if (th_ > 1) {                                                                  \
+            _Pragma("omp parallel for num_threads(th_) schedule(static)")               \
+            for (int b = 0; b < nb_; b++)                                               \
+                body;                                                                   \
+        } else {                                                                        \
+            for (int b = 0; b < nb_; b++)                                               \
+                body;                                                                   \
+        }                                                                               \
+    } while (0)
+
+/* Block b of the position pass; its two largest squared displacements since
+ * the last rebuild into block_sums[2b], [2b + 1]. */
+static void centred_positions_block(struct bal_sim *s, int b)
 {
     const double dt = s->dt;
-    const int n = s->n;
+    const int from = b * BLOCK, to = from + BLOCK < s->n ? from + BLOCK : s->n;
     double *restrict x = s->x, *restrict y = s->y, *restrict th = s->th;
     const double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
     const double *restrict xr = s->x_ref, *restrict yr = s->y_ref;
     double m1 = 0, m2 = 0;
     if (s->use_grid) {
         /* the displacement since the last rebuild in the same pass */
-        for (int i = 0; i < n; i++) {
+        for (int i = from; i < to; i++) {
             x[i] += vx[i] * dt;
             y[i] += vy[i] * dt;
             th[i] += w[i] * dt;
@@ -145,11 +168,24 @@ static void centred_positions(struct bal_sim *s)
             track_moves(dx * dx + dy * dy, &m1, &m2);
         }
     } else {
-        for (int i = 0; i < n; i++) {
+        for (int i = from; i < to; i++) {
             x[i] += vx[i] * dt;
             y[i] += vy[i] * dt;
             th[i] += w[i] * dt;
         }
+    }
+    s->par.block_sums[2 * b] = m1;
+    s->par.block_sums[2 * b + 1] = m2;
+}
+
+static void centred_positions(struct bal_sim *s)
+{
+    FOR_BLOCKS(s, b, centred_positions_block(s, b));
+    /* the two largest of all: the same whatever the blocks */
+    double m1 = 0, m2 = 0;
+    for (int b = 0; b < blocks_of(s); b++) {
+        track_moves(s->par.block_sums[2 * b], &m1, &m2);
+        track_moves(s->par.block_sums[2 * b + 1], &m1, &m2);
     }
     moved(s, m1, m2);
 }
@@ -179,11 +215,12 @@ static void centred_previous(const struct bal_sim *s, int i, double *vx, double 
  * needs at t_N, v_N = (v_{N-1/2} + v_{N+1/2})/2 (energy.c): with global
  * damping Σ (m v_N² + I ω_N²), with dashpots Σ (F^D·v_N + M^D ω_N) — both
  * in registers here, where a pass of their own would recover v_{N-1/2} from
- * the force sums again.  Compiled in four variants, as the pair loops. */
+ * the force sums again.  Compiled in four variants, as the pair loops; one
+ * block at a time, its sums into block_sums[2b], [2b + 1]. */
 static inline __attribute__((always_inline)) void
-centred_update(struct bal_sim *s, const int damped, const int dashpots)
+centred_block(struct bal_sim *s, int b, const int damped, const int dashpots)
 {
-    const int n = s->n;
+    const int from = b * BLOCK, to = from + BLOCK < s->n ? from + BLOCK : s->n;
     const double dt = s->dt;
     const double half = s->alpha * dt / 2;
     const double keep = 1 - half, scale = 1 / (1 + half);
@@ -194,7 +231,7 @@ centred_update(struct bal_sim *s, const int damped, const int dashpots)
     const float *restrict dfx = s->dash_fx, *restrict dfy = s->dash_fy, *restrict dtq = s->dash_tq;
     const uint8_t *restrict fixed = s->fixed;
     double glob = 0, dash = 0;
-    for (int i = 0; i < n; i++) {
+    for (int i = from; i < to; i++) {
         if (fixed[i])
             continue;
         const double ox = vx[i], oy = vy[i], ow = w[i];
@@ -213,6 +250,19 @@ centred_update(struct bal_sim *s, const int damped, const int dashpots)
             glob += (cx * cx + cy * cy) / im[i] + cw * cw / ii[i];
         if (dashpots)
             dash += (double)dfx[i] * cx + (double)dfy[i] * cy + (double)dtq[i] * cw;
+    }
+    s->par.block_sums[2 * b] = glob;
+    s->par.block_sums[2 * b + 1] = dash;
+}
+
+static inline __attribute__((always_inline)) void
+centred_update(struct bal_sim *s, const int damped, const int dashpots)
+{
+    FOR_BLOCKS(s, b, centred_block(s, b, damped, dashpots));
+    double glob = 0, dash = 0;
+    for (int b = 0; b < blocks_of(s); b++) {
+        glob += s->par.block_sums[2 * b];
+        dash += s->par.block_sums[2 * b + 1];
     }
     s->audit.glob_sum = 0.25 * glob;
     s->audit.dash_sum = 0.5 * dash;
@@ -431,6 +481,9 @@ enum bal_status bal_integrate_setup(struct bal_sim *s, struct bal_error *err)
 {
     const int which = s->scene->settings.integrator;
     s->integ = &integrators[which >= 0 && which <= BAL_INTEGRATOR_GEAR5 ? which : 0];
+    s->par.block_sums = calloc(2 * (size_t)(blocks_of(s) ? blocks_of(s) : 1), sizeof(double));
+    if (!s->par.block_sums)
+        return bal_error(err, BAL_ENOMEM, "%s: out of memory (%d discs)", s->scene->path, s->n);
     if (which != BAL_INTEGRATOR_GEAR5)
         return BAL_OK;
     const size_t n = (size_t)(s->n ? s->n : 1);

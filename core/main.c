@@ -2,7 +2,7 @@
  * main.c — the `ballast` command: the only place that parses the command
  * line, touches signals and maps a status to an exit code.
  *
- *   ballast run SCENE --out DIR [--set KEY=VALUE ...]
+ *   ballast run SCENE --out DIR [--set KEY=VALUE ...] [--threads N]
  *   ballast exact SCENE --out DIR [--set KEY=VALUE ...]
  *   ballast info SCENE [--set KEY=VALUE ...]
  *   ballast keys          (every scene key, as Markdown tables)
@@ -47,7 +47,7 @@ static int exit_code(enum bal_status st)
 
 static int usage(void)
 {
-    fputs("usage: ballast run SCENE --out DIR [--set KEY=VALUE ...]\n"
+    fputs("usage: ballast run SCENE --out DIR [--set KEY=VALUE ...] [--threads N]\n"
           "       ballast exact SCENE --out DIR [--set KEY=VALUE ...]\n"
           "       ballast info SCENE [--set KEY=VALUE ...]\n"
           "       ballast keys\n"
@@ -80,6 +80,7 @@ struct args {
     const char *cmd, *scene, *out;
     int n_sets;
     char **sets;
+    const char *threads; /* --threads N, or NULL */
 };
 
 static int parse_args(int argc, char **argv, struct args *a)
@@ -96,6 +97,8 @@ static int parse_args(int argc, char **argv, struct args *a)
             a->out = argv[++k];
         else if (strcmp(argv[k], "--set") == 0 && k + 1 < argc)
             a->sets[a->n_sets++] = argv[++k];
+        else if (strcmp(argv[k], "--threads") == 0 && k + 1 < argc)
+            a->threads = argv[++k];
         else if (argv[k][0] != '-' && !a->scene)
             a->scene = argv[k];
         else {
@@ -168,8 +171,20 @@ static int prepare(const struct args *a, const char *cmd, struct bal_scene *sc,
         fprintf(stderr, "ballast %s: --out DIR is required\n", cmd);
         return 2;
     }
-    if (load(sc, a, &err) || bal_sim_create(sim, sc, &err)) {
+    if (a->threads) {
+        char *end;
+        const long t = strtol(a->threads, &end, 10);
+        if (*end || end == a->threads || t < 1 || t > 16) {
+            fprintf(stderr, "ballast %s: --threads %s: not a whole number from 1 to 16\n", cmd,
+                    a->threads);
+            return 2;
+        }
+    }
+    if (load(sc, a, &err) || bal_sim_create(sim, sc, &err) ||
+        (a->threads && bal_sim_set_threads(*sim, atoi(a->threads), &err))) {
         fprintf(stderr, "%s\n", err.msg);
+        bal_sim_free(*sim);
+        *sim = NULL;
         bal_scene_free(sc);
         return exit_code(err.code);
     }

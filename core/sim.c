@@ -96,6 +96,7 @@ void bal_sim_free(struct bal_sim *s)
     bal_pairs_free(&s->pw);
     bal_grid_scratch_free(&s->rs);
     bal_integrate_free(s);
+    bal_par_free(&s->par);
     free(s);
 }
 
@@ -390,6 +391,8 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
     if (!s)
         return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
     s->scene = sc;
+    s->par.threads = 1;
+    s->par.planned = -1;
     const struct bal_settings *st = &sc->settings;
     s->alpha = st->alpha;
     s->beta = st->beta;
@@ -642,6 +645,16 @@ void bal_sim_set_stage(struct bal_sim *s, int stage)
         s->walls[k].omega = g->moves[m].omega;
     }
     s->stage = stage;
+}
+
+enum bal_status bal_sim_set_threads(struct bal_sim *s, int threads, struct bal_error *err)
+{
+    if (threads < 1 || threads > BAL_MAX_THREADS)
+        return bal_error(err, BAL_EINVAL, "threads: %d is out of range (1 to %d)", threads,
+                         BAL_MAX_THREADS);
+    s->par.threads = threads;
+    s->par.planned = -1; /* cut the list again */
+    return BAL_OK;
 }
 
 static double seconds_now(void)

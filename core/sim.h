@@ -163,6 +163,37 @@ struct bal_integrator_type {
     int staggered;
 };
 
+/* Several threads in one cycle (OpenMP), with results bitwise those of one
+ * thread (contacts.c, integrate.c):
+ * - the disc–disc list is cut into ranges of whole chunks, one per thread.
+ *   Range t adds directly to the sums of the discs above zone[t], the
+ *   highest j of the ranges before it, which no earlier range touches; what
+ *   it adds to the others it logs, and the logs are replayed in range order
+ *   after the loop.  Every disc's sums thus add the same terms in the same
+ *   order as one thread going through the whole list;
+ * - the sums over candidates (the friction loss) and over discs (the audit's
+ *   sums of the velocity update) add up fixed blocks, then the blocks in
+ *   order, whatever the number of threads. */
+#define BAL_MAX_THREADS 16
+struct bal_sum_log {             /* what range t adds to disc k, logged */
+    double fx, fy, tq;
+    float dfx, dfy, dtq;
+    int32_t k;
+};
+struct bal_par {
+    int threads;                 /* asked for (bal_sim_set_threads); 1: serial */
+    int ranges;                  /* ranges of the current disc–disc list */
+    long planned;                /* s->rebuilds when the list was cut, -1: never */
+    long start[BAL_MAX_THREADS + 1]; /* first candidate of each range */
+    int zone[BAL_MAX_THREADS];   /* range t logs its sums for discs <= zone[t] */
+    int over[BAL_MAX_THREADS];   /* range t saw an overlap past the sieve */
+    struct bal_sum_log *log[BAL_MAX_THREADS];
+    long log_n[BAL_MAX_THREADS], log_cap[BAL_MAX_THREADS];
+    double *chunk_sums;          /* per chunk of candidates: the friction loss */
+    long chunk_cap;
+    double *block_sums;          /* per block of discs: 4 each (integrate.c) */
+};
+
 struct bal_sim {
     const struct bal_scene *scene;
 
@@ -192,6 +223,7 @@ struct bal_sim {
 
     /* contacts and neighbours */
     struct bal_pairs pp, pw;     /* disc–disc, disc–wall candidates */
+    struct bal_par par;          /* threads */
     struct bal_rebuild_scratch rs; /* the new list of a rebuild, one column at a time */
     struct bal_grid grid;
     int use_grid;
@@ -276,6 +308,12 @@ void bal_pairs_merge_history(struct bal_pairs *fresh, const struct bal_pairs *ol
 /* Position of `key` in the sorted list p, or -1 (binary search). */
 long bal_pairs_find(const struct bal_pairs *p, uint64_t key);
 bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping);
+/* Cut the disc–disc list into ranges for s->par.threads threads (the pair
+ * loop calls it after each rebuild); reserve the per-chunk sums for the
+ * list's capacity (after every reserve of s->pp); free it all. */
+void bal_par_plan(struct bal_sim *s);
+enum bal_status bal_par_reserve_chunks(struct bal_sim *s);
+void bal_par_free(struct bal_par *par);
 void bal_contacts_walls(struct bal_sim *s);
 /* The dashpot forces D_n, D_s of contact c of list p in the last cycle:
  * stored for walls, recomputed for disc pairs from the geometry at t_N and

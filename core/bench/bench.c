@@ -19,6 +19,8 @@
  *        bench --settling SCENE [N]  (the packing timed while it falls)
  *        bench --pair SCENE NA NB [ROUNDS]  (flat scaling in one process: timed
  *                                  runs alternate between the two packings)
+ *        bench --threads SCENE N T [ROUNDS]  (OpenMP: timed runs alternate
+ *                                  between 1 and T threads on one packing)
  *        bench --pile PILE_SCENE  (the L0 = 100 pile relaxed, 5 whole runs)
  *        bench --modules SCENE [N]       (what each optional module costs, one
  *                                         simulation per configuration from
@@ -321,6 +323,53 @@ static int scaling_pair(const char *path, long na, long nb, int rounds)
     }
     prepared_free(&p[0]);
     prepared_free(&p[1]);
+    return rc;
+}
+
+/* OpenMP: the settled N-disc packing, timed runs alternating between one
+ * thread and `threads`, `rounds` times; each one's median, min and max, and
+ * the median of the per-round speed-ups.  (Same results on any number of
+ * threads: make test checks it bitwise.) */
+static int threads_bench(const char *path, long n, int threads, int rounds)
+{
+    enum { MAX_ROUNDS = 64 };
+    if (rounds < 1 || rounds > MAX_ROUNDS || threads < 2 || threads > BAL_MAX_THREADS) {
+        fprintf(stderr, "bench: --threads: 2 <= threads <= %d, 1 <= rounds <= %d\n",
+                BAL_MAX_THREADS, MAX_ROUNDS);
+        return 2;
+    }
+    struct options o = {NULL, NULL, 0, TARGET_SECONDS, 0, 0};
+    struct prepared p;
+    if (prepare(path, n, &o, &p))
+        return 1;
+    struct bal_error err = {0};
+    double rate[2][MAX_ROUNDS], gain[MAX_ROUNDS];
+    const int count[2] = {1, threads};
+    int rc = 0;
+    for (int r = 0; r < rounds && rc == 0; r++) {
+        for (int k = 0; k < 2 && rc == 0; k++) {
+            rc = bal_sim_set_threads(p.sim, count[k], &err) != BAL_OK ||
+                 (rate[k][r] = timed_run(&p)) < 0;
+        }
+        if (rc == 0)
+            gain[r] = rate[1][r] / rate[0][r];
+    }
+    if (rc == 0) {
+        qsort(gain, (size_t)rounds, sizeof gain[0], cmp_double);
+        printf("# N=%d settled for %ld cycles: E_k/E_el = %.2g\n", p.sim->n, p.settled, p.ek_ee);
+        for (int k = 0; k < 2; k++) {
+            qsort(rate[k], (size_t)rounds, sizeof rate[k][0], cmp_double);
+            printf("bench threads=%d N=%d steps=%ld particle_steps_per_s=%.4g min=%.4g max=%.4g\n",
+                   count[k], p.sim->n, p.steps, rate[k][rounds / 2], rate[k][0],
+                   rate[k][rounds - 1]);
+        }
+        printf("bench threads speed-up %d/1 N=%d median=%.3f min=%.3f max=%.3f rounds=%d\n",
+               threads, p.sim->n, gain[rounds / 2], gain[0], gain[rounds - 1], rounds);
+        report_details(&p);
+    } else if (err.msg[0]) {
+        fprintf(stderr, "bench: %s\n", err.msg);
+    }
+    prepared_free(&p);
     return rc;
 }
 
@@ -941,6 +990,8 @@ int main(int argc, char **argv)
         return modules_step(argv[2], argv[3], atol(argv[4]), atoi(argv[5]));
     if (strcmp(argv[1], "--pair") == 0 && (argc == 5 || argc == 6))
         return scaling_pair(argv[2], atol(argv[3]), atol(argv[4]), argc == 6 ? atoi(argv[5]) : 9);
+    if (strcmp(argv[1], "--threads") == 0 && (argc == 5 || argc == 6))
+        return threads_bench(argv[2], atol(argv[3]), atoi(argv[4]), argc == 6 ? atoi(argv[5]) : 9);
     if (strcmp(argv[1], "--modules-summary") == 0 && argc == 7)
         return modules_summary(argv + 2);
     if (strcmp(argv[1], "--settling") == 0 && argc >= 3) {

@@ -32,6 +32,7 @@ Suite *suite_grid(void);
 Suite *suite_measure(void);
 Suite *suite_exact(void);
 Suite *suite_energy(void);
+Suite *suite_threads(void);
 
 /* Room for the scene texts the tests format. */
 #define T_TEXT_MAX 8192

@@ -1,0 +1,157 @@
+/*
+ * check_threads.c — suite "threads": a cycle on several threads (OpenMP;
+ * struct bal_par in sim.h) gives bitwise the results of one thread.
+ *
+ * The disc–disc list is cut into ranges, one per thread; a range logs what
+ * it adds to the discs an earlier range also reaches, and the logs are
+ * replayed in range order, so every force sum adds the same terms in the
+ * same order.  The sums over candidates and over discs add fixed blocks.
+ * Nothing here is a tolerance: the arrays are compared byte for byte.
+ */
+#include <string.h>
+
+#include "check_main.h"
+
+/* A falling, colliding packing with every module of the dense benchmark:
+ * friction with history, dashpots, global damping, gravity (6 times the
+ * benchmark's, so that it packs within the test's cycles), a box.  12 000
+ * discs give enough candidates for three ranges of at least
+ * PAR_MIN_CHUNKS chunks. */
+static const char *const packing_fmt =
+    "[settings]\ndt = 0.0007926748447693654\nforce_dt = 1\ngravity = 0 -60\n"
+    "beta = 0.001\nalpha = 0.5\n"
+    "[material grain]\nkn = 1e5\nks = 1e5\nfriction = 0.5\ndensity = 1\n"
+    "[material box]\nkn = 1e5\nks = 1e5\nfriction = 0.5\n"
+    "[fill pack]\nn = 12000\ncolumns = %d\nrmin = 0.5\nrmax = 0.75\nseed = 7\nbox = 1\n"
+    "headroom = 2\nvmax = 2\nmaterial = grain\nwall_material = box\n"
+    "[stage s]\ncycles = 100000\n";
+
+#define CYCLES 1000
+
+/* Run the packing CYCLES cycles on `threads` threads; the most candidates
+ * any range after the first logged in one cycle into *logged. */
+static struct tfx *run_on(int columns, int threads, long *logged)
+{
+    struct tfx *f = tfx_newf("threads", packing_fmt, columns);
+    ck_assert_int_eq(bal_sim_set_threads(f->sim, threads, &f->err), BAL_OK);
+    *logged = 0;
+    for (long k = 0; k < CYCLES; k++) {
+        t_steps(f, 1);
+        for (int t = 1; t < f->sim->par.ranges; t++)
+            *logged = f->sim->par.log_n[t] > *logged ? f->sim->par.log_n[t] : *logged;
+    }
+    return f;
+}
+
+static void same_doubles(const double *a, const double *b, size_t n, const char *what, int threads)
+{
+    ck_assert_msg(memcmp(a, b, n * sizeof *a) == 0, "%s differs on %d threads", what, threads);
+}
+
+static void same_floats(const float *a, const float *b, size_t n, const char *what, int threads)
+{
+    ck_assert_msg(memcmp(a, b, n * sizeof *a) == 0, "%s differs on %d threads", what, threads);
+}
+
+/* Every array the cycle writes, byte for byte, after the same cycles on
+ * one thread and on each count of `counts`. */
+static void check_as_one(int columns, const int *counts, int n_counts, long min_contacts,
+                         int shared)
+{
+    long logged;
+    struct tfx *one = run_on(columns, 1, &logged);
+    const struct bal_sim *a = one->sim;
+    ck_assert_int_eq(a->par.ranges, 1);
+    long contacts = 0;
+    for (long c = 0; c < a->pp.n; c++)
+        contacts += (a->pp.flags[c] & BAL_PAIR_TOUCHING) != 0;
+    ck_assert_int_gt(contacts, min_contacts); /* the discs collide: forces to sum */
+    for (int q = 0; q < n_counts; q++) {
+        const int th = counts[q];
+        struct tfx *many = run_on(columns, th, &logged);
+        const struct bal_sim *b = many->sim;
+        /* not vacuous: the list was cut, and discs shared between ranges */
+        ck_assert_int_eq(b->par.ranges, th);
+        ck_assert_int_gt(logged, 0);
+        if (shared) {
+            /* some disc is logged by two ranges: range t - 1 reaches past
+             * the first disc of range t */
+            int twice = 0;
+            for (int t = 2; t < b->par.ranges; t++)
+                twice |= b->par.zone[t - 1] >= b->pp.i[b->par.start[t]];
+            ck_assert_msg(twice, "no disc is logged by two ranges: the test is vacuous");
+        }
+        const size_t n = (size_t)a->n;
+        ck_assert_int_eq(a->n, b->n);
+        same_doubles(a->x, b->x, n, "x", th);
+        same_doubles(a->y, b->y, n, "y", th);
+        same_doubles(a->th, b->th, n, "rotation", th);
+        same_doubles(a->vx, b->vx, n, "v_x", th);
+        same_doubles(a->vy, b->vy, n, "v_y", th);
+        same_doubles(a->w, b->w, n, "omega", th);
+        same_doubles(a->fx, b->fx, n, "F_x sums", th);
+        same_doubles(a->fy, b->fy, n, "F_y sums", th);
+        same_doubles(a->tq, b->tq, n, "moment sums", th);
+        same_floats(a->dash_fx, b->dash_fx, n, "dashpot x sums", th);
+        same_floats(a->dash_fy, b->dash_fy, n, "dashpot y sums", th);
+        same_floats(a->dash_tq, b->dash_tq, n, "dashpot moment sums", th);
+        ck_assert_int_eq(a->pp.n, b->pp.n);
+        ck_assert_int_eq(a->rebuilds, b->rebuilds);
+        const size_t np = (size_t)a->pp.n;
+        ck_assert(memcmp(a->pp.i, b->pp.i, np * sizeof *a->pp.i) == 0);
+        ck_assert(memcmp(a->pp.j, b->pp.j, np * sizeof *a->pp.j) == 0);
+        same_doubles(a->pp.fn, b->pp.fn, np, "F_n history", th);
+        same_doubles(a->pp.fs, b->pp.fs, np, "F_s history", th);
+        ck_assert(memcmp(a->pp.flags, b->pp.flags, np) == 0);
+        /* the energy audit's sums over candidates and discs */
+        ck_assert(memcmp(&a->audit, &b->audit, sizeof a->audit) == 0);
+        tfx_release(many);
+    }
+}
+
+START_TEST(threads_bitwise_as_one)
+{
+    const int counts[] = {2, 3};
+    check_as_one(110, counts, 2, 2000, 0);
+}
+END_TEST
+
+/* A packing 4 rows deep and 3 000 discs wide: a range (16 chunks, ~1 800
+ * discs) is shorter than the reach of its candidates (the row above), so
+ * on 4 threads some discs get logged sums from two ranges, replayed in
+ * their order. */
+START_TEST(threads_bitwise_ranges_shorter_than_reach)
+{
+    const int counts[] = {4};
+    check_as_one(3000, counts, 1, 2000, 1);
+}
+END_TEST
+
+/* A thread count outside 1..BAL_MAX_THREADS is refused, and leaves the
+ * count as it was. */
+START_TEST(threads_count_checked)
+{
+    struct tfx *f = tfx_newf("threads", packing_fmt, 110);
+    ck_assert_int_eq(bal_sim_set_threads(f->sim, 0, &f->err), BAL_EINVAL);
+    ck_assert_msg(t_contains(f->err.msg, "threads"), "%s", f->err.msg);
+    ck_assert_int_eq(bal_sim_set_threads(f->sim, BAL_MAX_THREADS + 1, &f->err), BAL_EINVAL);
+    ck_assert_int_eq(f->sim->par.threads, 1);
+    ck_assert_int_eq(bal_sim_set_threads(f->sim, BAL_MAX_THREADS, &f->err), BAL_OK);
+    t_steps(f, 2); /* more threads asked for than the list has ranges for */
+    ck_assert_int_le(f->sim->par.ranges, BAL_MAX_THREADS);
+    ck_assert_int_ge(f->sim->par.ranges, 1);
+}
+END_TEST
+
+Suite *suite_threads(void)
+{
+    Suite *s = suite_create("threads");
+    TCase *tc = tcase_create("bitwise");
+    tcase_add_checked_fixture(tc, NULL, tfx_teardown);
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, threads_bitwise_as_one);
+    tcase_add_test(tc, threads_bitwise_ranges_shorter_than_reach);
+    tcase_add_test(tc, threads_count_checked);
+    suite_add_tcase(s, tc);
+    return s;
+}

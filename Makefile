@@ -8,6 +8,7 @@
 #   make bench        dense-packing benchmark (median and spread of 5 repeats)
 #   make bench-peer   ballast against LAMMPS on the same physics (cross-check, then the race)
 #   make bench-flat   the 1 000 000- against the 20 000-disc rate, alternating in one process
+#   make bench-threads  2 OpenMP threads against 1 on the settled packing (20 000, 320 000 discs)
 #   make clean
 
 # ---- settings -------------------------------------------------------------
@@ -32,7 +33,8 @@ TEST_SRC := $(wildcard core/tests/check_*.c)
 BENCH_SRC := core/bench/bench.c
 
 .PHONY: all deps test test-c test-prefix test-py test-sanitize validate bench bench-scaling \
-        bench-peer bench-modules bench-modules-count bench-scaling-count bench-flat clean keys sweep \
+        bench-peer bench-modules bench-modules-count bench-scaling-count bench-flat bench-threads \
+        clean keys sweep \
         test-valgrind
 
 all: deps bin/ballast
@@ -188,6 +190,13 @@ bench-scaling: deps $(BUILD)/bench
 # this VM's drift falls on both alike (about 35 minutes, most of it settling).
 bench-flat: deps $(BUILD)/bench
 	$(BUILD)/bench --pair cases/bench/dense.scene 20000 1000000 15
+
+# OpenMP: on each settled packing, timed runs alternating between 1 and 2 threads, 9
+# rounds (about 10 minutes, most of it settling the 320 000 discs).  The results are
+# bitwise those of one thread (make test checks it), so only the time differs.
+bench-threads: deps $(BUILD)/bench
+	$(BUILD)/bench --threads cases/bench/dense.scene 20000 2 9
+	$(BUILD)/bench --threads cases/bench/dense.scene 320000 2 9
 
 # Why the rate falls with N, in figures the machine's load does not change: per
 # particle-step of the timed cycles of the all-off packing (read from a file),

@@ -361,6 +361,7 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
                 in.n_candidates);
         json_number(f, in.wall_seconds > 0 ? (double)in.steps * in.n_discs / in.wall_seconds : 0);
         fprintf(f, ",\n  \"gravity\": [%.17g, %.17g]", s->g[0], s->g[1]);
+        fprintf(f, ",\n  \"threads\": %d", s->par.threads);
         fprintf(f, ",\n  \"timers\": {\"positions\": %.6g, \"neighbours\": %.6g, \"contacts\": %.6g, "
                    "\"walls\": %.6g, \"velocities\": %.6g}, \"reorders\": %ld",
                 s->timers.positions, s->timers.neighbours, s->timers.contacts, s->timers.walls,

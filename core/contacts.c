@@ -253,10 +253,14 @@ void bal_par_free(struct bal_par *par)
     memset(par, 0, sizeof *par);
 }
 
-/* The candidates c0..c1-1 of one chunk; `logged`: some of their sums go to
- * the log (see pair_range). */
+/* Where a run of chunks left off. */
+struct range_state {
+    long c0;     /* the next chunk */
+    int cleared; /* the sums of discs 0..cleared are started */
+    int over;    /* an overlap past the sieve */
+};
 
-/* One range of the disc–disc list (all of it on one thread; see struct
+/* A range of the disc–disc list (all of it on one thread; see struct
  * bal_par in sim.h for several).  The loop starts the cycle's force sums.
  * It runs in chunks of CLEAR_CHUNK candidates; before a chunk, the sums of
  * every disc up to the chunk's highest j are zeroed (pairs are sorted by i
@@ -272,16 +276,10 @@ void bal_par_free(struct bal_par *par)
  * Range t starts with the discs up to zone = par.zone[t] cleared by the
  * ranges before it, and logs what it adds to them (`logged` chunks: those
  * whose first i is in the zone); the last range clears the sums no
- * candidate reached.  Each chunk's friction loss goes to par.chunk_sums. */
-/* Where a run of chunks left off. */
-struct range_state {
-    long c0;     /* the next chunk */
-    int cleared; /* the sums of discs 0..cleared are started */
-    int over;    /* an overlap past the sieve */
-};
-
-/* Chunks of range t from st.c0 on: while their first i is in the zone
- * (`logged`), or to the end of the range. */
+ * candidate reached.  Each chunk's friction loss goes to par.chunk_sums.
+ *
+ * range_chunks: the chunks of range t from st.c0 on, while their first i is
+ * in the zone (`logged`), or to the end of the range. */
 static inline __attribute__((always_inline)) struct range_state
 range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int law,
              const int shear, const int damp, const int logged)

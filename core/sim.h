@@ -191,7 +191,7 @@ struct bal_par {
     long log_n[BAL_MAX_THREADS], log_cap[BAL_MAX_THREADS];
     double *chunk_sums;          /* per chunk of candidates: the friction loss */
     long chunk_cap;
-    double *block_sums;          /* per block of discs: 4 each (integrate.c) */
+    double *block_sums;          /* per block of discs, 2 each: a pass's sums (integrate.c) */
 };
 
 struct bal_sim {

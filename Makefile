@@ -187,7 +187,7 @@ bench-scaling: deps $(BUILD)/bench
 
 # The flat-scaling target judged in one process: the 20 000- and the 1 000 000-disc
 # packings settled, then 15 rounds of timed runs alternating between them, so that
-# this VM's drift falls on both alike (about 35 minutes, most of it settling).
+# this VM's drift falls on both alike (about 30 minutes, most of it settling, on every core).
 bench-flat: deps $(BUILD)/bench
 	$(BUILD)/bench --pair cases/bench/dense.scene 20000 1000000 15
 

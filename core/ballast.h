@@ -320,8 +320,9 @@ enum bal_status bal_sim_step(struct bal_sim *sim, struct bal_error *err);
 
 /* Select the wall motions of stage `stage` (index into the scene's stages). */
 void bal_sim_set_stage(struct bal_sim *sim, int stage);
-/* Run the cycles on this many threads (1, the default, to 16; OpenMP).
- * The results are bitwise those of one thread. */
+/* Run the cycles on this many threads (1, the default, to BAL_MAX_THREADS;
+ * OpenMP).  The results are bitwise those of one thread. */
+#define BAL_MAX_THREADS 16
 enum bal_status bal_sim_set_threads(struct bal_sim *sim, int threads, struct bal_error *err);
 
 /* Run every stage of the loading protocol, writing a row to `series` (may be

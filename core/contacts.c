@@ -256,7 +256,7 @@ void bal_par_free(struct bal_par *par)
 /* Where a run of chunks left off. */
 struct range_state {
     long c0;     /* the next chunk */
-    int cleared; /* the sums of discs 0..cleared are started */
+    int cleared; /* the sums of discs 0..cleared are started (or not this range's) */
     int over;    /* an overlap past the sieve */
 };
 
@@ -273,10 +273,10 @@ struct range_state {
  * compiler turns the clearing into memset calls, and a call in the loop
  * costs the loop its registers.)
  *
- * Range t starts with the discs up to zone = par.zone[t] cleared by the
- * ranges before it, and logs what it adds to them (`logged` chunks: those
- * whose first i is in the zone); the last range clears the sums no
- * candidate reached.  Each chunk's friction loss goes to par.chunk_sums.
+ * Range t never writes the sums of the discs up to zone = par.zone[t]
+ * directly (the ranges before it clear them, possibly at the same time):
+ * it logs what it adds to them (`logged` chunks: those whose first i is in
+ * the zone).  The last range clears the sums no candidate reached.  Each chunk's friction loss goes to par.chunk_sums.
  *
  * range_chunks: the chunks of range t from st.c0 on, while their first i is
  * in the zone (`logged`), or to the end of the range. */
@@ -381,7 +381,8 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
                     dcx = (float)(dn * ex + ds * ey);
                     dcy = (float)(dn * ey - ds * ex);
                 }
-                /* a - b is a + (-b) exactly: the replay adds the same */
+                /* a - b is a + (-b) exactly, so the replay adds the same
+                 * (but for the sign of a NaN: a run with one stops anyway) */
                 if (i <= zone)
                     log[n_log++] = (struct bal_sum_log){-fcx, -fcy, fts * r[i], -dcx, -dcy,
                                                         (float)(ds * r[i]), i};

@@ -127,10 +127,10 @@ static void moved_scan(struct bal_sim *s)
 /* centred: C&S eqs (22)-(23a), (35)-(36)                              */
 /* ------------------------------------------------------------------ */
 
-/* The centred passes go through the discs in blocks of this many; a block's
- * sums are its own, added up block after block, so that they are the same
- * on any number of threads (struct bal_par, sim.h). */
-#define BLOCK 4096
+/* The centred passes go through the discs in blocks of BAL_DISC_BLOCK; a
+ * block's sums are its own, added up block after block, so that they are
+ * the same on any number of threads (struct bal_par, sim.h). */
+#define BLOCK BAL_DISC_BLOCK
 
 static inline int blocks_of(const struct bal_sim *s) { return (s->n + BLOCK - 1) / BLOCK; }
 

@@ -81,6 +81,7 @@ struct args {
     int n_sets;
     char **sets;
     const char *threads; /* --threads N, or NULL */
+    int n_threads;       /* ... its value, checked */
 };
 
 static int parse_args(int argc, char **argv, struct args *a)
@@ -97,8 +98,17 @@ static int parse_args(int argc, char **argv, struct args *a)
             a->out = argv[++k];
         else if (strcmp(argv[k], "--set") == 0 && k + 1 < argc)
             a->sets[a->n_sets++] = argv[++k];
-        else if (strcmp(argv[k], "--threads") == 0 && k + 1 < argc)
+        else if (strcmp(argv[k], "--threads") == 0 && k + 1 < argc) {
             a->threads = argv[++k];
+            char *end;
+            const long t = strtol(a->threads, &end, 10);
+            if (*end || end == a->threads || t < 1 || t > BAL_MAX_THREADS) {
+                fprintf(stderr, "ballast: --threads %s: not a whole number from 1 to %d\n",
+                        a->threads, BAL_MAX_THREADS);
+                return 0;
+            }
+            a->n_threads = (int)t;
+        }
         else if (argv[k][0] != '-' && !a->scene)
             a->scene = argv[k];
         else {
@@ -171,17 +181,8 @@ static int prepare(const struct args *a, const char *cmd, struct bal_scene *sc,
         fprintf(stderr, "ballast %s: --out DIR is required\n", cmd);
         return 2;
     }
-    if (a->threads) {
-        char *end;
-        const long t = strtol(a->threads, &end, 10);
-        if (*end || end == a->threads || t < 1 || t > 16) {
-            fprintf(stderr, "ballast %s: --threads %s: not a whole number from 1 to 16\n", cmd,
-                    a->threads);
-            return 2;
-        }
-    }
     if (load(sc, a, &err) || bal_sim_create(sim, sc, &err) ||
-        (a->threads && bal_sim_set_threads(*sim, atoi(a->threads), &err))) {
+        (a->threads && bal_sim_set_threads(*sim, a->n_threads, &err))) {
         fprintf(stderr, "%s\n", err.msg);
         bal_sim_free(*sim);
         *sim = NULL;

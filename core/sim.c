@@ -938,6 +938,12 @@ void bal_sim_memory(const struct bal_sim *s, double *disc_bytes, double *pair_by
     double p = list_bytes(&s->pp) + list_bytes(&s->pw);
     p += (double)rs->cap * (sizeof *rs->key + sizeof *rs->map + sizeof *rs->bytes) +
          (double)rs->col_cap * sizeof *rs->col;
+    /* threads: the chunks' friction sums, the logs of ranges after the
+     * first, the blocks' sums */
+    p += (double)s->par.chunk_cap * sizeof *s->par.chunk_sums;
+    for (int t = 0; t < BAL_MAX_THREADS; t++)
+        p += (double)s->par.log_cap[t] * sizeof *s->par.log[t];
+    d += 2.0 * ((s->n + BAL_DISC_BLOCK - 1) / BAL_DISC_BLOCK + 1) * sizeof *s->par.block_sums;
     *disc_bytes = d;
     *pair_bytes = p;
 }

@@ -174,7 +174,6 @@ struct bal_integrator_type {
  * - the sums over candidates (the friction loss) and over discs (the audit's
  *   sums of the velocity update) add up fixed blocks, then the blocks in
  *   order, whatever the number of threads. */
-#define BAL_MAX_THREADS 16
 struct bal_sum_log {             /* what range t adds to disc k, logged */
     double fx, fy, tq;
     float dfx, dfy, dtq;
@@ -193,6 +192,7 @@ struct bal_par {
     long chunk_cap;
     double *block_sums;          /* per block of discs, 2 each: a pass's sums (integrate.c) */
 };
+#define BAL_DISC_BLOCK 4096          /* discs per block */
 
 struct bal_sim {
     const struct bal_scene *scene;

@@ -17,8 +17,9 @@ DENSE = REPO / "cases" / "bench" / "dense.scene"
 
 needs_ballast = pytest.mark.skipif(not BALLAST.exists(), reason="bin/ballast not built")
 
-# 12 000 discs: enough candidates for two ranges (16 chunks of 256 each at least).
-SETS = ["fill.pack.n=12000", "fill.pack.columns=155", "stage.settle.cycles=400",
+# 20 000 discs: about 40 000 candidates from the first cycle on, well above the two ranges
+# of 16 chunks of 256 that 2 threads need (check_threads.c asserts the cut itself).
+SETS = ["fill.pack.n=20000", "fill.pack.columns=200", "stage.settle.cycles=300",
         "stage.measure.cycles=100"]
 
 
@@ -46,6 +47,7 @@ def test_two_threads_write_what_one_writes(tmp_path):
     names = sorted(p.name for p in one.iterdir())
     assert names == sorted(p.name for p in two.iterdir())
     assert "contacts.tsv" in names and "discs.tsv" in names
+    assert json.loads((two / "run.json").read_text())["candidates"] > 2 * 16 * 256
     for name in names:
         if name == "run.json":
             assert without_clock(one / name, 1) == without_clock(two / name, 2)
@@ -61,3 +63,11 @@ def test_bad_thread_count_is_bad_input(tmp_path, count):
     assert done.returncode == 2
     assert "--threads" in done.stderr
     assert not out.exists()
+
+
+@needs_ballast
+def test_every_command_checks_the_thread_count():
+    done = subprocess.run([str(BALLAST), "info", str(DENSE), "--threads", "99"],
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2
+    assert "--threads 99" in done.stderr

@@ -179,6 +179,9 @@ clear_sums(double *restrict fx, double *restrict fy, double *restrict tq, float 
 /* Ranges shorter than this many chunks are not worth a thread. */
 #define PAR_MIN_CHUNKS 16
 
+/* Chunks of a list of n candidates. */
+static inline long chunks_of(long n) { return (n + CLEAR_CHUNK - 1) / CLEAR_CHUNK; }
+
 static int grow_log(struct bal_par *par, int t, long need)
 {
     if (need <= par->log_cap[t])
@@ -200,7 +203,7 @@ void bal_par_plan(struct bal_sim *s)
 {
     struct bal_par *par = &s->par;
     const struct bal_pairs *p = &s->pp;
-    const long chunks = (p->n + CLEAR_CHUNK - 1) / CLEAR_CHUNK;
+    const long chunks = chunks_of(p->n);
     int ranges = par->threads;
     if (ranges > chunks / PAR_MIN_CHUNKS)
         ranges = (int)(chunks / PAR_MIN_CHUNKS);
@@ -210,6 +213,11 @@ void bal_par_plan(struct bal_sim *s)
     for (int t = 1; t < ranges; t++)
         par->start[t] = chunks * t / ranges * CLEAR_CHUNK;
     par->start[ranges] = p->n;
+    par->zone[0] = -1;
+    par->planned = s->rebuilds;
+    par->ranges = 1;
+    if (ranges == 1)
+        return; /* no zones, no logs: no pass over the list */
     int seen = -1; /* the highest j of the ranges so far */
     for (int t = 0; t < ranges; t++) {
         const int zone = seen;
@@ -220,20 +228,17 @@ void bal_par_plan(struct bal_sim *s)
             seen = p->j[c] > seen ? p->j[c] : seen;
         }
         if (t > 0 && !grow_log(par, t, logged)) {
-            ranges = 1;
-            par->start[1] = p->n;
-            par->zone[0] = -1;
-            break;
+            par->start[1] = p->n; /* one range after all */
+            return;
         }
     }
     par->ranges = ranges;
-    par->planned = s->rebuilds;
 }
 
 enum bal_status bal_par_reserve_chunks(struct bal_sim *s)
 {
     struct bal_par *par = &s->par;
-    const long need = (s->pp.cap + CLEAR_CHUNK - 1) / CLEAR_CHUNK + 1;
+    const long need = chunks_of(s->pp.cap) + 1;
     if (need <= par->chunk_cap)
         return BAL_OK;
     double *q = realloc(par->chunk_sums, (size_t)need * sizeof *q);
@@ -506,7 +511,7 @@ pair_loop(struct bal_sim *restrict s, void (*on_threads)(struct bal_sim *), cons
     }
     if (shear) {
         double lost_fric = 0;
-        const long chunks = (s->pp.n + CLEAR_CHUNK - 1) / CLEAR_CHUNK;
+        const long chunks = chunks_of(s->pp.n);
         for (long k = 0; k < chunks; k++)
             lost_fric += par->chunk_sums[k];
         s->audit.d_friction += lost_fric;

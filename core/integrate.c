@@ -130,9 +130,8 @@ static void moved_scan(struct bal_sim *s)
 /* The centred passes go through the discs in blocks of BAL_DISC_BLOCK; a
  * block's sums are its own, added up block after block, so that they are
  * the same on any number of threads (struct bal_par, sim.h). */
-#define BLOCK BAL_DISC_BLOCK
 
-static inline int blocks_of(const struct bal_sim *s) { return (s->n + BLOCK - 1) / BLOCK; }
+static inline int blocks_of(const struct bal_sim *s) { return s->n > 0 ? bal_disc_blocks(s->n) : 0; }
 
 /* Run body(s, b) for every block b, on s->par.threads threads. */
 #define FOR_BLOCKS(s, b, body)                                                          \
@@ -153,7 +152,7 @@ static inline int blocks_of(const struct bal_sim *s) { return (s->n + BLOCK - 1)
 static void centred_positions_block(struct bal_sim *s, int b)
 {
     const double dt = s->dt;
-    const int from = b * BLOCK, to = from + BLOCK < s->n ? from + BLOCK : s->n;
+    const int from = b * BAL_DISC_BLOCK, to = from + BAL_DISC_BLOCK < s->n ? from + BAL_DISC_BLOCK : s->n;
     double *restrict x = s->x, *restrict y = s->y, *restrict th = s->th;
     const double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
     const double *restrict xr = s->x_ref, *restrict yr = s->y_ref;
@@ -220,7 +219,7 @@ static void centred_previous(const struct bal_sim *s, int i, double *vx, double 
 static inline __attribute__((always_inline)) void
 centred_block(struct bal_sim *s, int b, const int damped, const int dashpots)
 {
-    const int from = b * BLOCK, to = from + BLOCK < s->n ? from + BLOCK : s->n;
+    const int from = b * BAL_DISC_BLOCK, to = from + BAL_DISC_BLOCK < s->n ? from + BAL_DISC_BLOCK : s->n;
     const double dt = s->dt;
     const double half = s->alpha * dt / 2;
     const double keep = 1 - half, scale = 1 / (1 + half);
@@ -481,7 +480,7 @@ enum bal_status bal_integrate_setup(struct bal_sim *s, struct bal_error *err)
 {
     const int which = s->scene->settings.integrator;
     s->integ = &integrators[which >= 0 && which <= BAL_INTEGRATOR_GEAR5 ? which : 0];
-    s->par.block_sums = calloc(2 * (size_t)(blocks_of(s) ? blocks_of(s) : 1), sizeof(double));
+    s->par.block_sums = calloc(2 * (size_t)bal_disc_blocks(s->n), sizeof(double));
     if (!s->par.block_sums)
         return bal_error(err, BAL_ENOMEM, "%s: out of memory (%d discs)", s->scene->path, s->n);
     if (which != BAL_INTEGRATOR_GEAR5)

@@ -80,8 +80,7 @@ struct args {
     const char *cmd, *scene, *out;
     int n_sets;
     char **sets;
-    const char *threads; /* --threads N, or NULL */
-    int n_threads;       /* ... its value, checked */
+    int threads; /* --threads N, checked; 0: not given */
 };
 
 static int parse_args(int argc, char **argv, struct args *a)
@@ -99,15 +98,15 @@ static int parse_args(int argc, char **argv, struct args *a)
         else if (strcmp(argv[k], "--set") == 0 && k + 1 < argc)
             a->sets[a->n_sets++] = argv[++k];
         else if (strcmp(argv[k], "--threads") == 0 && k + 1 < argc) {
-            a->threads = argv[++k];
+            const char *v = argv[++k];
             char *end;
-            const long t = strtol(a->threads, &end, 10);
-            if (*end || end == a->threads || t < 1 || t > BAL_MAX_THREADS) {
-                fprintf(stderr, "ballast: --threads %s: not a whole number from 1 to %d\n",
-                        a->threads, BAL_MAX_THREADS);
+            const long t = strtol(v, &end, 10);
+            if (*end || end == v || t < 1 || t > BAL_MAX_THREADS) {
+                fprintf(stderr, "ballast: --threads %s: not a whole number from 1 to %d\n", v,
+                        BAL_MAX_THREADS);
                 return 0;
             }
-            a->n_threads = (int)t;
+            a->threads = (int)t;
         }
         else if (argv[k][0] != '-' && !a->scene)
             a->scene = argv[k];
@@ -182,7 +181,7 @@ static int prepare(const struct args *a, const char *cmd, struct bal_scene *sc,
         return 2;
     }
     if (load(sc, a, &err) || bal_sim_create(sim, sc, &err) ||
-        (a->threads && bal_sim_set_threads(*sim, a->n_threads, &err))) {
+        (a->threads && bal_sim_set_threads(*sim, a->threads, &err))) {
         fprintf(stderr, "%s\n", err.msg);
         bal_sim_free(*sim);
         *sim = NULL;

@@ -943,7 +943,7 @@ void bal_sim_memory(const struct bal_sim *s, double *disc_bytes, double *pair_by
     p += (double)s->par.chunk_cap * sizeof *s->par.chunk_sums;
     for (int t = 0; t < BAL_MAX_THREADS; t++)
         p += (double)s->par.log_cap[t] * sizeof *s->par.log[t];
-    d += 2.0 * ((s->n + BAL_DISC_BLOCK - 1) / BAL_DISC_BLOCK + 1) * sizeof *s->par.block_sums;
+    d += 2.0 * bal_disc_blocks(s->n) * sizeof *s->par.block_sums;
     *disc_bytes = d;
     *pair_bytes = p;
 }

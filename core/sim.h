@@ -194,6 +194,12 @@ struct bal_par {
 };
 #define BAL_DISC_BLOCK 4096          /* discs per block */
 
+/* Blocks of n discs; at least one, so that block_sums always exists. */
+static inline int bal_disc_blocks(int n)
+{
+    return n > 0 ? (n + BAL_DISC_BLOCK - 1) / BAL_DISC_BLOCK : 1;
+}
+
 struct bal_sim {
     const struct bal_scene *scene;
 

@@ -157,17 +157,17 @@ static inline double viscous(const struct bal_sim *s, double delta)
 
 /* Zero the force sums of discs from..to (inclusive). */
 static inline __attribute__((always_inline)) void
-clear_sums(double *restrict fx, double *restrict fy, double *restrict tq, float *restrict dfx,
-           float *restrict dfy, float *restrict dtq, int from, int to, const int damp)
+clear_sums(double *restrict fx, double *restrict fy, double *restrict tq, float *restrict dsh,
+           int from, int to, const int damp)
 {
     for (int k = from; k <= to; k++) {
         fx[k] = 0;
         fy[k] = 0;
         tq[k] = 0;
         if (damp) {
-            dfx[k] = 0;
-            dfy[k] = 0;
-            dtq[k] = 0;
+            dsh[3 * k] = 0;
+            dsh[3 * k + 1] = 0;
+            dsh[3 * k + 2] = 0;
         }
     }
 }
@@ -295,10 +295,11 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
     const double *restrict r = s->r;
     const int32_t *restrict mat = s->mat;
     double *restrict fx = s->fx, *restrict fy = s->fy, *restrict tq = s->tq;
-    float *restrict dfx = s->dash_fx, *restrict dfy = s->dash_fy, *restrict dtq = s->dash_tq;
+    float *restrict dsh = s->dash;
     const double dt = s->dt, nu = s->nu, delta0 = s->delta0;
     const int n_mat = s->n_mat;
     const struct bal_pair_law *restrict laws = s->law;
+    const struct bal_pair_law *restrict one_law = s->disc_law;
     /* The overlap budget is a share of the smaller radius of each pair: the
      * loop compares with that share of the scene's smallest radius (one
      * compare), and only if some overlap passes it are the pairs judged one
@@ -317,7 +318,7 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
         for (long c = c0; c < c1; c++)
             top = p->j[c] > top ? p->j[c] : top;
         if (top > cleared) {
-            clear_sums(fx, fy, tq, dfx, dfy, dtq, cleared + 1, top, damp);
+            clear_sums(fx, fy, tq, dsh, cleared + 1, top, damp);
             cleared = top;
         }
         double lost_fric = 0; /* energy audit (energy.c) */
@@ -334,7 +335,7 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
                     p->fs[c] = 0;
                 continue;
             }
-            const struct bal_pair_law *L = &laws[mat[i] * n_mat + mat[j]];
+            const struct bal_pair_law *L = one_law ? one_law : &laws[mat[i] * n_mat + mat[j]];
             const double dist = sqrt(d2);
             const double ex = dx / dist, ey = dy / dist;
             const double rvx = vx[i] - vx[j], rvy = vy[i] - vy[j];
@@ -397,10 +398,10 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
                     if (shear)
                         tq[i] += fts * r[i];
                     if (damp) {
-                        dfx[i] -= dcx;
-                        dfy[i] -= dcy;
+                        dsh[3 * i] -= dcx;
+                        dsh[3 * i + 1] -= dcy;
                         if (shear)
-                            dtq[i] += (float)(ds * r[i]);
+                            dsh[3 * i + 2] += (float)(ds * r[i]);
                     }
                 }
                 if (j <= zone)
@@ -412,10 +413,10 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
                     if (shear)
                         tq[j] += fts * r[j];
                     if (damp) {
-                        dfx[j] += dcx;
-                        dfy[j] += dcy;
+                        dsh[3 * j] += dcx;
+                        dsh[3 * j + 1] += dcy;
                         if (shear)
-                            dtq[j] += (float)(ds * r[j]);
+                            dsh[3 * j + 2] += (float)(ds * r[j]);
                     }
                 }
                 continue;
@@ -431,13 +432,13 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
             if (damp) {
                 /* the dashpots' share, for their work at t_N (energy.c) */
                 const float dcx = (float)(dn * ex + ds * ey), dcy = (float)(dn * ey - ds * ex);
-                dfx[i] -= dcx;
-                dfy[i] -= dcy;
-                dfx[j] += dcx;
-                dfy[j] += dcy;
+                dsh[3 * i] -= dcx;
+                dsh[3 * i + 1] -= dcy;
+                dsh[3 * j] += dcx;
+                dsh[3 * j + 1] += dcy;
                 if (shear) {
-                    dtq[i] += (float)(ds * r[i]);
-                    dtq[j] += (float)(ds * r[j]);
+                    dsh[3 * i + 2] += (float)(ds * r[i]);
+                    dsh[3 * j + 2] += (float)(ds * r[j]);
                 }
             }
         }
@@ -469,8 +470,7 @@ pair_range(struct bal_sim *restrict s, int t, const int law, const int shear, co
         st = logged_chunks(s, t, st, law, shear, damp);
     st = range_chunks(s, t, st, law, shear, damp, 0);
     if (t == s->par.ranges - 1)
-        clear_sums(s->fx, s->fy, s->tq, s->dash_fx, s->dash_fy, s->dash_tq, st.cleared + 1,
-                   s->n - 1, damp);
+        clear_sums(s->fx, s->fy, s->tq, s->dash, st.cleared + 1, s->n - 1, damp);
     s->par.over[t] = st.over;
 }
 
@@ -490,7 +490,7 @@ pair_loop(struct bal_sim *restrict s, void (*on_threads)(struct bal_sim *), cons
     else
         on_threads(s);
     double *restrict fx = s->fx, *restrict fy = s->fy, *restrict tq = s->tq;
-    float *restrict dfx = s->dash_fx, *restrict dfy = s->dash_fy, *restrict dtq = s->dash_tq;
+    float *restrict dsh = s->dash;
     int over = par->over[0];
     for (int t = 1; t < ranges; t++) {
         over |= par->over[t];
@@ -502,10 +502,10 @@ pair_loop(struct bal_sim *restrict s, void (*on_threads)(struct bal_sim *), cons
             if (shear)
                 tq[k] += log[e].tq;
             if (damp) {
-                dfx[k] += log[e].dfx;
-                dfy[k] += log[e].dfy;
+                dsh[3 * k] += log[e].dfx;
+                dsh[3 * k + 1] += log[e].dfy;
                 if (shear)
-                    dtq[k] += log[e].dtq;
+                    dsh[3 * k + 2] += log[e].dtq;
             }
         }
     }
@@ -631,12 +631,12 @@ void bal_contacts_walls(struct bal_sim *s)
         }
         const double dn = (L->cn + viscous(s, ri - dist)) * ndot;
         const double ds = (!shear || (flags & BAL_PAIR_SLIDING)) ? 0.0 : L->cs * sdot;
-        if (s->dash_fx) {
+        if (s->dash) {
             /* the dashpots' share on the disc, and their power on the wall
              * side (its velocity is prescribed): energy.c */
-            s->dash_fx[i] -= (float)(dn * ex + ds * tx);
-            s->dash_fy[i] -= (float)(dn * ey + ds * ty);
-            s->dash_tq[i] += (float)(ds * ri);
+            s->dash[3 * i] -= (float)(dn * ex + ds * tx);
+            s->dash[3 * i + 1] -= (float)(dn * ey + ds * ty);
+            s->dash[3 * i + 2] += (float)(ds * ri);
             wall_dash += dn * (wvx * ex + wvy * ey) + ds * (wvx * tx + wvy * ty);
         }
         p->fn[c] = fn;

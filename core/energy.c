@@ -178,14 +178,15 @@ static double dashpot_loss(const struct bal_sim *s)
     for (int i = 0; i < s->n; i++) {
         double vx, vy, w;
         bal_measure_velocity(s, i, &vx, &vy, &w);
-        p += (double)s->dash_fx[i] * vx + (double)s->dash_fy[i] * vy + (double)s->dash_tq[i] * w;
+        p += (double)s->dash[3 * i] * vx + (double)s->dash[3 * i + 1] * vy +
+             (double)s->dash[3 * i + 2] * w;
     }
     return -(p + s->audit.wall_dash) * s->dt;
 }
 
 void bal_energy_dashpots(struct bal_sim *s)
 {
-    if (!s->dash_fx)
+    if (!s->dash)
         return;
     const double loss = dashpot_loss(s);
     s->audit.d_dashpot += loss;

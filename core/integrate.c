@@ -227,7 +227,7 @@ centred_block(struct bal_sim *s, int b, const int damped, const int dashpots)
     double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
     const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict tq = s->tq;
     const double *restrict im = s->inv_m, *restrict ii = s->inv_i;
-    const float *restrict dfx = s->dash_fx, *restrict dfy = s->dash_fy, *restrict dtq = s->dash_tq;
+    const float *restrict dsh = s->dash;
     const uint8_t *restrict fixed = s->fixed;
     double glob = 0, dash = 0;
     for (int i = from; i < to; i++) {
@@ -248,7 +248,7 @@ centred_block(struct bal_sim *s, int b, const int damped, const int dashpots)
         if (damped)
             glob += (cx * cx + cy * cy) / im[i] + cw * cw / ii[i];
         if (dashpots)
-            dash += (double)dfx[i] * cx + (double)dfy[i] * cy + (double)dtq[i] * cw;
+            dash += (double)dsh[3 * i] * cx + (double)dsh[3 * i + 1] * cy + (double)dsh[3 * i + 2] * cw;
     }
     s->par.block_sums[2 * b] = glob;
     s->par.block_sums[2 * b + 1] = dash;
@@ -269,7 +269,7 @@ centred_update(struct bal_sim *s, const int damped, const int dashpots)
 
 static void centred_velocities(struct bal_sim *s)
 {
-    const int damped = s->alpha != 0, dashpots = s->dash_fx != NULL;
+    const int damped = s->alpha != 0, dashpots = s->dash != NULL;
     if (damped && dashpots)
         centred_update(s, 1, 1);
     else if (damped)

@@ -75,9 +75,7 @@ void bal_sim_free(struct bal_sim *s)
                          &s->inv_m, &s->inv_i, &s->fx, &s->fy, &s->tq, &s->x_ref, &s->y_ref};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(*arrays[k]);
-    free(s->dash_fx);
-    free(s->dash_fy);
-    free(s->dash_tq);
+    free(s->dash);
     free(s->density);
     free(s->id);
     free(s->slot);
@@ -497,10 +495,8 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         *arrays[k] = alloc_doubles((size_t)n, &ok);
     if (s->has_damping) {
         const size_t nf = (size_t)(n ? n : 1);
-        s->dash_fx = calloc(nf, sizeof *s->dash_fx);
-        s->dash_fy = calloc(nf, sizeof *s->dash_fy);
-        s->dash_tq = calloc(nf, sizeof *s->dash_tq);
-        ok = ok && s->dash_fx && s->dash_fy && s->dash_tq;
+        s->dash = calloc(3 * nf, sizeof *s->dash);
+        ok = ok && s->dash;
     }
     s->density = alloc_doubles((size_t)s->n_mat, &ok);
     for (int m = 0; ok && m < s->n_mat; m++)
@@ -557,6 +553,10 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         s->inv_i[i] = 1 / bal_inertia(s, i);
     }
     free_init(&d);
+    s->disc_law = n > 0 ? &s->law[s->mat[0] * s->n_mat + s->mat[0]] : NULL;
+    for (int i = 1; i < n && s->disc_law; i++)
+        if (s->mat[i] != s->mat[0])
+            s->disc_law = NULL;
 
     /* Time step. */
     s->start_energy = start_energy(s, sc);
@@ -931,8 +931,8 @@ void bal_sim_memory(const struct bal_sim *s, double *disc_bytes, double *pair_by
         d += 4 * n * sizeof *s->moment_prev;
     if (s->gear)
         d += BAL_GEAR_COLUMNS * n * sizeof *s->gear;
-    if (s->dash_fx)
-        d += 3 * n * sizeof *s->dash_fx;
+    if (s->dash)
+        d += 3 * n * sizeof *s->dash;
     d += (double)s->grid.cells_cap * sizeof *s->grid.start;
     const struct bal_rebuild_scratch *rs = &s->rs;
     double p = list_bytes(&s->pp) + list_bytes(&s->pw);

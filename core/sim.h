@@ -211,8 +211,10 @@ struct bal_sim {
     double *vx, *vy, *w;         /* velocities at t_{N-1/2} (t_{N+1/2} after a step) */
     double *r, *inv_m, *inv_i;   /* radius, 1/m, 1/I (m and I: bal_mass, bal_inertia) */
     double *fx, *fy, *tq;        /* force and moment sums of the last cycle */
-    float *dash_fx, *dash_fy, *dash_tq; /* the dashpots' part of them (only with damping:
-                                  * the energy audit; float: it needs 1e-6, not 1e-16) */
+    float *dash;                 /* the dashpots' part of them, 3 per disc: x, y, moment
+                                  * (only with damping: the energy audit; float: it
+                                  * needs 1e-6, not 1e-16; one array, not three: the
+                                  * pair loop of a large packing reads fewer streams) */
     double *x_ref, *y_ref;       /* positions at the last rebuild */
     int32_t *mat;
     uint8_t *fixed;
@@ -226,6 +228,9 @@ struct bal_sim {
     double *density;             /* per material: mass per area */
     int n_mat;
     struct bal_pair_law *law;    /* n_mat × n_mat */
+    const struct bal_pair_law *disc_law; /* the law of every disc pair when all discs
+                                  * are of one material (the pair loop then reads no
+                                  * material column), else NULL */
 
     /* contacts and neighbours */
     struct bal_pairs pp, pw;     /* disc–disc, disc–wall candidates */

@@ -868,6 +868,57 @@ START_TEST(contacts_psi_removes_force_jump)
 }
 END_TEST
 
+/* A scene whose discs are all of one material takes the law of every disc
+ * pair once (s->disc_law) and reads no material column in the pair loop.
+ * The same falling packing with every other disc switched to a second
+ * material of the same parameters takes the general path (disc_law NULL,
+ * as creation sets it for mixed materials) and must give bitwise the same
+ * positions, velocities and forces: the one law is the right one. */
+static const char *const one_mat_fmt =
+    "[settings]\ndt = 5e-4\ngravity = 0 -60\nbeta = 0.01\n"
+    "[material grain]\nkn = 1e5\nks = 7e4\nfriction = 0.4\ncohesion = 3\ndensity = 1\n"
+    "[material twin]\nkn = 1e5\nks = 7e4\nfriction = 0.4\ncohesion = 3\ndensity = 1\n"
+    "[material box]\nkn = 3e5\nks = 1e5\nfriction = 0.2\n"
+    "[fill pack]\nn = 400\ncolumns = 20\nrmin = 0.5\nrmax = 0.75\nseed = 3\nbox = 1\n"
+    "headroom = 2\nvmax = 2\nmaterial = grain\nwall_material = box\n[stage s]\ncycles = 100000\n%s";
+
+START_TEST(contacts_one_material_law)
+{
+    struct tfx *one = tfx_newf("one", one_mat_fmt, "");
+    struct tfx *mixed = tfx_newf("mixed", one_mat_fmt, "");
+    struct bal_sim *a = one->sim, *b = mixed->sim;
+    const int grain = a->mat[0], twin = bal_scene_find(&one->sc, BAL_SEC_MATERIAL, "twin");
+    ck_assert_int_ne(twin, grain);
+    ck_assert_ptr_eq(a->disc_law, &a->law[grain * a->n_mat + grain]);
+    for (int i = 1; i < b->n; i += 2)
+        b->mat[i] = twin;
+    b->disc_law = NULL;
+    t_steps(one, 1500);
+    t_steps(mixed, 1500);
+    long contacts = 0;
+    for (long c = 0; c < a->pp.n; c++)
+        contacts += (a->pp.flags[c] & BAL_PAIR_TOUCHING) != 0;
+    ck_assert_int_gt(contacts, 200); /* the discs collide */
+    const size_t n = (size_t)a->n * sizeof(double);
+    ck_assert(memcmp(a->x, b->x, n) == 0 && memcmp(a->y, b->y, n) == 0);
+    ck_assert(memcmp(a->vx, b->vx, n) == 0 && memcmp(a->w, b->w, n) == 0);
+    ck_assert(memcmp(a->fx, b->fx, n) == 0 && memcmp(a->tq, b->tq, n) == 0);
+    tfx_release(one);
+    tfx_release(mixed);
+
+    /* creation: discs of two materials have no single law */
+    struct tfx *two = tfx_newf("two", "[settings]\ndt = 1e-4\n"
+                                      "[material m]\nkn = 1e5\nks = 1e5\nfriction = 0.5\ndensity = 1\n"
+                                      "[material q]\nkn = 2e5\nks = 1e5\nfriction = 0.5\ndensity = 1\n"
+                                      "[disc a]\nx = 0 0\nr = 0.5\nmaterial = m\n"
+                                      "[disc b]\nx = 0.9 0\nr = 0.5\nmaterial = q\n"
+                                      "[stage s]\ncycles = 1\n%s",
+                               "");
+    ck_assert_ptr_null(two->sim->disc_law);
+    tfx_release(two);
+}
+END_TEST
+
 /* Every cycle starts the force sums from zero: the pair loop zeroes them
  * chunk by chunk, up to each chunk's highest j, and the rest at its end
  * (contacts.c).  Sums poisoned with NaN before a cycle must come out as the
@@ -892,10 +943,10 @@ START_TEST(contacts_sums_restart_each_cycle)
         kn);
     struct bal_sim *s = f->sim;
     ck_assert_int_eq(s->use_grid, 1);
-    ck_assert_ptr_nonnull(s->dash_fx);
+    ck_assert_ptr_nonnull(s->dash);
     for (int i = 0; i < s->n; i++) {
         s->fx[i] = s->fy[i] = s->tq[i] = NAN;
-        s->dash_fx[i] = s->dash_fy[i] = s->dash_tq[i] = NAN;
+        s->dash[3 * i] = s->dash[3 * i + 1] = s->dash[3 * i + 2] = NAN;
     }
     t_steps(f, 1);
     const char *const apart[] = {"a", "b", "c"};
@@ -903,7 +954,7 @@ START_TEST(contacts_sums_restart_each_cycle)
         const int i = t_slot(f, apart[k]);
         ck_assert_msg(s->fx[i] == 0 && s->fy[i] == 0 && s->tq[i] == 0, "disc %s: sums not zero",
                       apart[k]);
-        ck_assert(s->dash_fx[i] == 0 && s->dash_fy[i] == 0 && s->dash_tq[i] == 0);
+        ck_assert(s->dash[3 * i] == 0 && s->dash[3 * i + 1] == 0 && s->dash[3 * i + 2] == 0);
     }
     ck_assert_int_lt(t_slot(f, "a"), t_slot(f, "p")); /* before, between, after the pairs */
     ck_assert_int_gt(t_slot(f, "b"), t_slot(f, "q"));
@@ -917,7 +968,7 @@ START_TEST(contacts_sums_restart_each_cycle)
         ASSERT_REL(s->fx[i], -fn);
         ASSERT_REL(s->fx[j], fn);
         ck_assert(s->fy[i] == 0 && s->fy[j] == 0 && s->tq[i] == 0 && s->tq[j] == 0);
-        ck_assert(s->dash_fx[i] == 0 && s->dash_fx[j] == 0);
+        ck_assert(s->dash[3 * i] == 0 && s->dash[3 * j] == 0);
     }
 }
 END_TEST
@@ -934,6 +985,7 @@ Suite *suite_contacts(void)
     tcase_add_test(tc, contacts_pair_stiffness);
     tcase_add_test(tc, contacts_no_tension_and_reset);
     tcase_add_test(tc, contacts_sums_restart_each_cycle);
+    tcase_add_test(tc, contacts_one_material_law);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("friction");

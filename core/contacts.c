@@ -157,13 +157,12 @@ static inline double viscous(const struct bal_sim *s, double delta)
 
 /* Zero the force sums of discs from..to (inclusive). */
 static inline __attribute__((always_inline)) void
-clear_sums(double *restrict fx, double *restrict fy, double *restrict tq, float *restrict dsh,
-           int from, int to, const int damp)
+clear_sums(double *restrict f, float *restrict dsh, int from, int to, const int damp)
 {
     for (int k = from; k <= to; k++) {
-        fx[k] = 0;
-        fy[k] = 0;
-        tq[k] = 0;
+        f[3 * k] = 0;
+        f[3 * k + 1] = 0;
+        f[3 * k + 2] = 0;
         if (damp) {
             dsh[3 * k] = 0;
             dsh[3 * k + 1] = 0;
@@ -294,7 +293,7 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
     const double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
     const double *restrict r = s->r;
     const int32_t *restrict mat = s->mat;
-    double *restrict fx = s->fx, *restrict fy = s->fy, *restrict tq = s->tq;
+    double *restrict f = s->f;
     float *restrict dsh = s->dash;
     const double dt = s->dt, nu = s->nu, delta0 = s->delta0;
     const int n_mat = s->n_mat;
@@ -318,7 +317,7 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
         for (long c = c0; c < c1; c++)
             top = p->j[c] > top ? p->j[c] : top;
         if (top > cleared) {
-            clear_sums(fx, fy, tq, dsh, cleared + 1, top, damp);
+            clear_sums(f, dsh, cleared + 1, top, damp);
             cleared = top;
         }
         double lost_fric = 0; /* energy audit (energy.c) */
@@ -393,10 +392,10 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
                     log[n_log++] = (struct bal_sum_log){-fcx, -fcy, fts * r[i], -dcx, -dcy,
                                                         (float)(ds * r[i]), i};
                 else {
-                    fx[i] -= fcx;
-                    fy[i] -= fcy;
+                    f[3 * i] -= fcx;
+                    f[3 * i + 1] -= fcy;
                     if (shear)
-                        tq[i] += fts * r[i];
+                        f[3 * i + 2] += fts * r[i];
                     if (damp) {
                         dsh[3 * i] -= dcx;
                         dsh[3 * i + 1] -= dcy;
@@ -408,10 +407,10 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
                     log[n_log++] = (struct bal_sum_log){fcx, fcy, fts * r[j], dcx, dcy,
                                                         (float)(ds * r[j]), j};
                 else {
-                    fx[j] += fcx;
-                    fy[j] += fcy;
+                    f[3 * j] += fcx;
+                    f[3 * j + 1] += fcy;
                     if (shear)
-                        tq[j] += fts * r[j];
+                        f[3 * j + 2] += fts * r[j];
                     if (damp) {
                         dsh[3 * j] += dcx;
                         dsh[3 * j + 1] += dcy;
@@ -421,13 +420,13 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
                 }
                 continue;
             }
-            fx[i] -= fcx;
-            fy[i] -= fcy;
-            fx[j] += fcx;
-            fy[j] += fcy;
+            f[3 * i] -= fcx;
+            f[3 * i + 1] -= fcy;
+            f[3 * j] += fcx;
+            f[3 * j + 1] += fcy;
             if (shear) {
-                tq[i] += fts * r[i];
-                tq[j] += fts * r[j];
+                f[3 * i + 2] += fts * r[i];
+                f[3 * j + 2] += fts * r[j];
             }
             if (damp) {
                 /* the dashpots' share, for their work at t_N (energy.c) */
@@ -470,7 +469,7 @@ pair_range(struct bal_sim *restrict s, int t, const int law, const int shear, co
         st = logged_chunks(s, t, st, law, shear, damp);
     st = range_chunks(s, t, st, law, shear, damp, 0);
     if (t == s->par.ranges - 1)
-        clear_sums(s->fx, s->fy, s->tq, s->dash, st.cleared + 1, s->n - 1, damp);
+        clear_sums(s->f, s->dash, st.cleared + 1, s->n - 1, damp);
     s->par.over[t] = st.over;
 }
 
@@ -489,7 +488,7 @@ pair_loop(struct bal_sim *restrict s, void (*on_threads)(struct bal_sim *), cons
         pair_range(s, 0, law, shear, damp);
     else
         on_threads(s);
-    double *restrict fx = s->fx, *restrict fy = s->fy, *restrict tq = s->tq;
+    double *restrict f = s->f;
     float *restrict dsh = s->dash;
     int over = par->over[0];
     for (int t = 1; t < ranges; t++) {
@@ -497,10 +496,10 @@ pair_loop(struct bal_sim *restrict s, void (*on_threads)(struct bal_sim *), cons
         const struct bal_sum_log *restrict log = par->log[t];
         for (long e = 0; e < par->log_n[t]; e++) {
             const int k = log[e].k;
-            fx[k] += log[e].fx;
-            fy[k] += log[e].fy;
+            f[3 * k] += log[e].fx;
+            f[3 * k + 1] += log[e].fy;
             if (shear)
-                tq[k] += log[e].tq;
+                f[3 * k + 2] += log[e].tq;
             if (damp) {
                 dsh[3 * k] += log[e].dfx;
                 dsh[3 * k + 1] += log[e].dfy;
@@ -648,9 +647,9 @@ void bal_contacts_walls(struct bal_sim *s)
         const double ftn = fn + dn, fts = fs + ds;
         const double fcx = ftn * ex + fts * tx;
         const double fcy = ftn * ey + fts * ty;
-        s->fx[i] -= fcx;
-        s->fy[i] -= fcy;
-        s->tq[i] += fts * ri;
+        s->f[3 * i] -= fcx;
+        s->f[3 * i + 1] -= fcy;
+        s->f[3 * i + 2] += fts * ri;
         W->f[0] += fcx;
         W->f[1] += fcy;
         W->moment += (cx - W->p[0]) * fcy - (cy - W->p[1]) * fcx;

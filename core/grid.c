@@ -419,8 +419,9 @@ enum bal_status bal_grid_reorder(struct bal_sim *s, struct bal_error *err)
     const int n = s->n;
     if (n >= 2) {
         /* The sort keys (2 doubles a disc) and the permutation buffer live
-         * in the rebuild scratch column; stress moments need 4 a disc. */
-        const long need = (s->moment_prev ? 4L : 2L) * n;
+         * in the rebuild scratch column; the force sums need 3 a disc,
+         * stress moments 4. */
+        const long need = (s->moment_prev ? 4L : 3L) * n;
         if (need > s->rs.col_cap) {
             double *c = realloc(s->rs.col, (size_t)need * sizeof *c);
             if (!c)
@@ -431,10 +432,10 @@ enum bal_status bal_grid_reorder(struct bal_sim *s, struct bal_error *err)
         bal_grid_cell_order(s->x, s->y, n, 2 * s->r_max + s->skin,
                             (struct bal_cell_key *)s->rs.col, s->new2old);
 
-        double *columns[] = {s->x, s->y, s->th, s->vx, s->vy, s->w, s->r, s->inv_m,
-                             s->inv_i, s->fx, s->fy, s->tq};
+        double *columns[] = {s->x, s->y, s->th, s->vx, s->vy, s->w, s->r, s->inv_m, s->inv_i};
         for (size_t k = 0; k < sizeof columns / sizeof columns[0]; k++)
             permute_doubles(s, columns[k], 1);
+        permute_doubles(s, s->f, 3);
         if (s->moment_prev)
             permute_doubles(s, s->moment_prev, 4);
         permute_int32(s, s->id);

@@ -196,9 +196,9 @@ static void centred_previous(const struct bal_sim *s, int i, double *vx, double 
         return;
     }
     const double dt = s->dt, half = s->alpha * dt / 2;
-    const double ax = s->fx[i] * s->inv_m[i] * dt + s->g[0] * s->gfac * dt;
-    const double ay = s->fy[i] * s->inv_m[i] * dt + s->g[1] * s->gfac * dt;
-    const double aw = s->tq[i] * s->inv_i[i] * dt;
+    const double ax = s->f[3 * i] * s->inv_m[i] * dt + s->g[0] * s->gfac * dt;
+    const double ay = s->f[3 * i + 1] * s->inv_m[i] * dt + s->g[1] * s->gfac * dt;
+    const double aw = s->f[3 * i + 2] * s->inv_i[i] * dt;
     if (half == 0) {
         *vx = s->vx[i] - ax;
         *vy = s->vy[i] - ay;
@@ -225,7 +225,7 @@ centred_block(struct bal_sim *s, int b, const int damped, const int dashpots)
     const double keep = 1 - half, scale = 1 / (1 + half);
     const double gxdt = s->g[0] * s->gfac * dt, gydt = s->g[1] * s->gfac * dt;
     double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
-    const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict tq = s->tq;
+    const double *restrict f = s->f;
     const double *restrict im = s->inv_m, *restrict ii = s->inv_i;
     const float *restrict dsh = s->dash;
     const uint8_t *restrict fixed = s->fixed;
@@ -235,13 +235,13 @@ centred_block(struct bal_sim *s, int b, const int damped, const int dashpots)
             continue;
         const double ox = vx[i], oy = vy[i], ow = w[i];
         if (damped) {
-            vx[i] = (ox * keep + fx[i] * im[i] * dt + gxdt) * scale;
-            vy[i] = (oy * keep + fy[i] * im[i] * dt + gydt) * scale;
-            w[i] = (ow * keep + tq[i] * ii[i] * dt) * scale;
+            vx[i] = (ox * keep + f[3 * i] * im[i] * dt + gxdt) * scale;
+            vy[i] = (oy * keep + f[3 * i + 1] * im[i] * dt + gydt) * scale;
+            w[i] = (ow * keep + f[3 * i + 2] * ii[i] * dt) * scale;
         } else {
-            vx[i] = ox + (fx[i] * im[i] * dt + gxdt);
-            vy[i] = oy + (fy[i] * im[i] * dt + gydt);
-            w[i] = ow + tq[i] * ii[i] * dt;
+            vx[i] = ox + (f[3 * i] * im[i] * dt + gxdt);
+            vy[i] = oy + (f[3 * i + 1] * im[i] * dt + gydt);
+            w[i] = ow + f[3 * i + 2] * ii[i] * dt;
         }
         /* twice v_N */
         const double cx = ox + vx[i], cy = oy + vy[i], cw = ow + w[i];
@@ -293,15 +293,15 @@ static void verlet_positions(struct bal_sim *s)
     const double gx = s->g[0] * s->gfac, gy = s->g[1] * s->gfac;
     double *restrict x = s->x, *restrict y = s->y, *restrict th = s->th;
     double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
-    const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict tq = s->tq;
+    const double *restrict f = s->f;
     const double *restrict im = s->inv_m, *restrict ii = s->inv_i;
     const uint8_t *restrict fixed = s->fixed;
     for (int i = 0; i < n; i++) {
         if (fixed[i])
             continue;
-        vx[i] = vx[i] * keep + (fx[i] * im[i] + gx) * hdt;
-        vy[i] = vy[i] * keep + (fy[i] * im[i] + gy) * hdt;
-        w[i] = w[i] * keep + tq[i] * ii[i] * hdt;
+        vx[i] = vx[i] * keep + (f[3 * i] * im[i] + gx) * hdt;
+        vy[i] = vy[i] * keep + (f[3 * i + 1] * im[i] + gy) * hdt;
+        w[i] = w[i] * keep + f[3 * i + 2] * ii[i] * hdt;
         x[i] += vx[i] * dt;
         y[i] += vy[i] * dt;
         th[i] += w[i] * dt;
@@ -317,15 +317,15 @@ static void verlet_velocities(struct bal_sim *s)
     const double scale = 1 / (1 + s->alpha * s->dt / 2);
     const double gx = s->g[0] * s->gfac, gy = s->g[1] * s->gfac;
     double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
-    const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict tq = s->tq;
+    const double *restrict f = s->f;
     const double *restrict im = s->inv_m, *restrict ii = s->inv_i;
     const uint8_t *restrict fixed = s->fixed;
     for (int i = 0; i < n; i++) {
         if (fixed[i])
             continue;
-        vx[i] = (vx[i] + (fx[i] * im[i] + gx) * hdt) * scale;
-        vy[i] = (vy[i] + (fy[i] * im[i] + gy) * hdt) * scale;
-        w[i] = (w[i] + tq[i] * ii[i] * hdt) * scale;
+        vx[i] = (vx[i] + (f[3 * i] * im[i] + gx) * hdt) * scale;
+        vy[i] = (vy[i] + (f[3 * i + 1] * im[i] + gy) * hdt) * scale;
+        w[i] = (w[i] + f[3 * i + 2] * ii[i] * hdt) * scale;
     }
 }
 
@@ -337,9 +337,9 @@ static void verlet_previous(const struct bal_sim *s, int i, double *vx, double *
         return;
     }
     const double hdt = s->dt / 2, undo = 1 + s->alpha * s->dt / 2;
-    *vx = s->vx[i] * undo - (s->fx[i] * s->inv_m[i] + s->g[0] * s->gfac) * hdt;
-    *vy = s->vy[i] * undo - (s->fy[i] * s->inv_m[i] + s->g[1] * s->gfac) * hdt;
-    *w = s->w[i] * undo - s->tq[i] * s->inv_i[i] * hdt;
+    *vx = s->vx[i] * undo - (s->f[3 * i] * s->inv_m[i] + s->g[0] * s->gfac) * hdt;
+    *vy = s->vy[i] * undo - (s->f[3 * i + 1] * s->inv_m[i] + s->g[1] * s->gfac) * hdt;
+    *w = s->w[i] * undo - s->f[3 * i + 2] * s->inv_i[i] * hdt;
 }
 
 /* ------------------------------------------------------------------ */
@@ -431,19 +431,19 @@ static void gear_velocities(struct bal_sim *s)
     const int n = s->n;
     const double half_dt2 = s->dt * s->dt / 2, inv_dt = 1 / s->dt, alpha = s->alpha;
     double *q[3] = {s->x, s->y, s->th}, *v[3] = {s->vx, s->vy, s->w};
-    const double *f[3] = {s->fx, s->fy, s->tq}, *inv[3] = {s->inv_m, s->inv_m, s->inv_i};
+    const double *inv[3] = {s->inv_m, s->inv_m, s->inv_i};
     const double g[3] = {s->g[0] * s->gfac, s->g[1] * s->gfac, 0};
     for (int k = 0; k < 3; k++) {
         double *restrict qk = q[k], *restrict vk = v[k];
         double *restrict r2 = gear_col(s, GEAR_R2 + k), *restrict r3 = gear_col(s, GEAR_R3 + k);
         double *restrict r4 = gear_col(s, GEAR_R4 + k), *restrict r5 = gear_col(s, GEAR_R5 + k);
-        const double *restrict fk = f[k], *restrict ik = inv[k];
+        const double *restrict fk = s->f + k, *restrict ik = inv[k];
         const uint8_t *restrict fixed = s->fixed;
         const double gk = g[k];
         for (int i = 0; i < n; i++) {
             if (fixed[i])
                 continue;
-            const double acc = fk[i] * ik[i] + gk - alpha * vk[i];
+            const double acc = fk[3 * i] * ik[i] + gk - alpha * vk[i];
             gear_correct(&qk[i], &vk[i], &r2[i], &r3[i], &r4[i], &r5[i], acc, half_dt2, inv_dt);
         }
     }

@@ -115,7 +115,7 @@ double bal_measure_unbalanced(const struct bal_sim *s)
         if (s->fixed[i])
             continue;
         const double m = bal_mass(s, i);
-        const double sx = s->fx[i] + m * s->g[0], sy = s->fy[i] + m * s->g[1];
+        const double sx = s->f[3 * i] + m * s->g[0], sy = s->f[3 * i + 1] + m * s->g[1];
         smax = fmax(smax, hypot(sx, sy));
     }
     return smax / fbig;
@@ -255,10 +255,10 @@ double bal_measure_probe(const struct bal_sim *s, int probe)
     case BAL_PROBE_HELD_FX:
     case BAL_PROBE_HELD_FY: {
         double f = 0;
-        const double *fc = p->kind == BAL_PROBE_HELD_FX ? s->fx : s->fy;
+        const int k = p->kind == BAL_PROBE_HELD_FX ? 0 : 1;
         for (int i = 0; i < s->n; i++)
             if (s->fixed[i])
-                f += fc[i];
+                f += s->f[3 * i + k];
         return f;
     }
     case BAL_PROBE_WEIGHT_X:

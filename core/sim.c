@@ -72,7 +72,7 @@ void bal_sim_free(struct bal_sim *s)
     if (!s)
         return;
     double **arrays[] = {&s->x, &s->y, &s->th, &s->vx, &s->vy, &s->w, &s->r,
-                         &s->inv_m, &s->inv_i, &s->fx, &s->fy, &s->tq, &s->x_ref, &s->y_ref};
+                         &s->inv_m, &s->inv_i, &s->f, &s->x_ref, &s->y_ref};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         free(*arrays[k]);
     free(s->dash);
@@ -490,9 +490,10 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
 
     int ok = 1;
     double **arrays[] = {&s->x, &s->y, &s->th, &s->vx, &s->vy, &s->w, &s->r,
-                         &s->inv_m, &s->inv_i, &s->fx, &s->fy, &s->tq, &s->x_ref, &s->y_ref};
+                         &s->inv_m, &s->inv_i, &s->x_ref, &s->y_ref};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         *arrays[k] = alloc_doubles((size_t)n, &ok);
+    s->f = alloc_doubles(3 * (size_t)n, &ok);
     if (s->has_damping) {
         const size_t nf = (size_t)(n ? n : 1);
         s->dash = calloc(3 * nf, sizeof *s->dash);

@@ -210,7 +210,8 @@ struct bal_sim {
     double *x, *y, *th;          /* position, rotation */
     double *vx, *vy, *w;         /* velocities at t_{N-1/2} (t_{N+1/2} after a step) */
     double *r, *inv_m, *inv_i;   /* radius, 1/m, 1/I (m and I: bal_mass, bal_inertia) */
-    double *fx, *fy, *tq;        /* force and moment sums of the last cycle */
+    double *f;                   /* force and moment sums of the last cycle, 3 per disc:
+                                  * F_x, F_y, M (one array: one stream in the pair loop) */
     float *dash;                 /* the dashpots' part of them, 3 per disc: x, y, moment
                                   * (only with damping: the energy audit; float: it
                                   * needs 1e-6, not 1e-16; one array, not three: the

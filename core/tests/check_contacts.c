@@ -120,15 +120,15 @@ START_TEST(contacts_normal_force_sign)
     ASSERT_REL(L->fn[c], fn);
     ck_assert_double_eq(pair_fs(L, c), 0.0);
     const struct bal_sim *s = f->sim;
-    ASSERT_REL(s->fx[ip], -fn * e[0]);
-    ASSERT_REL(s->fy[ip], -fn * e[1]);
-    ASSERT_REL(s->fx[iq], fn * e[0]);
-    ASSERT_REL(s->fy[iq], fn * e[1]);
-    ck_assert_double_eq(s->fx[ip] + s->fx[iq], 0.0); /* equal and opposite */
-    ck_assert_double_eq(s->fy[ip] + s->fy[iq], 0.0);
-    ck_assert(s->fx[ip] * e[0] + s->fy[ip] * e[1] < 0); /* pointing apart */
-    ck_assert(s->fx[iq] * e[0] + s->fy[iq] * e[1] > 0);
-    ck_assert_double_eq(s->tq[ip], 0.0);
+    ASSERT_REL(s->f[3 * ip], -fn * e[0]);
+    ASSERT_REL(s->f[3 * ip + 1], -fn * e[1]);
+    ASSERT_REL(s->f[3 * iq], fn * e[0]);
+    ASSERT_REL(s->f[3 * iq + 1], fn * e[1]);
+    ck_assert_double_eq(s->f[3 * ip] + s->f[3 * iq], 0.0); /* equal and opposite */
+    ck_assert_double_eq(s->f[3 * ip + 1] + s->f[3 * iq + 1], 0.0);
+    ck_assert(s->f[3 * ip] * e[0] + s->f[3 * ip + 1] * e[1] < 0); /* pointing apart */
+    ck_assert(s->f[3 * iq] * e[0] + s->f[3 * iq + 1] * e[1] > 0);
+    ck_assert_double_eq(s->f[3 * ip + 2], 0.0);
     /* eq. (22): v_{3/2} = v_{1/2} + F/m Δt. */
     ASSERT_REL(s->vx[ip], up * e[0] - fn * e[0] / mass(RP) * DT);
     ASSERT_REL(s->vy[iq], -uq * e[1] + fn * e[1] / mass(RQ) * DT);
@@ -174,14 +174,14 @@ START_TEST(contacts_shear_force_sign)
     ck_assert(fs > 0);
     ASSERT_REL(pair_fs(L, c), fs);
     ck_assert_int_eq(L->flags[c], BAL_PAIR_TOUCHING); /* sticking */
-    ASSERT_REL(s->fx[ip], -fs * t1[0]);
-    ASSERT_REL(s->fy[ip], -fs * t1[1]);
-    ASSERT_REL(s->fx[iq], fs * t1[0]);
-    ASSERT_REL(s->fy[iq], fs * t1[1]);
-    ck_assert(s->fx[ip] * t[0] + s->fy[ip] * t[1] < 0); /* along −t on x */
-    ASSERT_REL(s->tq[ip], fs * RP);
-    ASSERT_REL(s->tq[iq], fs * RQ);
-    ck_assert(s->tq[ip] > 0 && s->tq[iq] > 0);
+    ASSERT_REL(s->f[3 * ip], -fs * t1[0]);
+    ASSERT_REL(s->f[3 * ip + 1], -fs * t1[1]);
+    ASSERT_REL(s->f[3 * iq], fs * t1[0]);
+    ASSERT_REL(s->f[3 * iq + 1], fs * t1[1]);
+    ck_assert(s->f[3 * ip] * t[0] + s->f[3 * ip + 1] * t[1] < 0); /* along −t on x */
+    ASSERT_REL(s->f[3 * ip + 2], fs * RP);
+    ASSERT_REL(s->f[3 * iq + 2], fs * RQ);
+    ck_assert(s->f[3 * ip + 2] > 0 && s->f[3 * iq + 2] > 0);
     /* eq. (23): ω_{3/2} = ω_{1/2} + M/I Δt. */
     ASSERT_REL(s->w[ip], fs * RP / inertia(RP) * DT);
     ASSERT_REL(s->w[iq], fs * RQ / inertia(RQ) * DT);
@@ -217,11 +217,11 @@ START_TEST(contacts_rotation_term)
     ck_assert_double_eq(L->fn[c], 0.0);
     ck_assert(fs < 0);
     ASSERT_REL(pair_fs(L, c), fs);
-    ASSERT_REL(s->fx[ip], -fs * t[0]);
-    ASSERT_REL(s->fy[ip], -fs * t[1]);
-    ASSERT_REL(s->fx[iq], fs * t[0]);
-    ASSERT_REL(s->tq[ip], fs * RP);
-    ASSERT_REL(s->tq[iq], fs * RQ);
+    ASSERT_REL(s->f[3 * ip], -fs * t[0]);
+    ASSERT_REL(s->f[3 * ip + 1], -fs * t[1]);
+    ASSERT_REL(s->f[3 * iq], fs * t[0]);
+    ASSERT_REL(s->f[3 * ip + 2], fs * RP);
+    ASSERT_REL(s->f[3 * iq + 2], fs * RQ);
     ASSERT_REL(s->w[ip], wp + fs * RP / inertia(RP) * DT);
     ASSERT_REL(s->w[iq], wq + fs * RQ / inertia(RQ) * DT);
 }
@@ -285,9 +285,9 @@ START_TEST(contacts_friction_cap_smaller_phi_and_c)
         ASSERT_REL(L->fn[c], fn);
         ASSERT_REL(pair_fs(L, c), cases[k].sign * cap);
         ck_assert_int_eq(L->flags[c], BAL_PAIR_TOUCHING | BAL_PAIR_SLIDING);
-        ASSERT_REL(s->fx[ip], -(fn * e[0] + cases[k].sign * cap * t[0]));
-        ASSERT_REL(s->fy[ip], -(fn * e[1] + cases[k].sign * cap * t[1]));
-        ASSERT_REL(s->tq[ip], cases[k].sign * cap * RP);
+        ASSERT_REL(s->f[3 * ip], -(fn * e[0] + cases[k].sign * cap * t[0]));
+        ASSERT_REL(s->f[3 * ip + 1], -(fn * e[1] + cases[k].sign * cap * t[1]));
+        ASSERT_REL(s->f[3 * ip + 2], cases[k].sign * cap * RP);
         ck_assert_double_eq(t_dn(f, L, c), 0.0);
         ck_assert_double_eq(t_ds(f, L, c), 0.0);
         tfx_release(f);
@@ -326,9 +326,9 @@ START_TEST(contacts_damping_sticking_and_sliding)
     ASSERT_REL(t_dn(f, L, c), dn);
     ASSERT_REL(pair_fs(L, c), fs);
     ASSERT_REL(t_ds(f, L, c), ds);
-    ASSERT_REL(f->sim->fx[ip], -((fn + dn) * e[0] + (fs + ds) * t[0]));
-    ASSERT_REL(f->sim->fy[ip], -((fn + dn) * e[1] + (fs + ds) * t[1]));
-    ASSERT_REL(f->sim->tq[ip], (fs + ds) * RP);
+    ASSERT_REL(f->sim->f[3 * ip], -((fn + dn) * e[0] + (fs + ds) * t[0]));
+    ASSERT_REL(f->sim->f[3 * ip + 1], -((fn + dn) * e[1] + (fs + ds) * t[1]));
+    ASSERT_REL(f->sim->f[3 * ip + 2], (fs + ds) * RP);
     tfx_release(f);
 
     /* sliding */
@@ -341,9 +341,9 @@ START_TEST(contacts_damping_sticking_and_sliding)
     ASSERT_REL(t_dn(f, L, c), dn);
     ASSERT_REL(pair_fs(L, c), cap);
     ck_assert_double_eq(t_ds(f, L, c), 0.0);
-    ASSERT_REL(f->sim->fx[ip], -((fn + dn) * e[0] + cap * t[0]));
-    ASSERT_REL(f->sim->fy[ip], -((fn + dn) * e[1] + cap * t[1]));
-    ASSERT_REL(f->sim->tq[ip], cap * RP);
+    ASSERT_REL(f->sim->f[3 * ip], -((fn + dn) * e[0] + cap * t[0]));
+    ASSERT_REL(f->sim->f[3 * ip + 1], -((fn + dn) * e[1] + cap * t[1]));
+    ASSERT_REL(f->sim->f[3 * ip + 2], cap * RP);
 }
 END_TEST
 
@@ -421,7 +421,7 @@ START_TEST(contacts_no_tension_and_reset)
     ck_assert_int_eq(L->flags[c], 0);
     ck_assert_double_eq(L->fn[c], 0.0);
     ck_assert_double_eq(pair_fs(L, c), 0.0);
-    ck_assert_double_eq(f->sim->fx[t_slot(f, "p")], 0.0);
+    ck_assert_double_eq(f->sim->f[3 * (t_slot(f, "p"))], 0.0);
 }
 END_TEST
 
@@ -573,15 +573,15 @@ START_TEST(contacts_power_law_static_overlap)
                       nu, L->fn[c], fw);
         const struct bal_sim *s = f->sim;
         const int is = t_slot(f, "s"), ia = t_slot(f, "a"), ib = t_slot(f, "b");
-        ck_assert_double_eq_tol(s->fx[is], fw * nw[0], OVERLAP_REL * fw);
-        ck_assert_double_eq_tol(s->fy[is], fw * nw[1], OVERLAP_REL * fw);
+        ck_assert_double_eq_tol(s->f[3 * is], fw * nw[0], OVERLAP_REL * fw);
+        ck_assert_double_eq_tol(s->f[3 * is + 1], fw * nw[1], OVERLAP_REL * fw);
         c = t_contact(f, "a", "b", &L);
         ck_assert_msg(fabs(L->fn[c] - fd) <= OVERLAP_REL * fd, "nu %g: disc F_n %.17g, expected %.17g",
                       nu, L->fn[c], fd);
-        ck_assert_double_eq_tol(s->fx[ia], -fd * e[0], OVERLAP_REL * fd);
-        ck_assert_double_eq_tol(s->fy[ia], -fd * e[1], OVERLAP_REL * fd);
-        ck_assert_double_eq_tol(s->fx[ib], fd * e[0], OVERLAP_REL * fd);
-        ck_assert_double_eq_tol(s->fy[ib], fd * e[1], OVERLAP_REL * fd);
+        ck_assert_double_eq_tol(s->f[3 * ia], -fd * e[0], OVERLAP_REL * fd);
+        ck_assert_double_eq_tol(s->f[3 * ia + 1], -fd * e[1], OVERLAP_REL * fd);
+        ck_assert_double_eq_tol(s->f[3 * ib], fd * e[0], OVERLAP_REL * fd);
+        ck_assert_double_eq_tol(s->f[3 * ib + 1], fd * e[1], OVERLAP_REL * fd);
         tfx_release(f);
     }
 }
@@ -902,7 +902,7 @@ START_TEST(contacts_one_material_law)
     const size_t n = (size_t)a->n * sizeof(double);
     ck_assert(memcmp(a->x, b->x, n) == 0 && memcmp(a->y, b->y, n) == 0);
     ck_assert(memcmp(a->vx, b->vx, n) == 0 && memcmp(a->w, b->w, n) == 0);
-    ck_assert(memcmp(a->fx, b->fx, n) == 0 && memcmp(a->tq, b->tq, n) == 0);
+    ck_assert(memcmp(a->f, b->f, 3 * n) == 0);
     tfx_release(one);
     tfx_release(mixed);
 
@@ -945,14 +945,14 @@ START_TEST(contacts_sums_restart_each_cycle)
     ck_assert_int_eq(s->use_grid, 1);
     ck_assert_ptr_nonnull(s->dash);
     for (int i = 0; i < s->n; i++) {
-        s->fx[i] = s->fy[i] = s->tq[i] = NAN;
+        s->f[3 * i] = s->f[3 * i + 1] = s->f[3 * i + 2] = NAN;
         s->dash[3 * i] = s->dash[3 * i + 1] = s->dash[3 * i + 2] = NAN;
     }
     t_steps(f, 1);
     const char *const apart[] = {"a", "b", "c"};
     for (int k = 0; k < 3; k++) {
         const int i = t_slot(f, apart[k]);
-        ck_assert_msg(s->fx[i] == 0 && s->fy[i] == 0 && s->tq[i] == 0, "disc %s: sums not zero",
+        ck_assert_msg(s->f[3 * i] == 0 && s->f[3 * i + 1] == 0 && s->f[3 * i + 2] == 0, "disc %s: sums not zero",
                       apart[k]);
         ck_assert(s->dash[3 * i] == 0 && s->dash[3 * i + 1] == 0 && s->dash[3 * i + 2] == 0);
     }
@@ -965,9 +965,9 @@ START_TEST(contacts_sums_restart_each_cycle)
     for (int k = 0; k < 2; k++) {
         const int i = t_slot(f, left[k]), j = t_slot(f, right[k]);
         const double fn = kn * (1.0 - gap[k]);
-        ASSERT_REL(s->fx[i], -fn);
-        ASSERT_REL(s->fx[j], fn);
-        ck_assert(s->fy[i] == 0 && s->fy[j] == 0 && s->tq[i] == 0 && s->tq[j] == 0);
+        ASSERT_REL(s->f[3 * i], -fn);
+        ASSERT_REL(s->f[3 * j], fn);
+        ck_assert(s->f[3 * i + 1] == 0 && s->f[3 * j + 1] == 0 && s->f[3 * i + 2] == 0 && s->f[3 * j + 2] == 0);
         ck_assert(s->dash[3 * i] == 0 && s->dash[3 * j] == 0);
     }
 }

@@ -1051,7 +1051,7 @@ static double smooth_error(int integ, double h, double *e_max)
     if (integ == BAL_INTEGRATOR_CENTRED) {
         s->vy[0] = V * cos(h / 2);
     } else if (integ == BAL_INTEGRATOR_VERLET) {
-        s->fy[0] = m * g;
+        s->f[3 * 0 + 1] = m * g;
     } else {
         s->gear[3 * 1 + 1] = -V * omega * omega * dt * dt * dt / 6; /* r3 of y */
         s->gear[9 * 1 + 1] = V * pow(omega, 4) * pow(dt, 5) / 120; /* r5 of y */
@@ -1125,7 +1125,7 @@ static double damped_error(int integ, double h)
         const double t = dt / 2;
         s->vy[0] = V / od * exp(-zw * t) * (od * cos(od * t) - zw * sin(od * t));
     } else if (integ == BAL_INTEGRATOR_VERLET) {
-        s->fy[0] = m * g - gam * V; /* spring carries the weight; dashpot resists V */
+        s->f[3 * 0 + 1] = m * g - gam * V; /* spring carries the weight; dashpot resists V */
     } else {
         double u[6] = {0, V, 0, 0, 0, 0}, fact = 1;
         for (int k = 2; k < 6; k++) {

@@ -141,8 +141,8 @@ START_TEST(walls_interior_contact)
     ck_assert_int_eq(L->flags[c], BAL_PAIR_TOUCHING);
     ASSERT_REL(L->fn[c], fn);
     ck_assert_double_eq_tol(pair_fs(L, c), 0.0, ROUNDOFF_REL * fn);
-    ASSERT_REL(f->sim->fx[i], fn * fr.n[0]);
-    ASSERT_REL(f->sim->fy[i], fn * fr.n[1]);
+    ASSERT_REL(f->sim->f[3 * i], fn * fr.n[0]);
+    ASSERT_REL(f->sim->f[3 * i + 1], fn * fr.n[1]);
     ASSERT_REL(t_probe_value(f, "f1"), -fn * fr.n[0]);
     ASSERT_REL(t_probe_value(f, "f2"), -fn * fr.n[1]);
     ASSERT_REL(t_probe_value(f, "mom"), -h * fn);
@@ -164,8 +164,8 @@ START_TEST(walls_other_side)
     t_steps(f, 1);
     const double fn = KN * u * DT;
     const int i = t_slot(f, "d");
-    ASSERT_REL(f->sim->fx[i], -fn * fr.n[0]);
-    ASSERT_REL(f->sim->fy[i], -fn * fr.n[1]);
+    ASSERT_REL(f->sim->f[3 * i], -fn * fr.n[0]);
+    ASSERT_REL(f->sim->f[3 * i + 1], -fn * fr.n[1]);
     ASSERT_REL(t_probe_value(f, "f1"), fn * fr.n[0]);
     ASSERT_REL(t_probe_value(f, "f2"), fn * fr.n[1]);
     ASSERT_REL(t_probe_value(f, "mom"), h * fn); /* h e × (F_n n) = h F_n */
@@ -201,8 +201,8 @@ START_TEST(walls_end_point_contact)
     ck_assert_int_eq(L->flags[c], BAL_PAIR_TOUCHING);
     ASSERT_REL(L->fn[c], fn);
     const int in = t_slot(f, "near");
-    ASSERT_REL(f->sim->fx[in], -fn * ec[0]);
-    ASSERT_REL(f->sim->fy[in], -fn * ec[1]);
+    ASSERT_REL(f->sim->f[3 * in], -fn * ec[0]);
+    ASSERT_REL(f->sim->f[3 * in + 1], -fn * ec[1]);
     /* The contact point is B: moment about P is h2 e × F_wall. */
     const double fw[2] = {fn * ec[0], fn * ec[1]};
     ASSERT_REL(t_probe_value(f, "mom"), H2 * (fr.e[0] * fw[1] - fr.e[1] * fw[0]));
@@ -210,8 +210,8 @@ START_TEST(walls_end_point_contact)
 
     c = t_contact(f, "far", "w", &L);
     ck_assert_int_eq(L->flags[c], 0);
-    ck_assert_double_eq(f->sim->fx[t_slot(f, "far")], 0.0);
-    ck_assert_double_eq(f->sim->fy[t_slot(f, "far")], 0.0);
+    ck_assert_double_eq(f->sim->f[3 * (t_slot(f, "far"))], 0.0);
+    ck_assert_double_eq(f->sim->f[3 * (t_slot(f, "far")) + 1], 0.0);
 }
 END_TEST
 
@@ -326,9 +326,9 @@ START_TEST(walls_moving_wall_contact)
     ASSERT_REL(L->fn[k], fn);
     ASSERT_REL(pair_fs(L, k), fs);
     const double fw[2] = {fn * ec[0] + fs * tc[0], fn * ec[1] + fs * tc[1]};
-    ASSERT_REL(f->sim->fx[i], -fw[0]);
-    ASSERT_REL(f->sim->fy[i], -fw[1]);
-    ASSERT_REL(f->sim->tq[i], fs * R);
+    ASSERT_REL(f->sim->f[3 * i], -fw[0]);
+    ASSERT_REL(f->sim->f[3 * i + 1], -fw[1]);
+    ASSERT_REL(f->sim->f[3 * i + 2], fs * R);
     ASSERT_REL(t_probe_value(f, "f1"), fw[0]);
     ASSERT_REL(t_probe_value(f, "f2"), fw[1]);
     ASSERT_REL(t_probe_value(f, "mom"), (c[0] - p1[0]) * fw[1] - (c[1] - p1[1]) * fw[0]);

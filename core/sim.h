@@ -2,12 +2,15 @@
  * sim.h — internal: the simulation state and the module interfaces of the
  * step pipeline.  Not part of the public API; the Check tests include it.
  *
- * Layout.  Discs are struct-of-arrays, stored in cell order (sorted once at
- * creation along a row-major cell grid so that neighbours are near each
- * other in memory).  `id[i]` is the disc's index in scene order (discs of
- * [disc] sections first, then those of each [fill]); outputs are written in
- * that order.  Array index i is stable for the lifetime of the simulation,
- * so contact keys built from indices are stable too.
+ * Layout.  Discs are struct-of-arrays in cell order: sorted along a
+ * row-major cell grid at creation and again every BAL_REORDER_EVERY
+ * rebuilds (grid.c), so that neighbours are near each other in memory.  The
+ * sums the pair loop adds to (force and moment; the dashpots' share) keep a
+ * disc's three together, so that in a packing larger than the cache the
+ * loop has fewer streams to wait on.  `id[i]` is the disc's index in scene
+ * order (discs of [disc] sections first, then those of each [fill]);
+ * outputs are written in that order.  A re-sort renumbers the discs and
+ * the keys of the candidate lists with them (new2old).
  *
  * Contacts.  Two flat candidate lists, disc–disc and disc–wall, each sorted
  * by key = (lo << 32) | hi (pair_key(); not stored: it is i and j).  A

@@ -874,18 +874,18 @@ END_TEST
  * material of the same parameters takes the general path (disc_law NULL,
  * as creation sets it for mixed materials) and must give bitwise the same
  * positions, velocities and forces: the one law is the right one. */
-static const char *const one_mat_fmt =
+static const char *const one_mat_scene =
     "[settings]\ndt = 5e-4\ngravity = 0 -60\nbeta = 0.01\n"
     "[material grain]\nkn = 1e5\nks = 7e4\nfriction = 0.4\ncohesion = 3\ndensity = 1\n"
     "[material twin]\nkn = 1e5\nks = 7e4\nfriction = 0.4\ncohesion = 3\ndensity = 1\n"
     "[material box]\nkn = 3e5\nks = 1e5\nfriction = 0.2\n"
     "[fill pack]\nn = 400\ncolumns = 20\nrmin = 0.5\nrmax = 0.75\nseed = 3\nbox = 1\n"
-    "headroom = 2\nvmax = 2\nmaterial = grain\nwall_material = box\n[stage s]\ncycles = 100000\n%s";
+    "headroom = 2\nvmax = 2\nmaterial = grain\nwall_material = box\n[stage s]\ncycles = 100000\n";
 
 START_TEST(contacts_one_material_law)
 {
-    struct tfx *one = tfx_newf("one", one_mat_fmt, "");
-    struct tfx *mixed = tfx_newf("mixed", one_mat_fmt, "");
+    struct tfx *one = tfx_new(one_mat_scene, "one");
+    struct tfx *mixed = tfx_new(one_mat_scene, "mixed");
     struct bal_sim *a = one->sim, *b = mixed->sim;
     const int grain = a->mat[0], twin = bal_scene_find(&one->sc, BAL_SEC_MATERIAL, "twin");
     ck_assert_int_ne(twin, grain);
@@ -907,13 +907,13 @@ START_TEST(contacts_one_material_law)
     tfx_release(mixed);
 
     /* creation: discs of two materials have no single law */
-    struct tfx *two = tfx_newf("two", "[settings]\ndt = 1e-4\n"
-                                      "[material m]\nkn = 1e5\nks = 1e5\nfriction = 0.5\ndensity = 1\n"
-                                      "[material q]\nkn = 2e5\nks = 1e5\nfriction = 0.5\ndensity = 1\n"
-                                      "[disc a]\nx = 0 0\nr = 0.5\nmaterial = m\n"
-                                      "[disc b]\nx = 0.9 0\nr = 0.5\nmaterial = q\n"
-                                      "[stage s]\ncycles = 1\n%s",
-                               "");
+    struct tfx *two = tfx_new("[settings]\ndt = 1e-4\n"
+                              "[material m]\nkn = 1e5\nks = 1e5\nfriction = 0.5\ndensity = 1\n"
+                              "[material q]\nkn = 2e5\nks = 1e5\nfriction = 0.5\ndensity = 1\n"
+                              "[disc a]\nx = 0 0\nr = 0.5\nmaterial = m\n"
+                              "[disc b]\nx = 0.9 0\nr = 0.5\nmaterial = q\n"
+                              "[stage s]\ncycles = 1\n",
+                              "two");
     ck_assert_ptr_null(two->sim->disc_law);
     tfx_release(two);
 }

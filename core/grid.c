@@ -259,8 +259,12 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
             g->start[c] = g->start[c - 1];
         g->start[0] = 0;
 
-        /* The three cells of a row are adjacent in `list`: one range each. */
-        int32_t nb[MAX_NEIGHBOURS];
+        /* The three cells of a row are adjacent in `list`: one range each.
+         * Every disc of the nine cells is tested and stored, and k moves on
+         * only for a candidate: whether j > i and whether it is near are
+         * both unpredictable, and as branches they cost the rebuild about
+         * half its time.  nb has room for one store past the limit. */
+        int32_t nb[MAX_NEIGHBOURS + 1];
         int any_fixed = 0;
         for (int i = 0; i < n; i++)
             any_fixed |= s->fixed[i];
@@ -273,25 +277,26 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
             const int xlo = cx > 0 ? cx - 1 : 0, xhi = cx + 1 < nx ? cx + 1 : nx - 1;
             const int ylo = cy > 0 ? cy - 1 : 0, yhi = cy + 1 < ny ? cy + 1 : ny - 1;
             const double xi = x[i], yi = y[i], ri = r[i];
+            /* Two held discs never move: their contact is no part of the
+             * dynamics (rare: tested as a branch, after the rest). */
+            const int held = any_fixed && s->fixed[i];
             int k = 0;
             for (int yy = ylo; yy <= yhi; yy++) {
                 const int a1 = g->start[yy * nx + xhi + 1];
                 for (int a = g->start[yy * nx + xlo]; a < a1; a++) {
                     const int j = g->list[a];
-                    /* Two held discs never move: their contact is no
-                     * part of the dynamics. */
-                    if (j <= i || (any_fixed && s->fixed[i] && s->fixed[j]))
-                        continue;
                     const double dx = x[j] - xi, dy = y[j] - yi;
                     const double reach = ri + r[j] + skin;
-                    if (dx * dx + dy * dy < reach * reach) {
-                        if (k == MAX_NEIGHBOURS)
-                            return bal_error(err, BAL_EUNSTABLE,
-                                             "neighbour grid: disc %d has more than %d "
-                                             "neighbours at step %ld (piled up?)",
-                                             s->id[i], MAX_NEIGHBOURS, s->step);
-                        nb[k++] = j;
-                    }
+                    int keep = (j > i) & (dx * dx + dy * dy < reach * reach);
+                    if (held)
+                        keep &= !s->fixed[j];
+                    nb[k] = j;
+                    k += keep;
+                    if (k == MAX_NEIGHBOURS + 1)
+                        return bal_error(err, BAL_EUNSTABLE,
+                                         "neighbour grid: disc %d has more than %d "
+                                         "neighbours at step %ld (piled up?)",
+                                         s->id[i], MAX_NEIGHBOURS, s->step);
                 }
             }
             /* Insertion sort: k is small. */

@@ -256,6 +256,44 @@ START_TEST(grid_held_pairs_left_out)
 }
 END_TEST
 
+/* The limit of a disc's candidates in a rebuild (MAX_NEIGHBOURS = 512 in
+ * grid.c), at its edge.  600 discs of radius 0.5 in a row, touching (x =
+ * 0.5 + k, exact in binary); disc k is a candidate of disc 0 while its
+ * distance k < 1 + skin.  A skin of 511.5 gives disc 0 exactly 512
+ * candidates: the list must be the brute-force one.  A skin of 512.5 gives
+ * it 513: bal_sim_create must refuse the scene and say why. */
+START_TEST(grid_neighbour_limit)
+{
+    static const char *fmt = "[settings]\ngrid = on\nskin = %s\n"
+                             "[material g]\nkn = 1e5\ndensity = 1\n"
+                             "[fill row]\nn = 600\ncolumns = 600\nrmin = 0.5\nrmax = 0.5\n"
+                             "material = g\n[stage s]\ncycles = 1\n";
+    char text[512];
+    snprintf(text, sizeof text, fmt, "511.5");
+    struct tfx *f = tfx_new(text, "limit-512");
+    const struct bal_sim *s = f->sim;
+    long expect = 0, most = 0;
+    for (int i = 0; i < s->n; i++) {
+        long mine = 0;
+        for (int j = 0; j < s->n; j++) {
+            const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
+            const double reach = s->r[i] + s->r[j] + 511.5;
+            mine += s->id[j] > s->id[i] && dx * dx + dy * dy < reach * reach;
+        }
+        expect += mine;
+        most = mine > most ? mine : most;
+    }
+    ck_assert_int_eq(most, 512);
+    ck_assert_int_eq(s->pp.n, expect);
+
+    snprintf(text, sizeof text, fmt, "512.5");
+    struct tfx *g = tfx_parse(text, "limit-513");
+    g->sc.settings.force_dt = 1;
+    ck_assert_int_eq(tfx_create(g), BAL_EUNSTABLE);
+    ck_assert_msg(t_contains(g->err.msg, "more than 512 neighbours"), "%s", g->err.msg);
+}
+END_TEST
+
 /* The tight case of d_1 + d_2: two discs flying head-on at each other, with
  * the gap at the rebuild just above the skin (so they are not candidates)
  * and no other disc moving.  Their first contact must be seen in the same
@@ -532,6 +570,7 @@ Suite *suite_grid(void)
     tcase_add_test(tc, grid_rebuild_when_skin_used_up);
     tcase_add_test(tc, grid_head_on_contact_not_missed);
     tcase_add_test(tc, grid_held_pairs_left_out);
+    tcase_add_test(tc, grid_neighbour_limit);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("history");

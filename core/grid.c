@@ -355,6 +355,83 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
 }
 
 /* ------------------------------------------------------------------ */
+/* When the lists break                                                 */
+/* ------------------------------------------------------------------ */
+
+/* At most this many discs are looked at one by one (below); with more the
+ * packing is flowing, and a rebuild is due anyway. */
+#define MAX_MOVERS 32
+
+static inline double moved_sq(const struct bal_sim *s, int i)
+{
+    const double dx = s->x[i] - s->x_ref[i], dy = s->y[i] - s->y_ref[i];
+    return dx * dx + dy * dy;
+}
+
+/* Can mover m, displaced by dm < skin since the rebuild, touch a disc j it
+ * is not listed with?  Only if d_m + d_j >= skin (else the gap of at least
+ * the skin that kept them apart is still open) and their distance at the
+ * rebuild is below r_m + r_j + d_m + d_j.  Such a j lay within 2 r_max +
+ * 2 skin < 2 h of m at the rebuild, so within two cells of m's cell then. */
+static int mover_can_touch(const struct bal_sim *s, int m, double dm)
+{
+    const struct bal_grid *g = &s->grid;
+    const double need = s->skin - dm;
+    int cx, cy;
+    cell_of(s->x_ref[m], s->y_ref[m], g, 1 / g->h, &cx, &cy);
+    const int xlo = cx > 1 ? cx - 2 : 0, xhi = cx + 2 < g->nx ? cx + 2 : g->nx - 1;
+    const int ylo = cy > 1 ? cy - 2 : 0, yhi = cy + 2 < g->ny ? cy + 2 : g->ny - 1;
+    for (int yy = ylo; yy <= yhi; yy++) {
+        const int a1 = g->start[yy * g->nx + xhi + 1];
+        for (int a = g->start[yy * g->nx + xlo]; a < a1; a++) {
+            const int j = g->list[a];
+            const double dj2 = j == m ? 0 : moved_sq(s, j);
+            if (dj2 < need * need)
+                continue;
+            const double dx = s->x_ref[j] - s->x_ref[m], dy = s->y_ref[j] - s->y_ref[m];
+            /* a margin of 1e-9 for the rounding of the distances */
+            const double reach = (s->r[m] + s->r[j] + dm + sqrt(dj2)) * (1 + 1e-9);
+            if (dx * dx + dy * dy >= reach * reach)
+                continue;
+            /* (m moved, so it is not held: the pair would be listed) */
+            const int lo = m < j ? m : j, hi = m < j ? j : m;
+            if (bal_pairs_find(&s->pp, ((uint64_t)(uint32_t)lo << 32) | (uint32_t)hi) < 0)
+                return 1;
+        }
+    }
+    return 0;
+}
+
+/* d_1 + d_2 >= skin says only that two discs somewhere have moved far;
+ * in a large packing they are mostly rattlers far apart, each in its own
+ * cage.  A pair that can touch has d_i + d_j >= skin, so one of them has
+ * moved at least skin/2: those discs (the movers) lie in blocks whose
+ * largest displacement is at least that, and each is checked against the
+ * discs around it. */
+int bal_grid_lists_broken(const struct bal_sim *s, double d1)
+{
+    const double skin = s->skin, half_sq = 0.25 * skin * skin;
+    if (d1 >= skin)
+        return 1;
+    const int blocks = bal_disc_blocks(s->n);
+    int movers = 0;
+    for (int b = 0; b < blocks; b++) {
+        if (s->par.block_sums[2 * b] < half_sq)
+            continue;
+        const int from = b * BAL_DISC_BLOCK;
+        const int to = from + BAL_DISC_BLOCK < s->n ? from + BAL_DISC_BLOCK : s->n;
+        for (int m = from; m < to; m++) {
+            const double dm2 = moved_sq(s, m);
+            if (dm2 < half_sq)
+                continue;
+            if (++movers > MAX_MOVERS || mover_can_touch(s, m, sqrt(dm2)))
+                return 1;
+        }
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------------ */
 /* Re-sorting discs into cell order                                     */
 /* ------------------------------------------------------------------ */
 

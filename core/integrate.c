@@ -84,6 +84,8 @@ static inline void track_moves(double d2, double *m1, double *m2)
     *m1 = d2 > *m1 ? d2 : *m1;
 }
 
+static inline int blocks_of(const struct bal_sim *s) { return s->n > 0 ? bal_disc_blocks(s->n) : 0; }
+
 static inline double moved_sq(const struct bal_sim *s, int i)
 {
     const double dx = s->x[i] - s->x_ref[i], dy = s->y[i] - s->y_ref[i];
@@ -91,14 +93,16 @@ static inline double moved_sq(const struct bal_sim *s, int i)
 }
 
 /* After the positions moved, with m1 >= m2 the two largest squared
- * displacements of any disc since the lists were built: walls move; decide
- * whether to rebuild.  A pair left out of the list had a gap of at least
- * the skin when it was built, and the gap of discs i and j closes by at
- * most d_i + d_j <= d_1 + d_2 (the two largest displacements of distinct
- * discs), so the list holds every contact until d_1 + d_2 reaches the
- * skin.  (The usual 2 d_1 rebuilds twice as often when a single rattler
- * moves, and in a large packing there is always one.)  A disc and a wall:
- * d_1 + the wall's largest displacement. */
+ * displacements of any disc since the lists were built (and each block's
+ * in par.block_sums): walls move; decide whether to rebuild.  A pair left
+ * out of the list had a gap of at least the skin when it was built, and
+ * the gap of discs i and j closes by at most d_i + d_j <= d_1 + d_2 (the
+ * two largest displacements of distinct discs), so the list holds every
+ * contact until d_1 + d_2 reaches the skin.  (The usual 2 d_1 rebuilds
+ * twice as often when a single rattler moves.)  Then the movers are looked
+ * at one by one (grid.c): two rattlers far apart cannot touch, and in a
+ * large packing there are always some.  A disc and a wall: d_1 + the
+ * wall's largest displacement. */
 static void moved(struct bal_sim *s, double m1, double m2)
 {
     bal_walls_move(s);
@@ -108,18 +112,27 @@ static void moved(struct bal_sim *s, double m1, double m2)
     double wmax = 0;
     for (int k = 0; k < s->n_walls; k++)
         wmax = fmax(wmax, s->walls[k].disp);
-    if (d1 + d2 >= s->skin || d1 + wmax >= s->skin)
+    if (d1 + wmax >= s->skin || (d1 + d2 >= s->skin && bal_grid_lists_broken(s, d1)))
         s->need_rebuild = 1;
 }
 
 /* The two largest squared displacements, in a pass of their own (verlet and
- * gear5; centred keeps them in its position loop). */
+ * gear5; centred keeps them in its position loop), and each block's. */
 static void moved_scan(struct bal_sim *s)
 {
     double m1 = 0, m2 = 0;
     if (s->use_grid)
-        for (int i = 0; i < s->n; i++)
-            track_moves(moved_sq(s, i), &m1, &m2);
+        for (int b = 0; b < blocks_of(s); b++) {
+            const int from = b * BAL_DISC_BLOCK;
+            const int to = from + BAL_DISC_BLOCK < s->n ? from + BAL_DISC_BLOCK : s->n;
+            double b1 = 0, b2 = 0;
+            for (int i = from; i < to; i++)
+                track_moves(moved_sq(s, i), &b1, &b2);
+            s->par.block_sums[2 * b] = b1;
+            s->par.block_sums[2 * b + 1] = b2;
+            track_moves(b1, &m1, &m2);
+            track_moves(b2, &m1, &m2);
+        }
     moved(s, m1, m2);
 }
 
@@ -131,7 +144,6 @@ static void moved_scan(struct bal_sim *s)
  * block's sums are its own, added up block after block, so that they are
  * the same on any number of threads (struct bal_par, sim.h). */
 
-static inline int blocks_of(const struct bal_sim *s) { return s->n > 0 ? bal_disc_blocks(s->n) : 0; }
 
 /* Run body(s, b) for every block b, on s->par.threads threads. */
 #define FOR_BLOCKS(s, b, body)                                                          \

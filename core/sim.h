@@ -339,6 +339,12 @@ void bal_contact_dashpots(const struct bal_sim *s, const struct bal_pairs *p, lo
 
 /* grid.c */
 enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err);
+/* Called when the two largest displacements since the last rebuild, d_1
+ * >= d_2, reach the skin together: is there a pair outside the list that
+ * can touch now?  1 if so (or if it cannot tell cheaply), 0 if the lists
+ * still hold every contact.  Reads the displacement maxima of each block of
+ * discs from par.block_sums (the position pass's). */
+int bal_grid_lists_broken(const struct bal_sim *s, double d1);
 /* Re-sort the discs into cell order of their current positions, carrying
  * every per-disc array and the probes along, then rebuild the lists (their
  * history found through the permutation). */

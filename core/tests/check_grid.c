@@ -171,22 +171,33 @@ START_TEST(grid_candidates_sparse_scene)
 }
 END_TEST
 
-/* When the lists are rebuilt.  skin = 0.2, Δt = 1e-3.  `mover` alone runs
- * at 0.7, the others rest: d_1 + d_2 = 0.7 N Δt ≥ 0.2 first at
- * N = ⌈285.7⌉ = 286, then every 286 cycles: 600 cycles → rebuilds at 286
- * and 572, plus the one at creation: 3.  With a second mover at 0.4:
- * 1.1 N Δt ≥ 0.2 at N = ⌈181.8⌉ = 182.  A wall moving at 0.3 with the
- * discs at rest: 0.3 N Δt ≥ 0.2 at N = ⌈666.7⌉ = 667: 700 cycles → 2. */
+/* When the lists are rebuilt.  skin = 0.2, Δt = 1e-3, radii 0.5.  `mover`
+ * (at the origin) alone runs at 0.7, the others rest: d_1 = 0.7 N Δt
+ * reaches the skin first at N = ⌈285.7⌉ = 286, then every 286 cycles: 600
+ * cycles → rebuilds at 286 and 572, plus the one at creation: 3.
+ *
+ * With a second mover, d_1 + d_2 reaching the skin is not enough: the two
+ * must be able to touch, that is be less than r + r + d_1 + d_2 apart at
+ * the rebuild, and not be a listed pair already.
+ * - `a` 5 above, running at 0.4 (d_1 + d_2 = 1.1 N Δt = 0.2 at N = 182):
+ *   too far to touch, so again the first rebuild is at 286.
+ * - `a` at (1.3, 0) (gap 0.3 > skin: not listed), running at 0.4 across:
+ *   1.1 N Δt > 0.3 first at N = ⌈272.7⌉ = 273; no rebuild at 272.
+ * - `a` at (1.1, 0) (gap 0.1: listed), mover and `a` running apart along y
+ *   at 0.5 each: d_1 + d_2 = N Δt reaches the skin at 200, but their pair
+ *   is in the list; the rebuild comes when d_1 = 0.5 N Δt = 0.2, at 400.
+ * A wall moving at 0.3 with the discs at rest: 0.3 N Δt ≥ 0.2 at N =
+ * ⌈666.7⌉ = 667: 700 cycles → 2. */
 START_TEST(grid_rebuild_when_skin_used_up)
 {
     static const char *const movers =
         "[settings]\ngrid = on\nskin = 0.2\ndt = 1e-3\n"
         "[material g]\nkn = 1e5\ndensity = 1\n"
-        "[disc mover]\nx = 0 0\nr = 0.5\nv = 0.7 0\nmaterial = g\n"
-        "[disc a]\nx = 0 5\nr = 0.5\nv = %s\nmaterial = g\n"
+        "[disc mover]\nx = 0 0\nr = 0.5\nv = %s\nmaterial = g\n"
+        "[disc a]\nx = %s\nr = 0.5\nv = %s\nmaterial = g\n"
         "[disc b]\nx = 5 5\nr = 0.5\nmaterial = g\n"
         "[stage s]\ncycles = 1\n";
-    struct tfx *f = tfx_newf("one mover", movers, "0 0");
+    struct tfx *f = tfx_newf("one mover", movers, "0.7 0", "0 5", "0 0");
     ck_assert_int_eq(info_of(f).rebuilds, 1);
     t_steps(f, 285);
     ck_assert_int_eq(info_of(f).rebuilds, 1);
@@ -196,8 +207,25 @@ START_TEST(grid_rebuild_when_skin_used_up)
     ck_assert_int_eq(info_of(f).rebuilds, 3);
     tfx_release(f);
 
-    f = tfx_newf("two movers", movers, "0 -0.4");
-    t_steps(f, 181);
+    f = tfx_newf("two movers far apart", movers, "0.7 0", "0 5", "0 -0.4");
+    t_steps(f, 285);
+    ck_assert_int_eq(info_of(f).rebuilds, 1);
+    t_steps(f, 1);
+    ck_assert_int_eq(info_of(f).rebuilds, 2);
+    tfx_release(f);
+
+    f = tfx_newf("two movers near", movers, "0.7 0", "1.3 0", "0 0.4");
+    ck_assert_int_eq(f->sim->pp.n, 0); /* mover-a is not listed */
+    t_steps(f, 272);
+    ck_assert_int_eq(info_of(f).rebuilds, 1);
+    t_steps(f, 1);
+    ck_assert_int_eq(info_of(f).rebuilds, 2);
+    tfx_release(f);
+
+    f = tfx_newf("two listed movers", movers, "0 0.5", "1.1 0", "0 -0.5");
+    const struct bal_pairs *listed;
+    ck_assert_int_ge(t_contact(f, "mover", "a", &listed), 0);
+    t_steps(f, 399);
     ck_assert_int_eq(info_of(f).rebuilds, 1);
     t_steps(f, 1);
     ck_assert_int_eq(info_of(f).rebuilds, 2);
@@ -216,6 +244,35 @@ START_TEST(grid_rebuild_when_skin_used_up)
     ck_assert_int_eq(info_of(f).rebuilds, 2);
     t_steps(f, 700 - 667);
     ck_assert_int_eq(info_of(f).rebuilds, 2);
+}
+END_TEST
+
+/* Past MAX_MOVERS = 32 movers (grid.c) the packing counts as flowing and
+ * d_1 + d_2 >= skin rebuilds at once.  Discs 5 apart in a row, skin 0.2,
+ * Δt = 1e-3, all running sideways to the row at 0.3: no two can touch, so
+ * 32 of them rebuild first when one alone has moved the skin, 0.3 N Δt >=
+ * 0.2 at N = ⌈666.7⌉ = 667; 33 of them when 0.6 N Δt >= 0.2, at N =
+ * ⌈333.3⌉ = 334. */
+START_TEST(grid_many_movers_rebuild)
+{
+    for (int movers = 32; movers <= 33; movers++) {
+        char text[T_TEXT_MAX];
+        int len = snprintf(text, sizeof text,
+                           "[settings]\ngrid = on\nskin = 0.2\ndt = 1e-3\n"
+                           "[material g]\nkn = 1e5\ndensity = 1\n[stage s]\ncycles = 1\n");
+        for (int k = 0; k < movers; k++)
+            len += snprintf(text + len, sizeof text - (size_t)len,
+                            "[disc d%d]\nx = %d 0\nr = 0.5\nv = 0 0.3\nmaterial = g\n", k,
+                            5 * k);
+        ck_assert_int_lt(len, (int)sizeof text);
+        struct tfx *f = tfx_new(text, "movers");
+        const long first = movers == 32 ? 667 : 334;
+        t_steps(f, first - 1);
+        ck_assert_int_eq(info_of(f).rebuilds, 1);
+        t_steps(f, 1);
+        ck_assert_int_eq(info_of(f).rebuilds, 2);
+        tfx_release(f);
+    }
 }
 END_TEST
 
@@ -507,6 +564,99 @@ START_TEST(grid_on_off_agree_on_packing)
 }
 END_TEST
 
+/* Rattlers in cages, where the lists outlive d_1 + d_2 >= skin.  Three
+ * cages 12 apart, each a ring of 8 held discs (radius 0.5, ring radius
+ * 1.8), with a free disc of radius 0.4 flying about inside: gap 0.9 to
+ * the ring, skin 0.2, so each rattler hits its ring from outside its list
+ * of the last rebuild, and the three often have moved 0.1 or more at
+ * once, far apart.  With the grid the run must be the all-pairs run (to
+ * round-off, AGREE_ABS), and the test counts the cycles in which d_1 + d_2
+ * had reached the skin without a rebuild: the path must have been taken. */
+START_TEST(grid_rattlers_keep_their_lists)
+{
+    char base[T_TEXT_MAX - 64], on_txt[T_TEXT_MAX], off_txt[T_TEXT_MAX];
+    int len = snprintf(base, sizeof base,
+                       "[material g]\nkn = 1e5\ndensity = 1\n[stage s]\ncycles = 1\n");
+    const double speeds[3][2] = {{3.1, 1.3}, {-2.2, 2.9}, {0.7, -3.4}};
+    for (int c = 0; c < 3; c++) {
+        for (int k = 0; k < 8; k++)
+            len += snprintf(base + len, sizeof base - (size_t)len,
+                            "[disc c%dk%d]\nx = %.17g %.17g\nr = 0.5\nfixed = 1\nmaterial = g\n",
+                            c, k, 12.0 * c + 1.8 * cos(k * BAL_PI / 4), 1.8 * sin(k * BAL_PI / 4));
+        len += snprintf(base + len, sizeof base - (size_t)len,
+                        "[disc r%d]\nx = %d 0\nr = 0.4\nv = %g %g\nmaterial = g\n", c, 12 * c,
+                        speeds[c][0], speeds[c][1]);
+    }
+    ck_assert_int_lt(len, (int)sizeof base);
+    snprintf(on_txt, sizeof on_txt, "[settings]\ngrid = on\nskin = 0.2\ndt = 1e-4\n%s", base);
+    snprintf(off_txt, sizeof off_txt, "[settings]\ngrid = off\ndt = 1e-4\n%s", base);
+    struct tfx *on = tfx_new(on_txt, "on"), *off = tfx_new(off_txt, "off");
+    const struct bal_sim *a = on->sim, *b = off->sim;
+    long kept = 0, touching = 0;
+    for (int k = 0; k < 20000; k++) {
+        t_steps(on, 1);
+        t_steps(off, 1);
+        double d1 = 0, d2 = 0;
+        for (int i = 0; i < a->n; i++) {
+            const double d = hypot(a->x[i] - a->x_ref[i], a->y[i] - a->y_ref[i]);
+            d2 = d > d1 ? d1 : d > d2 ? d : d2;
+            d1 = d > d1 ? d : d1;
+        }
+        kept += d1 + d2 >= 0.2;
+        for (long c = 0; c < b->pp.n; c++)
+            touching += (b->pp.flags[c] & BAL_PAIR_TOUCHING) != 0;
+    }
+    double worst = 0;
+    for (int id = 0; id < a->n; id++) {
+        const int i = a->slot[id], j = b->slot[id];
+        worst = fmax(worst, fabs(a->x[i] - b->x[j]) + fabs(a->y[i] - b->y[j]));
+        worst = fmax(worst, fabs(a->vx[i] - b->vx[j]) + fabs(a->vy[i] - b->vy[j]));
+    }
+    ck_assert_msg(worst < AGREE_ABS, "grid on/off differ by %g", worst);
+    ck_assert_int_gt(touching, 100);        /* the rattlers hit their rings */
+    ck_assert_int_gt(kept, 1000);           /* lists kept past d_1 + d_2 >= skin */
+    ck_assert_int_gt(info_of(on).rebuilds, 20);
+}
+END_TEST
+
+/* Two movers in neighbouring cells that meet before either has moved the
+ * skin.  A row of 50 discs at rest (touching, no force) keeps the grid
+ * fine; p and q fly head-on above it at 0.9 and -0.8 with a gap of 0.25
+ * (skin 0.2: not listed).  d_p + d_q reaches the skin at N = 1177 with no
+ * contact possible yet; they touch once 1.7e-4 N > 0.25, at N = 1471, when
+ * d_p = 0.13 and d_q = 0.12.  The rebuild must come in that cycle (the
+ * contact seen as with all pairs), and not before. */
+START_TEST(grid_movers_meet_across_cells)
+{
+    static const char *const fmt = "[settings]\ngrid = %s\nskin = 0.2\ndt = 1e-4\n"
+                                   "[material g]\nkn = 1e5\ndensity = 1\n"
+                                   "[fill row]\nn = 50\ncolumns = 50\nrmin = 0.5\nrmax = 0.5\n"
+                                   "material = g\n"
+                                   "[disc p]\nx = 20 3\nr = 0.5\nv = 0.9 0\nmaterial = g\n"
+                                   "[disc q]\nx = 21.25 3\nr = 0.5\nv = -0.8 0\nmaterial = g\n"
+                                   "[stage s]\ncycles = 1\n"
+                                   "[probe fn]\nquantity = contact_fn\na = p\nb = q\n";
+    struct tfx *on = tfx_newf("on", fmt, "on"), *off = tfx_newf("off", fmt, "off");
+    const struct bal_grid *g = &on->sim->grid;
+    const int p = t_slot(on, "p"), q = t_slot(on, "q");
+    ck_assert_int_ne((int)((on->sim->x[p] - g->x0) / g->h), (int)((on->sim->x[q] - g->x0) / g->h));
+    long first_on = -1, first_off = -1;
+    for (long k = 1; k <= 1600 && (first_on < 0 || first_off < 0); k++) {
+        t_steps(on, 1);
+        t_steps(off, 1);
+        if (k == 1470)
+            ck_assert_int_eq(info_of(on).rebuilds, 1);
+        if (first_on < 0 && t_probe_value(on, "fn") > 0)
+            first_on = k;
+        if (first_off < 0 && t_probe_value(off, "fn") > 0)
+            first_off = k;
+    }
+    ck_assert_int_eq(first_off, 1471);
+    ck_assert_int_eq(first_on, first_off);
+    ck_assert_int_eq(info_of(on).rebuilds, 2);
+}
+END_TEST
+
 /* Re-sorting the discs into cell order (bal_grid_reorder) renumbers every
  * array and the contact lists but is no physics: a frictional packing
  * settling under gravity, re-sorted every 7 cycles, keeps each disc (by its
@@ -571,6 +721,7 @@ Suite *suite_grid(void)
     tcase_add_test(tc, grid_head_on_contact_not_missed);
     tcase_add_test(tc, grid_held_pairs_left_out);
     tcase_add_test(tc, grid_neighbour_limit);
+    tcase_add_test(tc, grid_many_movers_rebuild);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("history");
@@ -578,6 +729,8 @@ Suite *suite_grid(void)
     tcase_add_test(tc, grid_merge_history);
     tcase_add_test(tc, grid_history_survives_rebuild);
     tcase_add_test(tc, grid_on_off_agree_on_packing);
+    tcase_add_test(tc, grid_rattlers_keep_their_lists);
+    tcase_add_test(tc, grid_movers_meet_across_cells);
     tcase_add_test(tc, grid_reorder_is_no_physics);
     suite_add_tcase(s, tc);
     return s;

@@ -362,12 +362,6 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
  * packing is flowing, and a rebuild is due anyway. */
 #define MAX_MOVERS 32
 
-static inline double moved_sq(const struct bal_sim *s, int i)
-{
-    const double dx = s->x[i] - s->x_ref[i], dy = s->y[i] - s->y_ref[i];
-    return dx * dx + dy * dy;
-}
-
 /* Can mover m, displaced by dm < skin since the rebuild, touch a disc j it
  * is not listed with?  Only if d_m + d_j >= skin (else the gap of at least
  * the skin that kept them apart is still open) and their distance at the
@@ -385,7 +379,7 @@ static int mover_can_touch(const struct bal_sim *s, int m, double dm)
         const int a1 = g->start[yy * g->nx + xhi + 1];
         for (int a = g->start[yy * g->nx + xlo]; a < a1; a++) {
             const int j = g->list[a];
-            const double dj2 = j == m ? 0 : moved_sq(s, j);
+            const double dj2 = j == m ? 0 : bal_moved_sq(s, j);
             if (dj2 < need * need)
                 continue;
             const double dx = s->x_ref[j] - s->x_ref[m], dy = s->y_ref[j] - s->y_ref[m];
@@ -421,7 +415,7 @@ int bal_grid_lists_broken(const struct bal_sim *s, double d1)
         const int from = b * BAL_DISC_BLOCK;
         const int to = from + BAL_DISC_BLOCK < s->n ? from + BAL_DISC_BLOCK : s->n;
         for (int m = from; m < to; m++) {
-            const double dm2 = moved_sq(s, m);
+            const double dm2 = bal_moved_sq(s, m);
             if (dm2 < half_sq)
                 continue;
             if (++movers > MAX_MOVERS || mover_can_touch(s, m, sqrt(dm2)))

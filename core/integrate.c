@@ -86,12 +86,6 @@ static inline void track_moves(double d2, double *m1, double *m2)
 
 static inline int blocks_of(const struct bal_sim *s) { return s->n > 0 ? bal_disc_blocks(s->n) : 0; }
 
-static inline double moved_sq(const struct bal_sim *s, int i)
-{
-    const double dx = s->x[i] - s->x_ref[i], dy = s->y[i] - s->y_ref[i];
-    return dx * dx + dy * dy;
-}
-
 /* After the positions moved, with m1 >= m2 the two largest squared
  * displacements of any disc since the lists were built (and each block's
  * in par.block_sums): walls move; decide whether to rebuild.  A pair left
@@ -127,7 +121,7 @@ static void moved_scan(struct bal_sim *s)
             const int to = from + BAL_DISC_BLOCK < s->n ? from + BAL_DISC_BLOCK : s->n;
             double b1 = 0, b2 = 0;
             for (int i = from; i < to; i++)
-                track_moves(moved_sq(s, i), &b1, &b2);
+                track_moves(bal_moved_sq(s, i), &b1, &b2);
             s->par.block_sums[2 * b] = b1;
             s->par.block_sums[2 * b + 1] = b2;
             track_moves(b1, &m1, &m2);
@@ -143,7 +137,6 @@ static void moved_scan(struct bal_sim *s)
 /* The centred passes go through the discs in blocks of BAL_DISC_BLOCK; a
  * block's sums are its own, added up block after block, so that they are
  * the same on any number of threads (struct bal_par, sim.h). */
-
 
 /* Run body(s, b) for every block b, on s->par.threads threads. */
 #define FOR_BLOCKS(s, b, body)                                                          \

@@ -338,6 +338,12 @@ void bal_contact_dashpots(const struct bal_sim *s, const struct bal_pairs *p, lo
                           double *dn, double *ds);
 
 /* grid.c */
+/* Squared displacement of disc i since the lists were built. */
+static inline double bal_moved_sq(const struct bal_sim *s, int i)
+{
+    const double dx = s->x[i] - s->x_ref[i], dy = s->y[i] - s->y_ref[i];
+    return dx * dx + dy * dy;
+}
 enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err);
 /* Called when the two largest displacements since the last rebuild, d_1
  * >= d_2, reach the skin together: is there a pair outside the list that

@@ -6,7 +6,9 @@
  * once and never rebuilt, and the step pays nothing for a grid.  With many
  * discs a cell grid finds the pairs whose gap is below a Verlet skin, and
  * the lists are rebuilt only when some disc (or wall) has moved far enough
- * to close that skin (integrate.c decides).  The cross-over
+ * to close that skin (integrate.c tracks the displacements; when the two
+ * largest could have closed it, bal_grid_lists_broken looks at the discs
+ * that moved most).  The cross-over
  * BAL_GRID_CROSSOVER was measured with `make bench-grid` (see README).
  *
  * Cells are square with side 2 r_max + skin, so every candidate of a disc

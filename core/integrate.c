@@ -163,7 +163,8 @@ static void centred_positions_block(struct bal_sim *s, int b)
     const double *restrict xr = s->x_ref, *restrict yr = s->y_ref;
     double m1 = 0, m2 = 0;
     if (s->use_grid) {
-        /* the displacement since the last rebuild in the same pass */
+        /* the displacement since the last rebuild in the same pass (the
+         * expression of bal_moved_sq, on this loop's own pointers) */
         for (int i = from; i < to; i++) {
             x[i] += vx[i] * dt;
             y[i] += vy[i] * dt;

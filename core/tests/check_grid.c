@@ -184,8 +184,9 @@ END_TEST
  * - `a` at (1.3, 0) (gap 0.3 > skin: not listed), running at 0.4 across:
  *   1.1 N Δt > 0.3 first at N = ⌈272.7⌉ = 273; no rebuild at 272.
  * - `a` at (1.1, 0) (gap 0.1: listed), mover and `a` running apart along y
- *   at 0.5 each: d_1 + d_2 = N Δt reaches the skin at 200, but their pair
- *   is in the list; the rebuild comes when d_1 = 0.5 N Δt = 0.2, at 400.
+ *   at 0.45 each: d_1 + d_2 = 0.9 N Δt reaches the skin at N = ⌈222.2⌉ =
+ *   223, but their pair is in the list; the rebuild comes when d_1 =
+ *   0.45 N Δt reaches it, at N = ⌈444.4⌉ = 445.
  * A wall moving at 0.3 with the discs at rest: 0.3 N Δt ≥ 0.2 at N =
  * ⌈666.7⌉ = 667: 700 cycles → 2. */
 START_TEST(grid_rebuild_when_skin_used_up)
@@ -222,10 +223,10 @@ START_TEST(grid_rebuild_when_skin_used_up)
     ck_assert_int_eq(info_of(f).rebuilds, 2);
     tfx_release(f);
 
-    f = tfx_newf("two listed movers", movers, "0 0.5", "1.1 0", "0 -0.5");
+    f = tfx_newf("two listed movers", movers, "0 0.45", "1.1 0", "0 -0.45");
     const struct bal_pairs *listed;
     ck_assert_int_ge(t_contact(f, "mover", "a", &listed), 0);
-    t_steps(f, 399);
+    t_steps(f, 444);
     ck_assert_int_eq(info_of(f).rebuilds, 1);
     t_steps(f, 1);
     ck_assert_int_eq(info_of(f).rebuilds, 2);
@@ -567,11 +568,14 @@ END_TEST
 /* Rattlers in cages, where the lists outlive d_1 + d_2 >= skin.  Three
  * cages 12 apart, each a ring of 8 held discs (radius 0.5, ring radius
  * 1.8), with a free disc of radius 0.4 flying about inside: gap 0.9 to
- * the ring, skin 0.2, so each rattler hits its ring from outside its list
- * of the last rebuild, and the three often have moved 0.1 or more at
- * once, far apart.  With the grid the run must be the all-pairs run (to
- * round-off, AGREE_ABS), and the test counts the cycles in which d_1 + d_2
- * had reached the skin without a rebuild: the path must have been taken. */
+ * the ring, skin 0.2.  The three often have moved 0.1 or more at once, far
+ * apart, so d_1 + d_2 reaches the skin long before any can touch a disc it
+ * is not listed with.  (The ring does not move, so a rattler reaches an
+ * unlisted ring disc only after moving the skin, which rebuilds anyway;
+ * the test of a contact found by looking at the movers is the next one.)
+ * The test counts the cycles in which d_1 + d_2 had reached the skin
+ * without a rebuild, which must be many, and the run must still be the
+ * all-pairs run (to round-off, AGREE_ABS). */
 START_TEST(grid_rattlers_keep_their_lists)
 {
     char base[T_TEXT_MAX - 64], on_txt[T_TEXT_MAX], off_txt[T_TEXT_MAX];
@@ -619,39 +623,51 @@ START_TEST(grid_rattlers_keep_their_lists)
 }
 END_TEST
 
-/* Two movers in neighbouring cells that meet before either has moved the
- * skin.  A row of 50 discs at rest (touching, no force) keeps the grid
- * fine; p and q fly head-on above it at 0.9 and -0.8 with a gap of 0.25
- * (skin 0.2: not listed).  d_p + d_q reaches the skin at N = 1177 with no
- * contact possible yet; they touch once 1.7e-4 N > 0.25, at N = 1471, when
- * d_p = 0.13 and d_q = 0.12.  The rebuild must come in that cycle (the
- * contact seen as with all pairs), and not before. */
-START_TEST(grid_movers_meet_across_cells)
+/* Two movers that meet before either has moved the skin, two cells apart.
+ * A row of 50 discs at rest (touching, no force) keeps the grid fine; p
+ * and q, radius 0.5, fly head-on above it at 0.9 and -0.8 with a gap of
+ * 0.35 (skin 0.2: not listed).  d_p + d_q reaches the skin at N = 1177
+ * with no contact possible yet; they touch once 1.7e-4 N > 0.35, at N =
+ * ⌈2058.8⌉ = 2059, when d_p = 0.185 and d_q = 0.165 (d_p reaches the skin
+ * only at N = 2223).  The rebuild must come in that cycle (the contact seen
+ * as with all pairs), and not before.  Their centres are 1.35 apart, more
+ * than a cell (h = 2 r_max + skin = 1.2, or wider): p is put near the right
+ * edge of a cell, so that q is two cells further, where only a search of
+ * two cells around each mover finds it.
+ * The grid's origin and cell size come from a first build of the scene
+ * (p and q do not change them: they lie inside the row's extent). */
+START_TEST(grid_movers_meet_two_cells_apart)
 {
     static const char *const fmt = "[settings]\ngrid = %s\nskin = 0.2\ndt = 1e-4\n"
                                    "[material g]\nkn = 1e5\ndensity = 1\n"
                                    "[fill row]\nn = 50\ncolumns = 50\nrmin = 0.5\nrmax = 0.5\n"
                                    "material = g\n"
-                                   "[disc p]\nx = 20 3\nr = 0.5\nv = 0.9 0\nmaterial = g\n"
-                                   "[disc q]\nx = 21.25 3\nr = 0.5\nv = -0.8 0\nmaterial = g\n"
+                                   "[disc p]\nx = %.17g 3\nr = 0.5\nv = 0.9 0\nmaterial = g\n"
+                                   "[disc q]\nx = %.17g 3\nr = 0.5\nv = -0.8 0\nmaterial = g\n"
                                    "[stage s]\ncycles = 1\n"
                                    "[probe fn]\nquantity = contact_fn\na = p\nb = q\n";
-    struct tfx *on = tfx_newf("on", fmt, "on"), *off = tfx_newf("off", fmt, "off");
+    struct tfx *first = tfx_newf("layout", fmt, "on", 20.0, 21.35);
+    const double x0 = first->sim->grid.x0, h = first->sim->grid.h;
+    tfx_release(first);
+    const double xp = x0 + 15.95 * h, xq = xp + 1.35;
+    struct tfx *on = tfx_newf("on", fmt, "on", xp, xq), *off = tfx_newf("off", fmt, "off", xp, xq);
     const struct bal_grid *g = &on->sim->grid;
+    ck_assert_double_eq(g->x0, x0);
+    ck_assert_double_eq(g->h, h);
     const int p = t_slot(on, "p"), q = t_slot(on, "q");
-    ck_assert_int_ne((int)((on->sim->x[p] - g->x0) / g->h), (int)((on->sim->x[q] - g->x0) / g->h));
+    ck_assert_int_eq((int)((on->sim->x[q] - g->x0) / g->h), (int)((on->sim->x[p] - g->x0) / g->h) + 2);
     long first_on = -1, first_off = -1;
-    for (long k = 1; k <= 1600 && (first_on < 0 || first_off < 0); k++) {
+    for (long k = 1; k <= 2200 && (first_on < 0 || first_off < 0); k++) {
         t_steps(on, 1);
         t_steps(off, 1);
-        if (k == 1470)
+        if (k == 2058)
             ck_assert_int_eq(info_of(on).rebuilds, 1);
         if (first_on < 0 && t_probe_value(on, "fn") > 0)
             first_on = k;
         if (first_off < 0 && t_probe_value(off, "fn") > 0)
             first_off = k;
     }
-    ck_assert_int_eq(first_off, 1471);
+    ck_assert_int_eq(first_off, 2059);
     ck_assert_int_eq(first_on, first_off);
     ck_assert_int_eq(info_of(on).rebuilds, 2);
 }
@@ -730,7 +746,7 @@ Suite *suite_grid(void)
     tcase_add_test(tc, grid_history_survives_rebuild);
     tcase_add_test(tc, grid_on_off_agree_on_packing);
     tcase_add_test(tc, grid_rattlers_keep_their_lists);
-    tcase_add_test(tc, grid_movers_meet_across_cells);
+    tcase_add_test(tc, grid_movers_meet_two_cells_apart);
     tcase_add_test(tc, grid_reorder_is_no_physics);
     suite_add_tcase(s, tc);
     return s;

@@ -414,9 +414,8 @@ int bal_grid_lists_broken(const struct bal_sim *s, double d1)
     for (int b = 0; b < blocks; b++) {
         if (s->par.block_sums[2 * b] < half_sq)
             continue;
-        const int from = b * BAL_DISC_BLOCK;
-        const int to = from + BAL_DISC_BLOCK < s->n ? from + BAL_DISC_BLOCK : s->n;
-        for (int m = from; m < to; m++) {
+        const int to = bal_block_end(s->n, b);
+        for (int m = b * BAL_DISC_BLOCK; m < to; m++) {
             const double dm2 = bal_moved_sq(s, m);
             if (dm2 < half_sq)
                 continue;

@@ -117,10 +117,9 @@ static void moved_scan(struct bal_sim *s)
     double m1 = 0, m2 = 0;
     if (s->use_grid)
         for (int b = 0; b < blocks_of(s); b++) {
-            const int from = b * BAL_DISC_BLOCK;
-            const int to = from + BAL_DISC_BLOCK < s->n ? from + BAL_DISC_BLOCK : s->n;
+            const int to = bal_block_end(s->n, b);
             double b1 = 0, b2 = 0;
-            for (int i = from; i < to; i++)
+            for (int i = b * BAL_DISC_BLOCK; i < to; i++)
                 track_moves(bal_moved_sq(s, i), &b1, &b2);
             s->par.block_sums[2 * b] = b1;
             s->par.block_sums[2 * b + 1] = b2;
@@ -157,7 +156,7 @@ static void moved_scan(struct bal_sim *s)
 static void centred_positions_block(struct bal_sim *s, int b)
 {
     const double dt = s->dt;
-    const int from = b * BAL_DISC_BLOCK, to = from + BAL_DISC_BLOCK < s->n ? from + BAL_DISC_BLOCK : s->n;
+    const int from = b * BAL_DISC_BLOCK, to = bal_block_end(s->n, b);
     double *restrict x = s->x, *restrict y = s->y, *restrict th = s->th;
     const double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
     const double *restrict xr = s->x_ref, *restrict yr = s->y_ref;
@@ -225,7 +224,7 @@ static void centred_previous(const struct bal_sim *s, int i, double *vx, double 
 static inline __attribute__((always_inline)) void
 centred_block(struct bal_sim *s, int b, const int damped, const int dashpots)
 {
-    const int from = b * BAL_DISC_BLOCK, to = from + BAL_DISC_BLOCK < s->n ? from + BAL_DISC_BLOCK : s->n;
+    const int from = b * BAL_DISC_BLOCK, to = bal_block_end(s->n, b);
     const double dt = s->dt;
     const double half = s->alpha * dt / 2;
     const double keep = 1 - half, scale = 1 / (1 + half);

@@ -203,6 +203,13 @@ static inline int bal_disc_blocks(int n)
     return n > 0 ? (n + BAL_DISC_BLOCK - 1) / BAL_DISC_BLOCK : 1;
 }
 
+/* One past the last disc of block b of n discs (its first is b BAL_DISC_BLOCK). */
+static inline int bal_block_end(int n, int b)
+{
+    const int to = (b + 1) * BAL_DISC_BLOCK;
+    return to < n ? to : n;
+}
+
 struct bal_sim {
     const struct bal_scene *scene;
 

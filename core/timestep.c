@@ -85,6 +85,7 @@
  *    of 2/(ω (√(1+ζ²) + ζ)), with the network's part the better of the two
  *    bounds.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 
@@ -250,31 +251,46 @@ static double damped_limit(double omega2, double beta)
     return 2 / (w * (sqrt(1 + z * z) + z));
 }
 
+/* Coordinations up to this many neighbours get the exact packing sum
+ * below; larger ones (radius ratios beyond about 1:20) its closed-form
+ * bound, so the estimate costs a bounded amount per disc whatever the
+ * radii (a ratio of 1e7 once looped 10^9 times here). */
+#define BAL_DT_COORD_EXACT 64
+
 /* N discs of radius r touching one of radius R, not overlapping each other:
- * their normals are at least 2a apart, a = asin(r/(R + r)).  Returns N and
- * in *lambda a bound on λ_max(Σ n nᵀ): in each half-plane the normals are
- * at least 2a apart, so Σ cos²φ is largest when they are packed at spacing
- * 2a around the direction; the best offset is searched on a fine grid (the
- * sum is a step function of the offset; 256 steps is more than the at most
- * π/a points that fit), and the whole is at most N. */
-static int coordination(double R, double r, double *lambda)
+ * their normals are at least 2a apart, a = asin(r/(R + r)).  Returns N (a
+ * double: for a ratio of 1e300 it exceeds every integer type) and in
+ * *lambda a bound on λ_max(Σ n nᵀ): in each half-plane the normals are at
+ * least 2a apart, so Σ cos²φ is largest when they are packed at spacing 2a
+ * around the direction; the best offset is searched on a fine grid (the sum
+ * is a step function of the offset; 256 steps is more than the at most π/a
+ * points that fit), and the whole is at most N.  Beyond BAL_DT_COORD_EXACT
+ * neighbours the search is replaced by its bound: cos² rises then falls on
+ * [−π/2, π/2], so a sum over points 2a apart is at most the integral over
+ * the spacing plus the peak, π/(4a) + 1. */
+static double coordination(double R, double r, double *lambda)
 {
     const double a = asin(fmin(1.0, r / (R + r)));
-    const int n = (int)floor(BAL_PI / a + 1e-9);
+    const double n = floor(BAL_PI / a + 1e-9);
     double best = 0;
-    for (int k = 0; k <= 256; k++) {
-        const double off = 2 * a * k / 256.0;
-        double sum = 0;
-        for (int j = -n; j <= n; j++) {
-            const double phi = off + 2 * a * j;
-            if (fabs(phi) <= 0.5 * BAL_PI) {
-                const double c = cos(phi);
-                sum += c * c;
+    if (n > BAL_DT_COORD_EXACT) {
+        best = BAL_PI / (4 * a) + 1;
+    } else {
+        const int m = (int)n;
+        for (int k = 0; k <= 256; k++) {
+            const double off = 2 * a * k / 256.0;
+            double sum = 0;
+            for (int j = -m; j <= m; j++) {
+                const double phi = off + 2 * a * j;
+                if (fabs(phi) <= 0.5 * BAL_PI) {
+                    const double c = cos(phi);
+                    sum += c * c;
+                }
             }
+            best = fmax(best, sum);
         }
-        best = fmax(best, sum);
     }
-    *lambda = fmin(2 * best, (double)n);
+    *lambda = fmin(2 * best, n);
     return n;
 }
 
@@ -299,7 +315,9 @@ static int start_contacts(const struct bal_sim *s, struct dt_list *l)
     const double cells_max = (double)BAL_DT_CELLS_PER_DISC * n + 16;
     while (((x1 - x0) / h + 1) * ((y1 - y0) / h + 1) > cells_max)
         h *= 2;
-    const int nx = (int)((x1 - x0) / h) + 1, ny = (int)((y1 - y0) / h) + 1;
+    /* At most cells_max cells (the loop above), so both fit an int. */
+    const int nx = bal_cell_index((x1 - x0) / h, INT_MAX - 1) + 1;
+    const int ny = bal_cell_index((y1 - y0) / h, INT_MAX - 1) + 1;
     const long nc = (long)nx * ny;
     int32_t *start = calloc((size_t)nc + 1, sizeof *start);
     int32_t *list = malloc((size_t)(n ? n : 1) * sizeof *list);
@@ -308,7 +326,8 @@ static int start_contacts(const struct bal_sim *s, struct dt_list *l)
     if (!start || !list || !cell)
         status = -1;
     for (int i = 0; status == 0 && i < n; i++) {
-        const int cx = (int)((s->x[i] - x0) / h), cy = (int)((s->y[i] - y0) / h);
+        const int cx = bal_cell_index((s->x[i] - x0) / h, nx);
+        const int cy = bal_cell_index((s->y[i] - y0) / h, ny);
         cell[i] = (int32_t)((long)cy * nx + cx);
         start[cell[i] + 1]++;
     }
@@ -363,7 +382,7 @@ static int start_contacts(const struct bal_sim *s, struct dt_list *l)
  * coordination(); computed once per disc, not once per weight γ (about
  * 8 000 cosines each). */
 struct dt_coord {
-    int n;
+    double n;
     double lambda;
 };
 
@@ -372,14 +391,13 @@ struct dt_coord {
 static double coordination_omega2(const struct bal_sim *s, int i, struct dt_coord co,
                                   double inv_m_max, double gamma, double *beta)
 {
-    double lambda = co.lambda;
-    int n = co.n;
+    double lambda = co.lambda, n = co.n;
     /* ... and no more contacts than the scene has other bodies (two discs
      * colliding: one partner, so the bound is that of one spring) */
-    const int others = s->n - 1 + s->n_walls;
+    const double others = (double)s->n - 1 + s->n_walls;
     if (n > others) {
         n = others;
-        lambda = fmin(lambda, (double)others);
+        lambda = fmin(lambda, others);
     }
     double ia, ra;
     disc_inv(s, i, &ia, &ra);

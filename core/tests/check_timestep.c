@@ -429,6 +429,68 @@ START_TEST(network_coordination_capped_by_bodies)
 }
 END_TEST
 
+/* Issue 18: radius ratios up to what the format holds.  Two discs apart,
+ * so each bound is that of one spring (capped by the bodies, above), but
+ * the coordination ⌊π/asin(r/(R + r))⌋ is about 3e7 and 3e100: it once
+ * looped that many times here (minutes for 1e7) and converted 3e100 to int
+ * (undefined).  The expected bound is the small disc's, k (2/m_s). */
+START_TEST(network_coordination_extreme_ratios)
+{
+    const double big[] = {1.0, 1e50}, small[] = {1e-7, 1e-50};
+    for (int k = 0; k < 2; k++) {
+        struct tfx *f = tfx_newf("ts",
+                                 "[material m]\nkn = %.17g\ndensity = %.17g\n"
+                                 "[disc a]\nx = 0 0\nr = %.17g\nmaterial = m\n"
+                                 "[disc b]\nx = %.17g 0\nr = %.17g\nmaterial = m\n"
+                                 "[stage s]\ncycles = 1\n",
+                                 KN, RHO, big[k], 3 * big[k], small[k]);
+        ASSERT_REL(bound_of(f), 2 / sqrt(KN * 2 / disc_mass(small[k])));
+        tfx_release(f);
+    }
+}
+END_TEST
+
+/* Beyond 64 neighbours (here R = 30 r: N = ⌊π/asin(1/31)⌋ = 97) the fan's
+ * sum is replaced by its bound π/(4a) + 1 per half-plane (cos² rises then
+ * falls on [−π/2, π/2]: a sum over points 2a apart is at most the integral
+ * π/2 over the spacing 2a, plus the peak 1).  So Λ = 2 (π/(4a) + 1) =
+ * 50.69 of the 97, with 110 far discs so that the bodies do not cap it. */
+START_TEST(network_coordination_closed_form)
+{
+    static char text[T_TEXT_MAX];
+    int len = snprintf(text, sizeof text,
+                       "[material m]\nkn = %.17g\ndensity = %.17g\n"
+                       "[disc a]\nx = 0 0\nr = %.17g\nmaterial = m\n[stage s]\ncycles = 1\n",
+                       KN, RHO, 30 * RR);
+    for (int k = 0; k < 110; k++)
+        len += snprintf(text + len, sizeof text - (size_t)len,
+                        "[disc f%d]\nx = %d 500\nr = %.17g\nmaterial = m\n", k, 3 * k, RR);
+    struct tfx *f = tfx_new(text, "ts");
+    const double a = asin(1.0 / 31);
+    ck_assert_int_eq((int)floor(BAL_PI / a), 97);
+    const double lambda = 2 * (BAL_PI / (4 * a) + 1);
+    ck_assert_double_eq_tol(lambda, 50.69, 0.01);
+    const double w2 = KN * (1 / disc_mass(30 * RR) + 1 / disc_mass(RR)) * lambda;
+    ASSERT_REL(bound_of(f), 2 / sqrt(w2));
+}
+END_TEST
+
+/* The bound used beyond 64 neighbours holds where the search is used too:
+ * for every ratio R/r from 1 to 20 (N from 6 to 64), the best fan sum
+ * (searched 40 times finer than the core does) is at most 2 (π/(4a) + 1),
+ * and within 2 of it (the bound is not loose). */
+START_TEST(network_coordination_bound_holds)
+{
+    for (double q = 1; q <= 20; q += 0.5) {
+        const double a = asin(1 / (q + 1));
+        const int n = (int)floor(BAL_PI / a);
+        const double search = fan_lambda(a, n), bound = fmin(2 * (BAL_PI / (4 * a) + 1), n);
+        ck_assert_msg(search <= bound + 1e-12 && bound - search < 2,
+                      "R/r = %g: search %.6g, bound %.6g", q, search, bound);
+    }
+}
+END_TEST
+
 /* The power law's stiffness ν k_n (δ/δ0)^(ν−1) is taken at the largest
  * overlap the scene's energy allows when nothing feeds it: with ν = 3/2 the
  * energy bound gives δ ∝ E^(1/(ν+1)), so the estimate ∝ k_eff^(-1/2) ∝
@@ -495,6 +557,9 @@ Suite *suite_timestep(void)
     tcase_add_test(net, network_nine_discs_spectral);
     tcase_add_test(net, network_coordination);
     tcase_add_test(net, network_coordination_capped_by_bodies);
+    tcase_add_test(net, network_coordination_extreme_ratios);
+    tcase_add_test(net, network_coordination_closed_form);
+    tcase_add_test(net, network_coordination_bound_holds);
     tcase_add_test(net, network_hertz_energy_bound);
     tcase_add_test(net, network_all_held);
     suite_add_tcase(s, net);

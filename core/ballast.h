@@ -364,7 +364,9 @@ double bal_measure_unbalanced(const struct bal_sim *sim);
 
 /* Write the series header (cycle, time, probe names) / one row. */
 void bal_output_series_header(const struct bal_sim *sim, FILE *f);
-void bal_output_series_row(const struct bal_sim *sim, FILE *f);
+/* The row is written only when every probe value is finite; otherwise
+ * BAL_EUNSTABLE names the probe (file:line). */
+enum bal_status bal_output_series_row(const struct bal_sim *sim, FILE *f, struct bal_error *err);
 /* Name of disc `id` (scene order): its [disc] name, or FILL.k. */
 void bal_output_disc_name(const struct bal_sim *sim, int id, char *buf, size_t size);
 /* Write contacts.tsv, discs.tsv and walls.tsv of the final state into dir. */

@@ -237,13 +237,66 @@ void bal_energy_report(const struct bal_sim *s, struct bal_energy *e)
                                     : (e->imbalance == 0 ? 0 : INFINITY);
 }
 
+/* Why the audit is not finite: the first disc whose share of the gravity
+ * potential, or contact whose stored energy, overflows; else the audit's
+ * running sums (the kinetic energies are finite: check_finite ran first). */
+static enum bal_status audit_not_finite(const struct bal_sim *s, const struct bal_energy *e,
+                                        struct bal_error *err)
+{
+    for (int i = 0; i < s->n; i++) {
+        if (s->fixed[i] || isfinite(bal_mass(s, i) * (s->g[0] * s->x[i] + s->g[1] * s->y[i])))
+            continue;
+        char name[2 * BAL_NAME_MAX];
+        bal_output_disc_name(s, s->id[i], name, sizeof name);
+        return bal_error(err, BAL_EUNSTABLE,
+                         "%s: disc %s: its gravity potential m g.x is not finite at step %ld "
+                         "(gravity or position near the limits of a double?)",
+                         s->scene->path, name, s->step);
+    }
+    for (int walls = 0; walls < 2; walls++) {
+        const struct bal_pairs *p = walls ? &s->pw : &s->pp;
+        for (long c = 0; c < p->n; c++) {
+            if (!(p->flags[c] & BAL_PAIR_TOUCHING))
+                continue;
+            double rmin;
+            const struct bal_pair_law *L;
+            const double delta = bal_sim_overlap(s, walls, c, &rmin, &L);
+            const double fs = pair_fs(p, c);
+            if (isfinite(bal_measure_normal_energy(s, L, p->fn[c], delta) + fs * fs / L->ks))
+                continue;
+            char a[2 * BAL_NAME_MAX], b[3 * BAL_NAME_MAX];
+            bal_sim_pair_names(s, walls, c, a, sizeof a, b, sizeof b);
+            return bal_error(err, BAL_EUNSTABLE,
+                             "%s: the energy stored in the contact of disc %s and %s is not "
+                             "finite at step %ld (force %g: stiffness or load near the limits "
+                             "of a double?)",
+                             s->scene->path, a, b, s->step, p->fn[c]);
+        }
+    }
+    return bal_error(err, BAL_EUNSTABLE,
+                     "%s: the energy audit is not finite at step %ld (work of the walls %g, of "
+                     "gravity %g; dissipated %g, %g, %g): values near the limits of a double?",
+                     s->scene->path, s->step, e->work_walls, e->work_gravity,
+                     e->dissipated_dashpot, e->dissipated_friction, e->dissipated_global);
+}
+
 enum bal_status bal_energy_guard(const struct bal_sim *s, struct bal_error *err)
 {
-    const double limit = s->scene->settings.energy_guard;
-    if (limit <= 0 || !s->audit.started)
+    if (!s->audit.started)
         return BAL_OK;
     struct bal_energy e;
     bal_energy_report(s, &e);
+    /* Every term the run writes (run.json, the energy probes) must be a
+     * number, whether or not the runaway guard is on. */
+    const double terms[] = {e.kinetic0, e.elastic0, e.kinetic, e.elastic, e.work_walls,
+                            e.work_gravity, e.dissipated_dashpot, e.dissipated_friction,
+                            e.dissipated_global, e.imbalance, e.throughput};
+    for (size_t k = 0; k < sizeof terms / sizeof terms[0]; k++)
+        if (!isfinite(terms[k]))
+            return audit_not_finite(s, &e, err);
+    const double limit = s->scene->settings.energy_guard;
+    if (limit <= 0)
+        return BAL_OK;
     /* Created energy (a negative imbalance) beyond `limit` times what went
      * through the run: the scheme is feeding the motion. */
     if (-e.imbalance > limit * e.throughput && -e.imbalance > 0)

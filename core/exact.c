@@ -78,6 +78,7 @@
 #include <gsl/gsl_vector.h>
 
 #include "exact.h"
+#include "scene.h"
 
 /* Most solves (factorisations of K) of the whole iteration.  Phase 1 takes
  * a handful; phase 2 about one per contact it has to change. */
@@ -741,9 +742,12 @@ enum bal_status bal_exact_solve(const struct bal_sim *s, struct bal_exact *out,
 
     if (s->normal_law == BAL_NORMAL_POWER && s->nu != 1.0)
         return bal_error(err, BAL_EINVAL,
-                         "%s: exact solver: the power law with nu = %g is not linear; the "
-                         "exact solution needs linear springs (nu = 1 or the incremental law)",
-                         scene_path(s), s->nu);
+                         "%s:%d: nu: exact solver: the power law with nu = %g is not linear; "
+                         "the exact solution needs linear springs (nu = 1 or the incremental "
+                         "law)",
+                         scene_path(s),
+                         s->scene->settings.key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "nu")],
+                         s->nu);
 
     struct work w;
     memset(&w, 0, sizeof w);

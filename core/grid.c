@@ -28,6 +28,7 @@
  * scatters neighbours across memory.  The rebuild that follows finds each
  * pair's history through the permutation.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -182,9 +183,8 @@ static enum bal_status install(const struct bal_sim *s, struct bal_pairs *p,
 static inline void cell_of(double x, double y, const struct bal_grid *g, double inv_h, int *cx,
                            int *cy)
 {
-    const int ix = (int)((x - g->x0) * inv_h), iy = (int)((y - g->y0) * inv_h);
-    *cx = ix < g->nx ? ix : g->nx - 1;
-    *cy = iy < g->ny ? iy : g->ny - 1;
+    *cx = bal_cell_index((x - g->x0) * inv_h, g->nx);
+    *cy = bal_cell_index((y - g->y0) * inv_h, g->ny);
 }
 
 enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
@@ -211,10 +211,16 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
             y0 = yi < y0 ? yi : y0;
             y1 = yi > y1 ? yi : y1;
         }
-        if (!(isfinite(x0) && isfinite(x1) && isfinite(y0) && isfinite(y1)))
+        if (!(isfinite(x0) && isfinite(x1) && isfinite(y0) && isfinite(y1))) {
+            int bad = 0;
+            while (bad < n - 1 && isfinite(s->x[bad] + s->y[bad]))
+                bad++;
+            char name[2 * BAL_NAME_MAX];
+            bal_output_disc_name(s, s->id[bad], name, sizeof name);
             return bal_error(err, BAL_EUNSTABLE,
-                             "neighbour grid: a disc position is not finite at step %ld",
-                             s->step);
+                             "%s: disc %s: its position is not finite at step %ld (neighbour grid)",
+                             s->scene->path, name, s->step);
+        }
         if (!(isfinite(x1 - x0) && isfinite(y1 - y0)))
             return bal_error(err, BAL_EUNSTABLE,
                              "%s: neighbour grid: the discs spread over more than the largest "
@@ -231,7 +237,9 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
          * cell counts must fit an int).  Seen while fixing a fuzzing finding. */
         while (((x1 - x0) / h + 1) * ((y1 - y0) / h + 1) > 8.0 * n + 64 && isfinite(h))
             h *= 2;
-        int nx = (int)((x1 - x0) / h) + 1, ny = (int)((y1 - y0) / h) + 1;
+        /* At most 8 n + 64 cells (the loop above), so both fit an int. */
+        int nx = bal_cell_index((x1 - x0) / h, INT_MAX - 1) + 1;
+        int ny = bal_cell_index((y1 - y0) / h, INT_MAX - 1) + 1;
         long nc = (long)nx * ny;
         if (nc + 1 > g->cells_cap) {
             int32_t *st = realloc(g->start, (size_t)(nc + 1) * sizeof *st);
@@ -294,11 +302,14 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
                         keep &= !s->fixed[j];
                     nb[k] = j;
                     k += keep;
-                    if (k == MAX_NEIGHBOURS + 1)
+                    if (k == MAX_NEIGHBOURS + 1) {
+                        char name[2 * BAL_NAME_MAX];
+                        bal_output_disc_name(s, s->id[i], name, sizeof name);
                         return bal_error(err, BAL_EUNSTABLE,
-                                         "neighbour grid: disc %d has more than %d "
-                                         "neighbours at step %ld (piled up?)",
-                                         s->id[i], MAX_NEIGHBOURS, s->step);
+                                         "%s: disc %s has more than %d neighbours within "
+                                         "reach at step %ld (piled up?)",
+                                         s->scene->path, name, MAX_NEIGHBOURS, s->step);
+                    }
                 }
             }
             /* Insertion sort: k is small. */

@@ -66,12 +66,30 @@ void bal_output_series_header(const struct bal_sim *s, FILE *f)
     fputc('\n', f);
 }
 
-void bal_output_series_row(const struct bal_sim *s, FILE *f)
+enum bal_status bal_output_series_row(const struct bal_sim *s, FILE *f, struct bal_error *err)
 {
+    /* Measured first, into the simulation's row buffer, so that a value
+     * that is not finite stops the run before anything of the row is
+     * written. */
+    for (int p = 0; p < s->n_probes; p++) {
+        const double v = bal_measure_probe(s, p);
+        if (!isfinite(v)) {
+            const struct bal_probe_def *pd = &s->scene->probes[p];
+            const int ki = bal_scene_key_index(BAL_SEC_PROBE, "quantity");
+            return bal_error(err, BAL_EUNSTABLE,
+                             "%s:%d: quantity: [probe %s]: the value is %g at step %ld, not a "
+                             "finite number (the state overflowed: time step too large for the "
+                             "stiffness, or values near the limits of a double?)",
+                             s->scene->path, pd->key_line[ki] > 0 ? pd->key_line[ki] : pd->line,
+                             pd->name, v, s->step);
+        }
+        s->row_values[p] = v;
+    }
     fprintf(f, "%ld\t%.17g", s->step, s->time);
     for (int p = 0; p < s->n_probes; p++)
-        fprintf(f, "\t%.17g", bal_measure_probe(s, p));
+        fprintf(f, "\t%.17g", s->row_values[p]);
     fputc('\n', f);
+    return BAL_OK;
 }
 
 static FILE *open_tmp(const char *dir, const char *name, struct bal_error *err)

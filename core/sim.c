@@ -84,6 +84,7 @@ void bal_sim_free(struct bal_sim *s)
     free(s->walls);
     free(s->law);
     free(s->probes);
+    free(s->row_values);
     free(s->row);
     free(s->new2old);
     free(s->moment);
@@ -346,14 +347,107 @@ static double start_energy(const struct bal_sim *s, const struct bal_scene *sc)
     return e > 0 ? e : 0;
 }
 
+void bal_sim_disc_origin(const struct bal_scene *sc, int id, enum bal_disc_prop prop, char *buf,
+                         size_t size)
+{
+    /* The key of each property in a [disc], a [fill] and a [pile] section. */
+    static const char *const keys[][3] = {
+        [BAL_DISC_PLACE] = {"x", "origin", "origin"},
+        [BAL_DISC_SIZE] = {"r", "rmin", "d"},
+        [BAL_DISC_SPEED] = {"v", "vmax", "d"},
+        [BAL_DISC_SPIN] = {"omega", "vmax", "d"},
+    };
+    if (id < sc->n_discs) {
+        const struct bal_disc_def *d = &sc->discs[id];
+        const char *key = keys[prop][0];
+        const int ki = bal_scene_key_index(BAL_SEC_DISC, key);
+        const int line = ki >= 0 && d->key_line[ki] > 0 ? d->key_line[ki] : d->line;
+        snprintf(buf, size, "%s:%d: %s: disc %s", sc->path, line, key, d->name);
+        return;
+    }
+    long k = id - sc->n_discs;
+    for (int f = 0; f < sc->n_fills; f++, k -= sc->fills[f - 1].n) {
+        const struct bal_fill_def *fd = &sc->fills[f];
+        if (k >= fd->n)
+            continue;
+        const char *key = keys[prop][1];
+        const int ki = bal_scene_key_index(BAL_SEC_FILL, key);
+        const int line = ki >= 0 && fd->key_line[ki] > 0 ? fd->key_line[ki] : fd->line;
+        snprintf(buf, size, "%s:%d: %s: disc %s.%ld of [fill %s]", sc->path, line, key, fd->name,
+                 k, fd->name);
+        return;
+    }
+    for (int p = 0; p < sc->n_piles; p++) {
+        const struct bal_pile_def *pd = &sc->piles[p];
+        const long n = bal_sim_pile_count(pd);
+        if (k >= n) {
+            k -= n;
+            continue;
+        }
+        const char *key = keys[prop][2];
+        const int ki = bal_scene_key_index(BAL_SEC_PILE, key);
+        const int line = ki >= 0 && pd->key_line[ki] > 0 ? pd->key_line[ki] : pd->line;
+        snprintf(buf, size, "%s:%d: %s: disc %s.%ld of [pile %s]", sc->path, line, key, pd->name,
+                 k, pd->name);
+        return;
+    }
+    snprintf(buf, size, "%s: disc %d", sc->path, id);
+}
+
+/* Everything the run derives from a disc's data must be a finite double:
+ * its mass and moment of inertia (positive, with finite inverses), its
+ * kinetic energy, its weight and its share of the gravity potential, and
+ * the sums of these over the scene (which the energy audit and the probes
+ * write).  A value that overflows or underflows is refused here, naming the
+ * disc and the key that made it, rather than found as a non-finite column
+ * after the run, or as a time step of 0 with no origin. */
+static enum bal_status check_derived(const struct bal_sim *s, struct bal_error *err)
+{
+    const struct bal_scene *sc = s->scene;
+    double ek = 0, eg = 0;
+    for (int i = 0; i < s->n; i++) {
+        const double m = bal_mass(s, i), in = bal_inertia(s, i);
+        const double e = 0.5 * m * (s->vx[i] * s->vx[i] + s->vy[i] * s->vy[i]);
+        const double spin = 0.5 * in * s->w[i] * s->w[i];
+        const double g = m * (s->g[0] * s->x[i] + s->g[1] * s->y[i]);
+        const double weight = m * hypot(s->g[0], s->g[1]);
+        char where[3 * BAL_NAME_MAX + 600];
+        const char *what = NULL;
+        enum bal_disc_prop prop = BAL_DISC_SIZE;
+        if (!(m > 0 && isfinite(m) && isfinite(s->inv_m[i])))
+            what = "its mass, density x pi r^2, is not a positive finite number (the radius "
+                   "or the material's density is too small or too large)";
+        else if (!(in > 0 && isfinite(in) && isfinite(s->inv_i[i])))
+            what = "its moment of inertia m r^2/2 is not a positive finite number (the radius or "
+                   "the material's density is too small or too large)";
+        else if (!isfinite(e) || !isfinite(ek + e))
+            what = "its kinetic energy m |v|^2/2 (or the scene's total) overflows a double",
+            prop = BAL_DISC_SPEED;
+        else if (!isfinite(spin) || !isfinite(ek + e + spin))
+            what = "its rotational energy I omega^2/2 (or the scene's total) overflows a double",
+            prop = BAL_DISC_SPIN;
+        else if (!isfinite(g) || !isfinite(weight) || (!s->fixed[i] && !isfinite(eg + g)))
+            what = "its weight m g or its gravity potential m g.x (or the scene's total) "
+                   "overflows a double",
+            prop = BAL_DISC_PLACE;
+        if (what) {
+            bal_sim_disc_origin(sc, s->id[i], prop, where, sizeof where);
+            return bal_error(err, BAL_EINVAL, "%s: %s", where, what);
+        }
+        ek += e + spin;
+        if (!s->fixed[i])
+            eg += g;
+    }
+    return BAL_OK;
+}
+
 /* Bodies that overlap at the start are refused unless the scene allows it:
  * an overlap nobody meant is a typo, and it starts the run with energy the
  * scene never declared.  Two held discs may overlap (they never move: MLH's
  * bumpy bottoms with c < 0); touching within 1e-9 of the radius is contact. */
 static enum bal_status check_overlaps(const struct bal_sim *s, struct bal_error *err)
 {
-    const struct bal_settings *st = &s->scene->settings;
-    if (st->allow_overlap)
+    if (s->scene->settings.allow_overlap)
         return BAL_OK;
     for (int walls = 0; walls < 2; walls++) {
         const struct bal_pairs *p = walls ? &s->pw : &s->pp;
@@ -368,12 +462,16 @@ static enum bal_status check_overlaps(const struct bal_sim *s, struct bal_error 
                 continue;
             char a[2 * BAL_NAME_MAX], b[3 * BAL_NAME_MAX];
             bal_sim_pair_names(s, walls, c, a, sizeof a, b, sizeof b);
-            const int line = st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "allow_overlap")];
+            if (s->fixed[i]) /* name the free disc first */
+                snprintf(b, sizeof b, "disc %s", a);
+            /* Where the (free) disc was placed is where the overlap was written. */
+            char where[3 * BAL_NAME_MAX + 600];
+            bal_sim_disc_origin(s->scene, s->id[s->fixed[i] ? j : i], BAL_DISC_PLACE, where,
+                                sizeof where);
             return bal_error(err, BAL_EINVAL,
-                             "%s:%d: allow_overlap: disc %s and %s overlap by %.6g (%.3g of the "
-                             "smaller radius) at the start; expected bodies apart or touching, or "
-                             "settings.allow_overlap = 1",
-                             s->scene->path, line, a, b, delta, delta / rmin);
+                             "%s: overlaps %s by %.6g (%.3g of the smaller radius) at the start; "
+                             "expected bodies apart or touching, or settings.allow_overlap = 1",
+                             where, b, delta, delta / rmin);
         }
     }
     return BAL_OK;
@@ -409,9 +507,24 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         n_total += sc->fills[f].n;
     for (int p = 0; p < sc->n_piles; p++)
         n_total += bal_sim_pile_count(&sc->piles[p]);
-    if (n_total > 100000000L) {
+    if (n_total > BAL_MAX_DISCS) {
+        /* The generator that passes the limit, for its line. */
+        long seen = sc->n_discs;
+        char where[BAL_NAME_MAX + 600];
+        snprintf(where, sizeof where, "%s", sc->path);
+        for (int f = 0; f < sc->n_fills && seen <= BAL_MAX_DISCS; f++)
+            if ((seen += sc->fills[f].n) > BAL_MAX_DISCS)
+                snprintf(where, sizeof where, "%s:%d: n: [fill %s]", sc->path,
+                         sc->fills[f].key_line[bal_scene_key_index(BAL_SEC_FILL, "n")],
+                         sc->fills[f].name);
+        for (int p = 0; p < sc->n_piles && seen <= BAL_MAX_DISCS; p++)
+            if ((seen += bal_sim_pile_count(&sc->piles[p])) > BAL_MAX_DISCS)
+                snprintf(where, sizeof where, "%s:%d: L: [pile %s]", sc->path,
+                         sc->piles[p].key_line[bal_scene_key_index(BAL_SEC_PILE, "L")],
+                         sc->piles[p].name);
         bal_sim_free(s);
-        return bal_error(err, BAL_EINVAL, "%s: %ld discs; at most 100000000", sc->path, n_total);
+        return bal_error(err, BAL_EINVAL, "%s: the scene has %ld discs; at most %ld", where,
+                         n_total, BAL_MAX_DISCS);
     }
     const int n = (int)n_total;
     s->n = n;
@@ -559,15 +672,34 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         if (s->mat[i] != s->mat[0])
             s->disc_law = NULL;
 
+    if (check_derived(s, err)) {
+        bal_sim_free(s);
+        return err->code;
+    }
+
     /* Time step. */
     s->start_energy = start_energy(s, sc);
-    s->dt_estimate = bal_timestep_estimate(s);
+    struct bal_dt_detail dd;
+    bal_timestep_detail(s, &dd);
+    s->dt_estimate = dd.estimate;
     s->dt = st->dt > 0 ? st->dt : st->dt_fraction * s->dt_estimate;
     if (!(s->dt > 0 && isfinite(s->dt))) {
+        /* The masses are finite and positive (check_derived), so the step
+         * leaves the doubles only through the stiffness: name the material
+         * of the disc that sets the estimate. */
+        const int id = dd.binding_disc >= 0 ? dd.binding_disc : 0;
+        const struct bal_material_def *m = &sc->materials[s->mat[s->slot[id]]];
+        const int ki = bal_scene_key_index(BAL_SEC_MATERIAL, "kn");
+        char disc[2 * BAL_NAME_MAX];
+        bal_output_disc_name(s, id, disc, sizeof disc);
         const double dt = s->dt; /* read before the free (fuzzing found the use after it) */
         bal_sim_free(s);
-        return bal_error(err, BAL_EINVAL, "%s: time step %g is not a positive number", sc->path,
-                         dt);
+        return bal_error(err, BAL_EINVAL,
+                         "%s:%d: kn: [material %s]: the time step %g (dt_fraction x the estimate "
+                         "%g for disc %s) is not a positive finite number; expected a stiffness "
+                         "whose ratio to the masses is within the range of a double",
+                         sc->path, m->key_line[ki] > 0 ? m->key_line[ki] : m->line, m->name, dt,
+                         dd.estimate, disc);
     }
     if (s->dt >= s->dt_estimate && !st->force_dt) {
         const char *key = st->dt > 0 ? "dt" : "dt_fraction";
@@ -605,7 +737,8 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
     /* Probes. */
     s->n_probes = sc->n_probes;
     s->probes = calloc((size_t)(sc->n_probes ? sc->n_probes : 1), sizeof *s->probes);
-    if (!s->probes) {
+    s->row_values = calloc((size_t)(sc->n_probes ? sc->n_probes : 1), sizeof *s->row_values);
+    if (!s->probes || !s->row_values) {
         bal_sim_free(s);
         return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
     }
@@ -722,17 +855,23 @@ enum bal_status bal_sim_step(struct bal_sim *s, struct bal_error *err)
     return bal_sim_cycle(s, err);
 }
 
-/* Is every position and velocity finite?  Names the first disc that is not. */
+/* Is every position and velocity finite, and every disc's kinetic energy
+ * (which the audit and the probes sum)?  Names the first disc that is not. */
 static enum bal_status check_finite(const struct bal_sim *s, struct bal_error *err)
 {
     for (int i = 0; i < s->n; i++) {
-        if (!isfinite(s->x[i] + s->y[i] + s->vx[i] + s->vy[i] + s->w[i])) {
+        const double v2 = s->vx[i] * s->vx[i] + s->vy[i] * s->vy[i];
+        const double e = bal_mass(s, i) * v2 + bal_inertia(s, i) * s->w[i] * s->w[i];
+        if (!isfinite(s->x[i] + s->y[i] + e)) {
             char name[2 * BAL_NAME_MAX];
             bal_output_disc_name(s, s->id[i], name, sizeof name);
             return bal_error(err, BAL_EUNSTABLE,
-                             "%s: disc %s: position or velocity is not finite at step %ld "
-                             "(time step too large for the stiffness?)",
-                             s->scene->path, name, s->step);
+                             "%s: disc %s: its %s is not finite at step %ld (time step too "
+                             "large for the stiffness, or values near the limits of a double?)",
+                             s->scene->path, name,
+                             isfinite(s->x[i] + s->y[i] + v2 + s->w[i]) ? "kinetic energy"
+                                                                         : "position or velocity",
+                             s->step);
         }
     }
     return BAL_OK;
@@ -796,8 +935,9 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
                 (status = bal_energy_guard(s, err)) != BAL_OK)
                 break;
             const int done = check && stop_rule_met(s, stage, log);
-            if (row || (done && series && g == sc->n_stages - 1))
-                bal_output_series_row(s, series);
+            if ((row || (done && series && g == sc->n_stages - 1)) &&
+                (status = bal_output_series_row(s, series, err)) != BAL_OK)
+                break;
             if (done) {
                 log->stopped = 1;
                 break;

@@ -280,6 +280,7 @@ struct bal_sim {
     /* probes */
     int n_probes;
     struct bal_probe_ref *probes;
+    double *row_values;          /* n_probes: a series row measured before it is written */
     int have_old;                /* a cycle has run with a staggered integrator: the
                                   * stored velocities are v_{N+1/2}, v_{N-1/2} can be
                                   * recovered, measurements average them (eq. 31) */
@@ -343,6 +344,15 @@ void bal_contacts_walls(struct bal_sim *s);
  * Zero for a contact that is not touching. */
 void bal_contact_dashpots(const struct bal_sim *s, const struct bal_pairs *p, long c,
                           double *dn, double *ds);
+
+/* The cell, 0 to n - 1, of a point c cell sizes from a grid's origin: the
+ * conversion to int is range-checked (a point beyond the grid, or not a
+ * number, takes the nearest edge cell; a double beyond INT_MAX converted
+ * without the check is undefined behaviour). */
+static inline int bal_cell_index(double c, int n)
+{
+    return c >= 0 ? (c < n ? (int)c : n - 1) : 0;
+}
 
 /* grid.c */
 /* Squared displacement of disc i since the lists were built. */
@@ -460,6 +470,16 @@ void bal_sim_pair_names(const struct bal_sim *s, int walls, long c, char *a, siz
                         size_t nb);
 void bal_sim_contact_point(const struct bal_sim *s, int i, int is_wall, int j, double *px,
                            double *py);
+/* Most discs a scene may make (array indices are int32_t). */
+#define BAL_MAX_DISCS 100000000L
+/* A property of a disc, for naming where the scene set it. */
+enum bal_disc_prop { BAL_DISC_PLACE, BAL_DISC_SIZE, BAL_DISC_SPEED, BAL_DISC_SPIN };
+/* "FILE:LINE: KEY: disc NAME" of the key that set property `prop` of the
+ * disc with scene-order index id: its [disc] key, or the key of the [fill]
+ * or [pile] that generated it (the section's header line when the key was
+ * left at its default). */
+void bal_sim_disc_origin(const struct bal_scene *sc, int id, enum bal_disc_prop prop, char *buf,
+                         size_t size);
 /* Bytes the simulation holds while it steps (every array at its allocated
  * capacity), split into what scales with discs and with candidate pairs. */
 void bal_sim_memory(const struct bal_sim *s, double *disc_bytes, double *pair_bytes);

@@ -268,6 +268,51 @@ START_TEST(energy_runaway_guard)
 }
 END_TEST
 
+/* Issue 18: a run that reports ok reports only numbers.  A disc pressed on
+ * a wall, its contact's force then set beyond what F_n²/(2 k_n) can hold in
+ * a double: the audit is not finite, and the guard stops the run naming the
+ * contact, whether or not the runaway guard is on (energy_guard = 0). */
+START_TEST(energy_guard_not_finite)
+{
+    for (int off = 0; off < 2; off++) {
+        struct tfx *f = tfx_newf("inf", "[settings]\ndt = 1e-4\nenergy_guard = %d\n"
+                                        "[material m]\nkn = 1e4\ndensity = 1\n"
+                                        "[disc a]\nx = 0 0.499\nr = 0.5\nmaterial = m\n"
+                                        "[wall w]\np = -1 0\nangle = 0\nh1 = 0\nh2 = 2\nmaterial = m\n"
+                                        "[stage s]\ncycles = 10\n",
+                                        off ? 0 : 1);
+        t_steps(f, 2);
+        ck_assert_int_eq(bal_energy_guard(f->sim, &f->err), BAL_OK);
+        const struct bal_pairs *list;
+        const long c = t_contact(f, "a", "w", &list);
+        ck_assert(list->flags[c] & BAL_PAIR_TOUCHING);
+        f->sim->pw.fn[c] = 1e160; /* 1e320 / 2e4 is not a double */
+        ck_assert_int_eq(bal_energy_guard(f->sim, &f->err), BAL_EUNSTABLE);
+        ck_assert_msg(t_contains(f->err.msg, "inf: the energy stored in the contact of disc a and "
+                                             "wall w is not finite at step 2"),
+                      "%s", f->err.msg);
+        tfx_release(f);
+    }
+}
+END_TEST
+
+/* The disc's share of the gravity potential, m g.x, overflowing while its
+ * position and speed are finite, is named too. */
+START_TEST(energy_guard_gravity_not_finite)
+{
+    struct tfx *f = tfx_newf("far", "[settings]\ndt = 1e-4\ngravity = 0 -1e300\n"
+                                    "[material m]\nkn = 1e4\ndensity = 1\n"
+                                    "[disc a]\nx = 0 0\nr = 0.5\nmaterial = m\n"
+                                    "[stage s]\ncycles = 10\n");
+    t_steps(f, 1);
+    f->sim->y[0] = 1e300;
+    f->sim->vy[0] = 0;
+    ck_assert_int_eq(bal_energy_guard(f->sim, &f->err), BAL_EUNSTABLE);
+    ck_assert_msg(t_contains(f->err.msg, "far: disc a: its gravity potential m g.x is not finite"),
+                  "%s", f->err.msg);
+}
+END_TEST
+
 Suite *suite_energy(void)
 {
     Suite *s = suite_create("energy");
@@ -288,6 +333,8 @@ Suite *suite_energy(void)
     tcase_add_test(tc, energy_overlap_budget_off);
     tcase_add_test(tc, energy_overlap_sieve_false_alarm);
     tcase_add_test(tc, energy_runaway_guard);
+    tcase_add_test(tc, energy_guard_not_finite);
+    tcase_add_test(tc, energy_guard_gravity_not_finite);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -609,6 +609,37 @@ START_TEST(measure_weight_follows_ramp)
 }
 END_TEST
 
+/* Issue 18: a series row is written only when every probe value is a
+ * number; otherwise nothing of it is written and the probe is named by its
+ * file, line and key. */
+START_TEST(measure_series_row_not_finite)
+{
+    struct tfx *f = tfx_new("[settings]\ndt = 1e-3\n"
+                            "[material m]\nkn = 1e4\ndensity = 2.385\n"
+                            "[disc d]\nx = 0.5 1.25\nr = 0.3\nmaterial = m\n"
+                            "[stage a]\ncycles = 6\n"
+                            "[probe ek]\nquantity = energy_kinetic\n"
+                            "[probe x]\nquantity = disc_x\na = d\n",
+                            "rows");
+    t_steps(f, 1);
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *out = open_memstream(&buf, &len);
+    ck_assert_ptr_nonnull(out);
+    ck_assert_int_eq(bal_output_series_row(f->sim, out, &f->err), BAL_OK);
+    fflush(out);
+    const size_t one_row = len;
+    ck_assert_uint_gt(one_row, 0);
+    f->sim->x[t_slot(f, "d")] = INFINITY;
+    ck_assert_int_eq(bal_output_series_row(f->sim, out, &f->err), BAL_EUNSTABLE);
+    fclose(out);
+    ck_assert_uint_eq(len, one_row); /* nothing of the second row */
+    ck_assert_msg(t_contains(f->err.msg, "rows:15: quantity: [probe x]: the value is inf at step 1"),
+                  "%s", f->err.msg);
+    free(buf);
+}
+END_TEST
+
 Suite *suite_measure(void)
 {
     Suite *s = suite_create("measure");
@@ -635,6 +666,7 @@ Suite *suite_measure(void)
     tcase_add_test(tc, measure_stress_anisotropic_principal);
     tcase_add_test(tc, measure_held_and_weight_probes);
     tcase_add_test(tc, measure_weight_follows_ramp);
+    tcase_add_test(tc, measure_series_row_not_finite);
     suite_add_tcase(s, tc);
     return s;
 }

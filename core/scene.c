@@ -425,6 +425,10 @@ enum bal_status bal_scene_parse(struct bal_scene *s, const char *text,
     char line[LINE_MAX_CHARS + 2];
 
     const char *p = text;
+    /* A UTF-8 byte-order mark, which some editors put at the start of a
+     * file, is not part of the first line. */
+    if (strncmp(p, "\xEF\xBB\xBF", 3) == 0)
+        p += 3;
     while (*p) {
         w.line++;
         const char *nl = strchr(p, '\n');
@@ -845,8 +849,11 @@ void bal_scene_print_keys(FILE *out)
             if (!key)
                 break;
             char range[96] = "";
+            /* A word's choices are printed whole (the probe quantities are
+             * longer than any fixed buffer kept for a numeric range). */
+            const char *shown = range;
             if (key->type == BAL_KEY_ENUM)
-                snprintf(range, sizeof range, "%s", key->choices);
+                shown = key->choices;
             else if (key->type == BAL_KEY_DOUBLE || key->type == BAL_KEY_LONG) {
                 char lo[32] = "", hi[32] = "";
                 if (key->min > -1e300)
@@ -858,7 +865,7 @@ void bal_scene_print_keys(FILE *out)
             }
             fprintf(out, "| `%s` | %s | %s | %s | %s |\n", key->name, type_names[key->type],
                     key->def ? (*key->def ? key->def : "(none)") : (key->required ? "required" : "(none)"),
-                    range, key->doc);
+                    shown, key->doc);
         }
     }
 }

@@ -167,6 +167,23 @@ static int cmd_info(const struct args *a)
     return 0;
 }
 
+/* Remove an earlier run's outputs from dir (with_json: run.json too, and
+ * first: a run killed while this runs must not leave an old run.json saying
+ * ok beside a missing series), or, after a failed run, the outputs it had
+ * finished, so that only run.json, saying why, remains. */
+static void remove_outputs(const char *dir, int with_json)
+{
+    const char *names[] = {"run.json", "series.tsv", "discs.tsv", "contacts.tsv", "walls.tsv",
+                           "stress.tsv", "stress_grid.tsv"};
+    for (size_t k = with_json ? 0 : 1; k < sizeof names / sizeof names[0]; k++) {
+        char p[1200];
+        snprintf(p, sizeof p, "%s/%s", dir, names[k]);
+        remove(p);
+        snprintf(p, sizeof p, "%s/%s.tmp", dir, names[k]);
+        remove(p);
+    }
+}
+
 /* What `run` and `exact` share: the scene loaded and validated, the
  * simulation created, the output folder made and emptied of an earlier
  * run's results (so nothing stale is read as new).  Returns -1 when ready,
@@ -178,6 +195,11 @@ static int prepare(const struct args *a, const char *cmd, struct bal_scene *sc,
     *sim = NULL;
     if (!a->out) {
         fprintf(stderr, "ballast %s: --out DIR is required\n", cmd);
+        return 2;
+    }
+    struct stat out_st;
+    if (stat(a->out, &out_st) == 0 && !S_ISDIR(out_st.st_mode)) {
+        fprintf(stderr, "ballast %s: --out %s is not a directory\n", cmd, a->out);
         return 2;
     }
     if (load(sc, a, &err) || bal_sim_create(sim, sc, &err) ||
@@ -194,13 +216,7 @@ static int prepare(const struct args *a, const char *cmd, struct bal_scene *sc,
         bal_scene_free(sc);
         return 3;
     }
-    const char *names[] = {"series.tsv", "discs.tsv", "contacts.tsv", "walls.tsv", "stress.tsv",
-                           "stress_grid.tsv", "run.json"};
-    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
-        char p[1200];
-        snprintf(p, sizeof p, "%s/%s", a->out, names[k]);
-        remove(p);
-    }
+    remove_outputs(a->out, 1);
     return -1;
 }
 
@@ -236,9 +252,9 @@ static int cmd_run(const struct args *a)
             st = bal_output_commit(a->out, "series.tsv", &err);
         if (st == BAL_OK)
             st = bal_output_state(sim, a->out, &err);
-        if (st != BAL_OK)
-            remove(tmp);
     }
+    if (st != BAL_OK)
+        remove_outputs(a->out, 0);
     struct bal_error jerr = {0};
     enum bal_status js = bal_output_run_json(sim, a->out, sc.path, a->n_sets, a->sets, st,
                                              st == BAL_OK ? "" : err.msg, &jerr);
@@ -319,6 +335,8 @@ static int cmd_exact(const struct args *a)
     enum bal_status st = bal_exact_solve(sim, &ex, &err);
     if (st == BAL_OK)
         st = write_exact(sim, &ex, a->out, &err);
+    if (st != BAL_OK)
+        remove_outputs(a->out, 0);
     bal_sim_add_seconds(sim, ex.seconds);
     struct bal_error jerr = {0};
     enum bal_status js = bal_output_run_json(sim, a->out, sc.path, a->n_sets, a->sets, st,

@@ -1,0 +1,135 @@
+"""The `ballast` command under careless or hostile use (issue 18), on the real bin/ballast
+(skipped when it is not built; `make test` builds it).
+
+- `--out` naming a file is refused as such (exit 2), not with internal temporary paths;
+- a scene saved with a UTF-8 byte-order mark runs like the same scene without it;
+- `ballast keys` lists every probe quantity (and so does the README, test_readme.py);
+- a rerun into a folder that held a finished run removes the old run.json before anything
+  else, so a kill at any moment never leaves it saying ok beside missing outputs;
+- on a full disk `run` and `exact` end with exit 3 and leave no temporary file (a small
+  tmpfs, mounted for the test: skipped where mounting is not permitted).
+"""
+import os
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+BALLAST = REPO / "bin" / "ballast"
+MINIMAL = REPO / "core" / "tests" / "scenes" / "minimal.scene"
+PILE = REPO / "cases" / "piles" / "pile30_smooth.scene"
+
+needs_ballast = pytest.mark.skipif(not BALLAST.exists(), reason="bin/ballast not built")
+OUTPUTS = ("run.json", "series.tsv", "discs.tsv", "contacts.tsv", "walls.tsv", "stress.tsv")
+
+
+def ballast(*args, timeout=120):
+    return subprocess.run([str(BALLAST), *map(str, args)], capture_output=True, text=True,
+                          timeout=timeout)
+
+
+@needs_ballast
+@pytest.mark.parametrize("command", ["run", "exact"])
+def test_out_naming_a_file_is_refused_as_such(tmp_path, command):
+    target = tmp_path / "afile"
+    target.write_text("keep me\n")
+    done = ballast(command, PILE if command == "exact" else MINIMAL, "--out", target)
+    assert done.returncode == 2
+    assert done.stderr.strip() == f"ballast {command}: --out {target} is not a directory"
+    assert target.read_text() == "keep me\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
+
+
+@needs_ballast
+def test_byte_order_mark_is_accepted(tmp_path):
+    plain, marked = tmp_path / "plain.scene", tmp_path / "marked.scene"
+    shutil.copy(MINIMAL, plain)
+    marked.write_bytes(b"\xef\xbb\xbf" + MINIMAL.read_bytes())
+    assert ballast("run", plain, "--out", tmp_path / "a").returncode == 0
+    done = ballast("run", marked, "--out", tmp_path / "b")
+    assert done.returncode == 0, done.stderr
+    for name in ("series.tsv", "discs.tsv", "contacts.tsv"):
+        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes()
+
+
+@needs_ballast
+def test_byte_order_mark_only_at_the_start(tmp_path):
+    text = MINIMAL.read_text().replace("[disc a]", "\ufeff[disc a]")
+    scene = tmp_path / "inner.scene"
+    scene.write_text(text, encoding="utf-8")
+    done = ballast("run", scene, "--out", tmp_path / "o")
+    assert done.returncode == 2 and "expected" in done.stderr
+    assert not (tmp_path / "o").exists()
+
+
+QUANTITIES = ("contact_fn contact_fs contact_sliding wall_f1 wall_f2 wall_moment wall_ecc disc_x "
+              "disc_y disc_vx disc_vy disc_theta disc_omega energy_kinetic energy_elastic "
+              "work_walls work_gravity dissipated_dashpot dissipated_friction dissipated_global "
+              "energy_imbalance unbalanced n_contacts n_sliding held_fx held_fy weight_x "
+              "weight_y").split()
+
+
+@needs_ballast
+def test_keys_list_every_probe_quantity():
+    keys = ballast("keys").stdout
+    row = next(line for line in keys.splitlines() if line.startswith("| `quantity` |"))
+    listed = row.split("|")[4].split()
+    assert listed == QUANTITIES
+
+
+@needs_ballast
+@pytest.mark.skipif(shutil.which("strace") is None, reason="strace is not installed")
+def test_rerun_removes_the_old_run_json_first(tmp_path):
+    out = tmp_path / "o"
+    assert ballast("run", MINIMAL, "--out", out).returncode == 0
+    trace = tmp_path / "trace"
+    done = subprocess.run(["strace", "-f", "-e", "trace=unlink,unlinkat", "-o", str(trace),
+                           str(BALLAST), "run", str(MINIMAL), "--out", str(out)],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    removed = [line for line in trace.read_text().splitlines()
+               if "unlink" in line and "= 0" in line]
+    names = [Path(line.split('"')[1]).name for line in removed]
+    assert names[:2] == ["run.json", "series.tsv"], names
+
+
+def _mount_tmpfs(path, size):
+    try:
+        done = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(path)],
+                              capture_output=True, text=True, timeout=30)
+    except OSError as exc:
+        return str(exc)
+    return "" if done.returncode == 0 else done.stderr.strip() or "mount failed"
+
+
+@pytest.fixture
+def full_disk():
+    """A 200 KiB tmpfs, nearly filled; unmounted afterwards."""
+    root = Path(tempfile.mkdtemp(prefix="ballast-full-"))
+    why = _mount_tmpfs(root, "200k")
+    if why:
+        root.rmdir()
+        pytest.skip(f"cannot mount a tmpfs here: {why}")
+    try:
+        (root / "filler").write_bytes(b"\0" * (190 * 1024))
+        yield root
+    finally:
+        subprocess.run(["umount", str(root)], capture_output=True, timeout=30)
+        root.rmdir()
+
+
+@needs_ballast
+@pytest.mark.parametrize("command", ["run", "exact"])
+def test_full_disk_is_an_io_error_and_leaves_no_temporary_file(full_disk, command):
+    out = full_disk / "o"
+    done = ballast(command, PILE, "--out", out, "--set", "stage.ramp.cycles=50",
+                   "--set", "stage.relax.cycles=50")
+    assert done.returncode == 3, done.stderr
+    assert "No space left on device" in done.stderr or "write failed" in done.stderr
+    left = sorted(p.name for p in out.iterdir()) if out.exists() else []
+    assert not [n for n in left if n.endswith(".tmp")], left
+    # What is left says why: at most a run.json, and no result file.
+    assert set(left) <= {"run.json"}, left

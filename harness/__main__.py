@@ -1,28 +1,41 @@
 """The command line: python3 -m harness {list,run,check,report,validate,rebaseline,sweep,cost}.
 
 Each command is a small function that loads the catalogue and references, picks the
-cases, and hands over to runner, gate, report or rebaseline.  Errors in case.txt or .ref
-files (named file:line) and unknown case names end the command with status 2.
+cases, and hands over to runner, gate, report or rebaseline.  Exit statuses besides 0 and
+1 (a check or run failed):
+
+  2    errors in case.txt or .ref files (named file:line), unknown case names, bad options;
+  3    the harness could not write under reports/ (or a reference file): disk full,
+       read-only, a path through a regular file -- one line names the path and the OS's
+       reason, and no temporary file is left (files.py);
+  75   another harness is using the same reports folder (lock.py; 75 is sysexits'
+       EX_TEMPFAIL: try again later);
+  130  interrupted (Ctrl-C, SIGTERM).
+
+Every command but `list` holds the reports folder's lock while it works.
 """
 import argparse
 import functools
 import os
 import shutil
 import sys
-import tempfile
+from contextlib import nullcontext
 from pathlib import Path
 
 from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_root
-from . import catalogue, references
+from . import catalogue, files, references, stability
 from . import sweep as sweeps
 from .compare import RunStore, evaluate_all, folder_locator
 from .gate import gate, sweep_table
 from .ini import IniError
+from .lock import Busy, reports_lock
 from .rebaseline import rebaseline
 from .report import write_report
 from .runner import jobs_for, run_all, sigterm_as_interrupt, sweep_jobs
 
 USAGE_ERROR = 2
+IO_ERROR = 3         # as the core's exit code for an I/O error
+BUSY = 75            # sysexits.h EX_TEMPFAIL: another harness holds the reports folder
 
 
 # ---------------------------------------------------------------- loading
@@ -66,6 +79,17 @@ def cmd_run(args):
         print("no cases selected", file=sys.stderr)
         return 1
     outcomes = run_all(jobs_for(cases, runs_root()), args.bin, args.jobs, sys.stdout, resume=args.resume)
+    return runs_status(outcomes)
+
+
+def runs_status(outcomes):
+    """0 if every run is ok; IO_ERROR (said on stderr) if the harness could not prepare or
+    record some run folder; else 1."""
+    unwritten = [o.io_error for o in outcomes if o.io_error]
+    if unwritten:
+        print(f"ballast-harness: {unwritten[0]}"
+              + (f" (and {len(unwritten) - 1} more run folder(s))" if len(unwritten) > 1 else ""), file=sys.stderr)
+        return IO_ERROR
     return 0 if all(o.ok for o in outcomes) else 1
 
 
@@ -120,7 +144,7 @@ def cmd_sweep(args):
     outcomes = run_all(jobs, args.bin, args.jobs, sys.stdout, resume=args.resume)
     checks = [c for c in load_checks(cases) if c.case == case.name and c.run_variants == [variant.name]]
     print_sweep(case, variant, checks, jobs)
-    return 0 if all(o.ok for o in outcomes) else 1
+    return runs_status(outcomes)
 
 
 def cmd_cost(args):
@@ -132,9 +156,17 @@ def cmd_cost(args):
     return 0
 def cmd_stability(args):
     """Stability limits per variant and the extreme probes (harness/stability.py)."""
-    from . import stability
-    reports_root().mkdir(parents=True, exist_ok=True)
-    work = Path(tempfile.mkdtemp(prefix="stability-runs.", dir=reports_root()))
+    for old in reports_root().glob("stability-runs.*"):     # left by a killed harness; we hold the lock
+        shutil.rmtree(old, ignore_errors=True)
+    work = files.scratch_folder(reports_root(), "stability-runs.")
+    try:
+        return _stability(args, work)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+def _stability(args, work):
+    """cmd_stability's work, its trial runs in the scratch folder work."""
     status = 0
     if not args.extremes_only:
         cases = selected(args, load_cases())
@@ -153,7 +185,6 @@ def cmd_stability(args):
         for r in rows:
             print(f"  {r['group']}/{r['probe']}: {r['outcome']}{'' if r['as_expected'] == 'yes' else '  UNEXPECTED'}")
         print(f"wrote {reports_root() / 'extremes.tsv'}")
-    shutil.rmtree(work, ignore_errors=True)
     return status
 
 
@@ -193,10 +224,13 @@ def print_sweep(case, variant, checks, jobs):
 
 def parser():
     p = argparse.ArgumentParser(prog="ballast-harness",
-                                description="ballast validation harness: run the cases, check them, report.")
+                                description="ballast validation harness: run the cases, check them, report.",
+                                epilog=f"exit status: 0 ok; 1 a check or a run failed; {USAGE_ERROR} bad input; "
+                                       f"{IO_ERROR} the harness could not write under the reports folder; "
+                                       f"{BUSY} another harness is using the reports folder; 130 interrupted")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    _selection(_command(sub, "list", cmd_list, "table of the cases: tier, variants, expected run time, what each checks"),
-               default_tier="full", names=False)
+    _selection(_command(sub, "list", cmd_list, "table of the cases: tier, variants, expected run time, what each checks",
+                        writes=False), default_tier="full", names=False)
     _runs(_selection(_command(sub, "run", cmd_run, "run every variant of the selected cases")))
     _selection(_command(sub, "check", cmd_check,
                         "evaluate the checks, print the gate table, write summary.json and junit.xml"))
@@ -227,9 +261,10 @@ def parser():
     return p
 
 
-def _command(sub, name, fn, text):
+def _command(sub, name, fn, text, writes=True):
+    """A subcommand; writes: it writes under reports/, so it holds the reports lock."""
     p = sub.add_parser(name, help=text, description=text)
-    p.set_defaults(fn=fn)
+    p.set_defaults(fn=fn, writes=writes)
     return p
 
 
@@ -255,13 +290,20 @@ def main(argv=None):
         args.bin = bin_path()
     try:
         with sigterm_as_interrupt():          # SIGTERM stops the runs like Ctrl-C: exit 130
-            return args.fn(args)
+            with reports_lock(reports_root(), args.command) if args.writes else nullcontext():
+                return args.fn(args)
     except (IniError, catalogue.CatalogueError) as exc:
         print(f"ballast-harness: {exc}", file=sys.stderr)
         return USAGE_ERROR
     except KeyboardInterrupt:
         print("\nballast-harness: interrupted", file=sys.stderr)
         return 130
+    except Busy as exc:
+        print(f"ballast-harness: {exc}", file=sys.stderr)
+        return BUSY
+    except OSError as exc:
+        print(f"ballast-harness: {files.describe(exc)}", file=sys.stderr)
+        return IO_ERROR
 
 
 if __name__ == "__main__":

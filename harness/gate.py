@@ -8,6 +8,7 @@ import json
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+from . import files
 from .compare import Verdict, evaluate_all
 
 COLUMNS = ("case", "variant", "check", "value", "reference", "tolerance", "kind", "result")
@@ -104,12 +105,10 @@ def write_junit(verdicts, path):
 
 
 def _write(path, text):
-    """Write text whole: to a temporary file, then rename."""
+    """Write text whole (files.write_text: a temporary file, then rename)."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
+    files.make_dirs(path.parent)
+    files.write_text(path, text)
 
 
 def exit_status(verdicts):

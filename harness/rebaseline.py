@@ -8,6 +8,7 @@ run of the case succeeded and every regression quantity evaluates to a finite nu
 import re
 from pathlib import Path
 
+from . import files
 from .compare import EvalError, quantity_in
 from .tables import RunProblem
 
@@ -66,10 +67,7 @@ def rewrite_file(path, changes):
         lines = f.read().splitlines(keepends=True)
     for number, text in changes.items():
         lines[number - 1] = replace_value(lines[number - 1], text)
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "w", encoding="utf-8", newline="") as f:
-        f.write("".join(lines))
-    tmp.replace(path)
+    files.write_text(path, "".join(lines))     # bytes as read: line endings kept
 
 
 def rebaseline(case, checks, store, out):

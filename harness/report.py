@@ -19,6 +19,10 @@ variant at (x, y) = two quantity expressions, joined in the order listed and lab
 with the variant name, optional log axes).  Whatever a figure cannot show -- a variant
 without data, an expression that fails, a non-positive value on a log axis, non-finite
 values -- is listed in its notes, never silently dropped.
+
+gnuplot draws in a scratch folder; the figures, summary.md and index.html reach reports/
+through files.py (a temporary file, then rename), so a killed report leaves each of them
+old or new, never empty or cut.
 """
 import base64
 import html
@@ -32,7 +36,8 @@ from pathlib import Path
 import numpy as np
 
 from . import REPO_ROOT
-from . import network, piles
+from . import files, network, piles
+from .children import options as child_options
 from .compare import EvalError, evaluate, evaluate_all
 from .gate import fmt_number, fmt_reference, read_summary, tally
 from .tables import RunProblem, read_harness_record, read_run_json
@@ -67,7 +72,7 @@ def git_revision(root=REPO_ROOT):
     """`git rev-parse --short HEAD`, or 'unknown'."""
     try:
         done = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root,
-                              capture_output=True, text=True, timeout=10)
+                              capture_output=True, text=True, timeout=10, **child_options(keep_lock=False))
     except (OSError, subprocess.SubprocessError):
         return "unknown"
     return done.stdout.strip() if done.returncode == 0 and done.stdout.strip() else "unknown"
@@ -140,9 +145,7 @@ def figure_data(case, figure, store, workdir):
 
 
 def _write_columns(path, arrays):
-    with open(path, "w", encoding="utf-8") as f:
-        for row in zip(*arrays):
-            f.write("\t".join(repr(float(x)) for x in row) + "\n")
+    files.write_text(path, "".join("\t".join(repr(float(x)) for x in row) + "\n" for row in zip(*arrays)))
 
 
 def gnuplot_script(figure, clauses, png, svg, settings=()):
@@ -234,7 +237,7 @@ def _points_script(case, figure, store, workdir, png, svg):
     if not rows:
         return None, notes + ["nothing to plot"]
     path = Path(workdir) / "points.dat"
-    path.write_text("".join(f"{x!r}\t{y!r}\t{name}\n" for x, y, name in rows), encoding="utf-8")
+    files.write_text(path, "".join(f"{x!r}\t{y!r}\t{name}\n" for x, y, name in rows))
     settings = [f"set logscale {figure.logscale}"] if figure.logscale else []
     clauses = [f"{gp_string(path)} using 1:2 with linespoints pt 7 ps 1 notitle",
                f"{gp_string(path)} using 1:2:3 with labels left offset char 0.8,0.6 notitle"]
@@ -324,28 +327,46 @@ def render_figure(case, figure, store, figures_dir):
     out = FigureOut(figure.name, figure.title, figure.paper)
     png, svg = (Path(figures_dir) / f"{case.name}_{figure.name}.{ext}" for ext in ("png", "svg"))
     for old in (png, svg):
-        old.unlink(missing_ok=True)
+        files.remove(old)
     if not shutil.which("gnuplot"):
         out.notes.append("gnuplot not found: figure not rendered")
         return out
     with tempfile.TemporaryDirectory(prefix="ballast-fig-") as workdir:
-        text, out.notes = SCRIPTS[figure.kind](case, figure, store, workdir, png, svg)
+        drawn = _drawn(workdir)
+        text, out.notes = SCRIPTS[figure.kind](case, figure, store, workdir, *drawn)
         if text is None:
             return out
         error = _run_gnuplot(text, workdir)
+        out.png, out.svg = _publish(drawn, (png, svg))
     if error:
         out.notes.append(f"gnuplot failed: {error}")
-    out.png = png if png.is_file() and png.stat().st_size else None
-    out.svg = svg if svg.is_file() and svg.stat().st_size else None
+    return out
+
+
+def _drawn(workdir):
+    """Where gnuplot draws a figure: the scratch folder (its data files end in .dat)."""
+    return Path(workdir) / "figure.png", Path(workdir) / "figure.svg"
+
+
+def _publish(drawn, final):
+    """Copy each non-empty drawing to its place in reports/figures (whole, by files.copy);
+    the places filled, None for a drawing gnuplot did not make."""
+    out = []
+    for source, path in zip(drawn, final):
+        made = source.is_file() and source.stat().st_size > 0
+        if made:
+            files.copy(source, path)
+        out.append(path if made else None)
     return out
 
 
 def _run_gnuplot(script, workdir):
     """Run gnuplot on script; '' on success, else its complaint."""
     path = Path(workdir) / "figure.gp"
-    path.write_text(script, encoding="utf-8")
+    files.write_text(path, script)
     try:
-        done = subprocess.run(["gnuplot", str(path)], capture_output=True, text=True, timeout=120)
+        done = subprocess.run(["gnuplot", str(path)], capture_output=True, text=True, timeout=120,
+                              **child_options(keep_lock=False))
     except (OSError, subprocess.SubprocessError) as exc:
         return str(exc)
     return "" if done.returncode == 0 else (done.stderr.strip().splitlines() or ["exit %d" % done.returncode])[-1]
@@ -379,8 +400,7 @@ def _saved(summary):
 def gather(cases, checks, store, runs_root, reports_dir):
     """A CaseReport per case: runs, rendered figures, verdicts."""
     summary = Path(reports_dir) / "summary.json"
-    saved, figures_dir = _saved(summary), Path(reports_dir) / "figures"
-    figures_dir.mkdir(parents=True, exist_ok=True)
+    saved, figures_dir = _saved(summary), files.make_dirs(Path(reports_dir) / "figures")
     reports = []
     for case in cases:
         verdicts, source = verdicts_for(case, checks, summary, saved, runs_root, store)
@@ -567,11 +587,10 @@ def write_report(cases, checks, store, runs_root, reports_dir, out=None):
     reports_dir = Path(reports_dir)
     reports = gather(cases, checks, store, runs_root, reports_dir)
     revision, date = git_revision(), now_text()
-    (reports_dir / "summary.md").write_text(markdown(reports, revision, date) + stability_markdown(reports_dir),
-                                            encoding="utf-8")
+    files.write_text(reports_dir / "summary.md", markdown(reports, revision, date) + stability_markdown(reports_dir))
     index = reports_dir / "index.html"
-    index.write_text(page(reports, revision, date).replace("</body></html>", stability_html(reports_dir) + "</body></html>"),
-                     encoding="utf-8")
+    files.write_text(index, page(reports, revision, date).replace("</body></html>",
+                                                                  stability_html(reports_dir) + "</body></html>"))
     if out:
         print(f"wrote {reports_dir / 'summary.md'} and {index}", file=out)
     return index
@@ -668,7 +687,7 @@ def render_cost(case, rows, figures_dir):
     out = FigureOut("error_cost_sweep", f"{case.name}: error against cost (declared sweeps)")
     png, svg = (Path(figures_dir) / f"{case.name}_error_cost_sweep.{ext}" for ext in ("png", "svg"))
     for old in (png, svg):
-        old.unlink(missing_ok=True)
+        files.remove(old)
     curves, defaults, out.notes, bad = cost_points(rows)
     if not curves and not bad:
         out.notes.append("nothing to plot")
@@ -687,21 +706,21 @@ def render_cost(case, rows, figures_dir):
         for i, name in enumerate(names):
             if name in curves:
                 path = Path(workdir) / f"curve{i}.dat"
-                path.write_text("".join(f"{x!r}\t{y!r}\t{label}\n" for x, y, label in curves[name]), encoding="utf-8")
+                files.write_text(path, "".join(f"{x!r}\t{y!r}\t{label}\n" for x, y, label in curves[name]))
                 # point types cycle filled/open, so curves that coincide (verlet on centred) stay visible
                 clauses += [f"{gp_string(path)} using 1:2 with linespoints pt {POINT_TYPES[i % len(POINT_TYPES)]} "
                             f"ps {1.0 if i % 2 == 0 else 1.6} lc {i + 1} title {gp_string(name)}",
                             f"{gp_string(path)} using 1:2:3 with labels left offset char 0.6,0.5 tc lt {i + 1} notitle"]
             if name in bad:
                 path = Path(workdir) / f"failed{i}.dat"
-                path.write_text("".join(f"{x!r}\t{top!r}\t\"{label}\"\n" for x, label in bad[name]), encoding="utf-8")
+                files.write_text(path, "".join(f"{x!r}\t{top!r}\t\"{label}\"\n" for x, label in bad[name]))
                 clauses += [f"{gp_string(path)} using 1:2 with points pt 2 ps 2 lw 2 lc {i + 1} "
                             f"title {gp_string(name + ': ' + UNSTABLE)}",
                             f"{gp_string(path)} using 1:2:3 with labels rotate by 90 left offset char 0,1 "
                             f"tc lt {i + 1} notitle"]
         if defaults:
             path = Path(workdir) / "default.dat"
-            path.write_text("".join(f"{x!r}\t{y!r}\n" for x, y in defaults), encoding="utf-8")
+            files.write_text(path, "".join(f"{x!r}\t{y!r}\n" for x, y in defaults))
             clauses.append(f"{gp_string(path)} using 1:2 with points pt 3 ps 3 lw 2 lc rgb 'black' "
                            "title 'default tier setting'")
         extra = ["set logscale xy", "set key outside"]
@@ -711,11 +730,11 @@ def render_cost(case, rows, figures_dir):
                          f"first {top!r} offset 0,-0.8 tc rgb 'gray'")
             if errors:
                 extra.append(f"set yrange [{min(errors) / 3!r}:{top * 30!r}]")
-        error = _run_gnuplot(gnuplot_script(figure, clauses, png, svg, extra), workdir)
+        drawn = _drawn(workdir)
+        error = _run_gnuplot(gnuplot_script(figure, clauses, *drawn, extra), workdir)
+        out.png, out.svg = _publish(drawn, (png, svg))
     if error:
         out.notes.append(f"gnuplot failed: {error}")
-    out.png = png if png.is_file() and png.stat().st_size else None
-    out.svg = svg if svg.is_file() and svg.stat().st_size else None
     return out
 
 

@@ -15,11 +15,15 @@ and recorded as failed; then KeyboardInterrupt goes on to the caller (exit 130).
 Resume (run_all(..., resume=True), `--resume` on the command line): a job whose folder
 holds a complete successful run with the same identity, its files unchanged since, is not
 run again; every other job is (see stale()).
+
+Killed outright (SIGKILL): every run dies with the harness (harness/children.py) and keeps
+the reports lock until it has (harness/lock.py), so a `--resume` at once is safe.  When the
+harness cannot prepare or record a run folder (disk full, read-only), the run fails with
+Outcome.io_error set, its half-written record removed; the command exits with status 3.
 """
 import hashlib
 import json
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -30,6 +34,8 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
+from . import files
+from .children import options as child_options
 from .tables import RunProblem, read_harness_record, read_run_json, run_failure, unfinished_outputs
 
 STDERR_TAIL = 5
@@ -62,6 +68,7 @@ class Outcome:
     wall: float
     cause: str = ""
     skipped: bool = False   # resumed: a complete run of the same identity was already there
+    io_error: str = ""      # the harness could not prepare or record the folder (see files.py)
 
 
 def jobs_for(cases, runs_root):
@@ -118,11 +125,9 @@ class Running:
 
 
 def fresh_folder(path):
-    """An empty folder at path (whatever was there is removed)."""
-    path = Path(path)
-    if path.exists():
-        shutil.rmtree(path)
-    path.mkdir(parents=True)
+    """An empty folder at path (whatever was there is removed); files.WriteError if not."""
+    files.remove_tree(path)
+    files.make_dirs(path)
 
 
 def run_one(job, binary, running=None, resume=False, binary_id=None):
@@ -137,8 +142,8 @@ def run_one(job, binary, running=None, resume=False, binary_id=None):
         return Outcome(job, True, record.get("returncode"), 0.0, skipped=True)
     try:
         fresh_folder(job.out)
-    except OSError as exc:
-        return Outcome(job, False, None, 0.0, f"cannot prepare {job.out}: {exc}")
+    except files.WriteError as exc:
+        return Outcome(job, False, None, 0.0, f"cannot prepare the run folder: {exc}", io_error=str(exc))
     cmd = command(job, binary)
     start = time.monotonic()
     try:
@@ -148,13 +153,17 @@ def run_one(job, binary, running=None, resume=False, binary_id=None):
     wall = time.monotonic() - start
     if running and returncode in INTERRUPTED:
         running.stop_starting()     # Ctrl-C reached the core's process group: start no other run
-    (job.out / "ballast.stdout").write_text(stdout, encoding="utf-8")
-    (job.out / "ballast.stderr").write_text(stderr, encoding="utf-8")
-    cause = _cause(job, returncode, stderr)
-    if cause and running and running.stopping:
-        cause = "interrupted: " + cause
-    outcome = Outcome(job, not cause, returncode, wall, cause)
-    _record(outcome, cmd, ident)
+    try:
+        files.write_text(job.out / "ballast.stdout", stdout)
+        files.write_text(job.out / "ballast.stderr", stderr)
+        cause = _cause(job, returncode, stderr)
+        if cause and running and running.stopping:
+            cause = "interrupted: " + cause
+        outcome = Outcome(job, not cause, returncode, wall, cause)
+        _record(outcome, cmd, ident)
+    except files.WriteError as exc:
+        # no harness.json: the folder reads as unfinished, and --resume runs it again
+        return Outcome(job, False, returncode, wall, f"cannot record the run: {exc}", io_error=str(exc))
     return outcome
 
 
@@ -221,7 +230,7 @@ def stale(job, ident):
 
 def _execute(cmd, cwd, running):
     proc = subprocess.Popen(cmd, cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, errors="replace")
+                            stderr=subprocess.PIPE, text=True, errors="replace", **child_options())
     if running:
         running.add(proc)
     try:
@@ -258,9 +267,7 @@ def _record(outcome, cmd, ident):
               "returncode": outcome.returncode, "wall_seconds": round(outcome.wall, 6),
               "ok": outcome.ok, "cause": outcome.cause, "kind": outcome.job.command,
               "identity": ident, "outputs": output_digests(folder)}
-    tmp = folder / "harness.json.tmp"
-    tmp.write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
-    tmp.replace(folder / "harness.json")
+    files.write_text(folder / "harness.json", json.dumps(record, indent=1) + "\n")
 
 
 class Progress:

@@ -48,6 +48,8 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from . import files
+from .children import options as child_options
 from .ini import parse_file
 
 ENERGY_GROWTH = 4.0
@@ -87,7 +89,7 @@ def targets_for(cases, one_per_case=False):
 def info(binary, scene, sets):
     """`ballast info` of a scene: estimate (the bound), single (C&S 2 sqrt(m/k)), dt."""
     cmd = [str(binary), "info", str(scene)] + [a for s in sets for a in ("--set", s)]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
+    proc = subprocess.run(cmd, capture_output=True, text=True, **child_options())
     if proc.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)}: exit {proc.returncode}: {proc.stderr.strip()}")
     return parse_info(proc.stdout)
@@ -154,7 +156,7 @@ class Trial:
 def run(binary, scene, sets, folder):
     """Run ballast once and read what the criteria need."""
     cmd = [str(binary), "run", str(scene), "--out", str(folder)] + [a for s in sets for a in ("--set", s)]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
+    proc = subprocess.run(cmd, capture_output=True, text=True, **child_options())
     t = Trial(proc.returncode, proc.stderr.strip())
     folder = Path(folder)
     try:
@@ -434,14 +436,11 @@ def limit_rows(limits):
 
 
 def write_tsv(rows, columns, path):
+    """The table, written whole (files.write_text)."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    with open(tmp, "w", encoding="utf-8") as f:
-        f.write("\t".join(columns) + "\n")
-        for r in rows:
-            f.write("\t".join(str(r.get(c, "")) for c in columns) + "\n")
-    os.replace(tmp, path)
+    files.make_dirs(path.parent)
+    files.write_text(path, "\t".join(columns) + "\n" +
+                     "".join("\t".join(str(r.get(c, "")) for c in columns) + "\n" for r in rows))
 
 
 def merge_tsv(rows, columns, path, key):

@@ -53,6 +53,7 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from . import files
 from .compare import EvalError, RunStore, quantity_in
 from .ini import IniError
 from .runner import Job
@@ -461,12 +462,10 @@ def _cell(x):
 def write_tsv(rows, path):
     """cost.tsv: one row per point, COST_COLUMNS; '-' for nothing (tmp file + rename)."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    files.make_dirs(path.parent)
     text = "\t".join(COST_COLUMNS) + "\n" + "".join(
         "\t".join(_cell(r[c]) for c in COST_COLUMNS) + "\n" for r in rows)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
+    files.write_text(path, text)
 
 
 def read_tsv(path):

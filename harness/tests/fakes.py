@@ -37,9 +37,14 @@ os.makedirs(out, exist_ok=True)
 k, n = float(p["k"]), int(p["n"])
 cols = ["cycle", "time", "F", "Ek"]
 if p["omit"]: cols.remove(p["omit"])
-def write(name, text):
-    with open(os.path.join(out, name + ".tmp"), "w") as f: f.write(text)
-    os.rename(os.path.join(out, name + ".tmp"), os.path.join(out, name))
+def write(name, text):     # as the core: whole (tmp + rename); on an I/O error no tmp, exit 3
+    tmp = os.path.join(out, name + ".tmp")
+    try:
+        with open(tmp, "w") as f: f.write(text)
+        os.rename(tmp, os.path.join(out, name))
+    except OSError as exc:
+        if os.path.exists(tmp): os.unlink(tmp)
+        print("ballast: %s: %s" % (os.path.join(out, name), exc.strerror), file=sys.stderr); sys.exit(3)
 if p["series"] == "1":
     rows = []
     for c in range(1, n + 1):

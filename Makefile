@@ -224,25 +224,39 @@ clean:
 
 -include $(LIB_OBJ:.o=.d) $(SAN_OBJ:.o=.d) $(BUILD)/main.d
 
-# ---- fuzzing (issue 7) ----------------------------------------------------
-# libFuzzer on the scene parser, --set, validate and short runs of small scenes
-# (core/tests/fuzz_scene.c), seeded at run time with every shipped scene and the
-# seeds in core/tests/fuzz/seeds; the inputs that once failed
-# (core/tests/fuzz/regress) are replayed first.  Fails on any crash, leak,
-# timeout or undefined behaviour.  FUZZ_TIME=600 make test-fuzz runs longer.
-FUZZ_CC   ?= clang
-FUZZ_TIME ?= 60
+# ---- fuzzing (issues 7 and 18) ---------------------------------------------
+# Two libFuzzer targets (clang -fsanitize=fuzzer,address,undefined), sharing the
+# checks of core/tests/fuzz_common.h:
+#   fuzz_scene     the scene parser, --set, validate and short runs of small scenes
+#                  (core/tests/fuzz_scene.c), seeded at run time with every shipped
+#                  scene and core/tests/fuzz/seeds; it first replays the scenes that
+#                  once failed (core/tests/fuzz/regress); 10 s an input;
+#   fuzz_extremes  well-formed scenes of legal but extreme numbers built from the
+#                  fuzzer's bytes (core/tests/fuzz_extremes.c); 3 s an input.
+# Fails on any crash, leak, timeout, undefined behaviour or broken invariant (a
+# refusal without its origin, a run that returns ok with a non-finite quantity).
+# FUZZ_TIME seconds of fuzzing in all, split evenly across FUZZ_TARGETS:
+# FUZZ_TIME=600 make test-fuzz runs longer, FUZZ_TARGETS=fuzz_extremes one target.
+FUZZ_CC      ?= clang
+FUZZ_TIME    ?= 60
+FUZZ_TARGETS ?= fuzz_scene fuzz_extremes
 FUZZ_SAN  := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 FUZZ_OBJ  := $(LIB_SRC:core/%.c=$(BUILD)/fuzz/%.o)
+FUZZ_BINS := $(BUILD)/fuzz/fuzz_scene $(BUILD)/fuzz/fuzz_extremes
 $(BUILD)/fuzz/%.o: core/%.c $(wildcard core/*.h)
 	@mkdir -p $(BUILD)/fuzz
 	$(FUZZ_CC) $(CFLAGS_BASE) -O1 -g $(FUZZ_SAN) -fsanitize=fuzzer-no-link -c $< -o $@
-$(BUILD)/fuzz/fuzz_scene: core/tests/fuzz_scene.c $(FUZZ_OBJ)
-	$(FUZZ_CC) $(CFLAGS_BASE) -O1 -g $(FUZZ_SAN) -fsanitize=fuzzer -Icore -o $@ $^ $(LDLIBS)
+$(FUZZ_BINS): $(BUILD)/fuzz/%: core/tests/%.c core/tests/fuzz_common.h $(FUZZ_OBJ)
+	$(FUZZ_CC) $(CFLAGS_BASE) -O1 -g $(FUZZ_SAN) -fsanitize=fuzzer -Icore -o $@ $< $(FUZZ_OBJ) \
+	  $(LDLIBS)
 
 .PHONY: test-fuzz fuzz-deps
 fuzz-deps:
 	@sh .ci/install-fuzz-deps
 test-fuzz: fuzz-deps
-	$(MAKE) $(BUILD)/fuzz/fuzz_scene
-	sh core/tests/fuzz/run $(BUILD)/fuzz/fuzz_scene $(FUZZ_TIME)
+	$(MAKE) -j$(JOBS) $(FUZZ_TARGETS:%=$(BUILD)/fuzz/%)
+	@set -e; each=$$(( $(FUZZ_TIME) / $(words $(FUZZ_TARGETS)) )); \
+	for t in $(FUZZ_TARGETS); do \
+	  echo "sh core/tests/fuzz/run $(BUILD)/fuzz/$$t $$each"; \
+	  sh core/tests/fuzz/run $(BUILD)/fuzz/$$t $$each; \
+	done

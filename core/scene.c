@@ -156,7 +156,9 @@ static int parse_number(const char **p, double *out)
     char *end;
     errno = 0;
     double v = strtod(*p, &end);
-    if (end == *p || errno == ERANGE || !isfinite(v))
+    /* A subnormal result (ERANGE, but not zero) is a number like any other;
+     * one that underflows to zero or overflows is refused. */
+    if (end == *p || !isfinite(v) || (errno == ERANGE && v == 0))
         return 0;
     if (*end != '\0' && !isspace((unsigned char)*end))
         return 0;
@@ -776,8 +778,9 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
     }
     for (int i = 0; i < s->n_materials; i++) {
         struct bal_material_def *m = &s->materials[i];
-        if (!(m->ks > 0 || m->ks == -1))
-            return FAIL_AT(m, BAL_SEC_MATERIAL, "ks", "expected ks > 0 (or omit it for ks = kn), "
+        if (!(m->ks >= 1e-150 || m->ks == -1))
+            return FAIL_AT(m, BAL_SEC_MATERIAL, "ks", "expected ks >= 1e-150, like kn (or omit it "
+                                                      "for ks = kn), "
                                                       "got %g", m->ks);
     }
     if (check_body_names(s, err))

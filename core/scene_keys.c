@@ -21,6 +21,11 @@
  * (sim.c), whose product overflows to inf/inf = NaN above about 9e153
  * (found by fuzzing: kn = 1e155 gave a NaN time step). */
 #define KBIG 1e150
+/* Smallest stiffness, for the same product: 2 k_a k_b underflows to 0 below
+ * about 1e-154 (found by fuzzing: kn = 1e-300 gave a pair stiffness of 0, a
+ * NaN elastic energy and an infinite time-step estimate).  scene.c checks
+ * ks against it too (ks may also be -1: equal to kn). */
+#define KMIN 1e-150
 
 #define S(field) offsetof(struct bal_settings, field)
 #define M(field) offsetof(struct bal_material_def, field)
@@ -80,7 +85,7 @@ const struct bal_key bal_scene_keys[] = {
      "predictor-corrector, MLH Sec. 5.3)"},
 
     /* [material NAME] */
-    {BAL_SEC_MATERIAL, "kn", BAL_KEY_DOUBLE, M(kn), NULL, 1, 1e-300, KBIG, NULL,
+    {BAL_SEC_MATERIAL, "kn", BAL_KEY_DOUBLE, M(kn), NULL, 1, KMIN, KBIG, NULL,
      "normal stiffness k_n, force/length (C&S eq. 16)"},
     {BAL_SEC_MATERIAL, "ks", BAL_KEY_DOUBLE, M(ks), "-1", 0, -1, KBIG, NULL,
      "shear stiffness k_s (C&S eq. 17); default: equal to kn"},

@@ -24,6 +24,7 @@
  * a series row every output_every cycles; it stops early, with a status,
  * on a signal or when the state stops being finite.
  */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -683,10 +684,11 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
     bal_timestep_detail(s, &dd);
     s->dt_estimate = dd.estimate;
     s->dt = st->dt > 0 ? st->dt : st->dt_fraction * s->dt_estimate;
-    if (!(s->dt > 0 && isfinite(s->dt))) {
+    if (!(s->dt > 0 && isfinite(s->dt) && s->dt_estimate > 0 && isfinite(s->dt_estimate))) {
         /* The masses are finite and positive (check_derived), so the step
-         * leaves the doubles only through the stiffness: name the material
-         * of the disc that sets the estimate. */
+         * or its estimate (which run.json writes, and dt_fraction divides
+         * by) leaves the doubles only through the stiffness: name the
+         * material of the disc that sets the estimate. */
         const int id = dd.binding_disc >= 0 ? dd.binding_disc : 0;
         const struct bal_material_def *m = &sc->materials[s->mat[s->slot[id]]];
         const int ki = bal_scene_key_index(BAL_SEC_MATERIAL, "kn");
@@ -695,11 +697,33 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         const double dt = s->dt; /* read before the free (fuzzing found the use after it) */
         bal_sim_free(s);
         return bal_error(err, BAL_EINVAL,
-                         "%s:%d: kn: [material %s]: the time step %g (dt_fraction x the estimate "
-                         "%g for disc %s) is not a positive finite number; expected a stiffness "
-                         "whose ratio to the masses is within the range of a double",
+                         "%s:%d: kn: [material %s]: the time step %g or its estimate %g (for "
+                         "disc %s) is not a positive finite number; expected a stiffness whose "
+                         "ratio to the masses is within the range of a double",
                          sc->path, m->key_line[ki] > 0 ? m->key_line[ki] : m->line, m->name, dt,
                          dd.estimate, disc);
+    }
+    if (!isfinite(s->dt / s->dt_estimate)) {
+        /* Only a forced step can be this large. */
+        bal_sim_free(s);
+        return bal_error(err, BAL_EINVAL,
+                         "%s:%d: dt: the time step %g is beyond %g times the stability estimate; "
+                         "expected a step whose ratio to the estimate is a finite number",
+                         sc->path, st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "dt")], st->dt,
+                         DBL_MAX);
+    }
+    if (!(s->alpha * s->dt < 2)) {
+        /* Global damping -alpha m v over a step alpha dt >= 2 reverses the
+         * velocity (the centred update's factor 1 - alpha dt/2 <= 0) and the
+         * velocity at t_N can no longer be recovered (a division by it). */
+        const double adt = s->alpha * s->dt;
+        bal_sim_free(s);
+        return bal_error(err, BAL_EINVAL,
+                         "%s:%d: alpha: global damping alpha = %g with the time step %g gives "
+                         "alpha dt = %g; expected alpha dt < 2 (alpha < %g)",
+                         sc->path, st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "alpha")],
+                         st->alpha, st->dt > 0 ? st->dt : st->dt_fraction * dd.estimate, adt,
+                         2 / (st->dt > 0 ? st->dt : st->dt_fraction * dd.estimate));
     }
     if (s->dt >= s->dt_estimate && !st->force_dt) {
         const char *key = st->dt > 0 ? "dt" : "dt_fraction";
@@ -859,6 +883,10 @@ enum bal_status bal_sim_step(struct bal_sim *s, struct bal_error *err)
  * (which the audit and the probes sum)?  Names the first disc that is not. */
 static enum bal_status check_finite(const struct bal_sim *s, struct bal_error *err)
 {
+    if (!isfinite(s->time))
+        return bal_error(err, BAL_EUNSTABLE,
+                         "%s: the simulated time is not finite at step %ld (time step %g)",
+                         s->scene->path, s->step, s->dt);
     for (int i = 0; i < s->n; i++) {
         const double v2 = s->vx[i] * s->vx[i] + s->vy[i] * s->vy[i];
         const double e = bal_mass(s, i) * v2 + bal_inertia(s, i) * s->w[i] * s->w[i];

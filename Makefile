@@ -44,7 +44,8 @@ deps:
 	@sh .ci/install-deps
 
 # ---- library and command --------------------------------------------------
-$(BUILD)/%.o: core/%.c | $(BUILD)
+# deps first, even under make -j on a fresh machine (GSL's headers come from it).
+$(BUILD)/%.o: core/%.c | $(BUILD) deps
 	$(CC) $(ALL_CFLAGS) -MMD -MP -c $< -o $@
 
 $(BUILD)/libballast.a: $(LIB_OBJ)

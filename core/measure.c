@@ -63,15 +63,8 @@ double bal_measure_kinetic(const struct bal_sim *s)
 double bal_measure_normal_energy(const struct bal_sim *s, const struct bal_pair_law *L, double fn,
                                  double delta)
 {
-    if (s->normal_law == BAL_NORMAL_INCREMENTAL)
-        return fn * fn / (2 * L->kn);
-    return L->kn * s->delta0 * s->delta0 * pow(delta / s->delta0, s->nu + 1) / (s->nu + 1);
-}
-
-/* ½ F_s²/k_s; a pair with k_s = 0 never carries a shear force. */
-static double shear_energy(const struct bal_pair_law *L, double fs)
-{
-    return L->ks > 0 ? fs * fs / (2 * L->ks) : 0;
+    const struct bal_law_params P = {s->normal_law, s->nu, s->delta0, s->gamma_n, s->psi, s->dt};
+    return bal_law_normal_energy(&P, L, fn, delta);
 }
 
 double bal_measure_elastic(const struct bal_sim *s)
@@ -86,7 +79,7 @@ double bal_measure_elastic(const struct bal_sim *s)
             const struct bal_pair_law *L;
             const double delta = bal_sim_overlap(s, walls, c, &rmin, &L);
             e += bal_measure_normal_energy(s, L, p->fn[c], delta);
-            e += shear_energy(L, pair_fs(p, c));
+            e += bal_law_shear_energy(L, pair_fs(p, c));
         }
     }
     return e;

@@ -752,7 +752,7 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
     s->pp.damping = 0; /* disc-pair dashpots are recomputed for reports */
     s->pw.shear = 1;
     s->pw.damping = 1;
-    s->pair_loop = bal_contacts_select(s->normal_law, s->has_shear, s->has_damping);
+    s->pair_loop = bal_contacts_select(s->has_shear, s->has_damping);
     if (bal_grid_rebuild(s, err) || check_overlaps(s, err)) {
         bal_sim_free(s);
         return err->code;

@@ -26,17 +26,9 @@
 #include <stdint.h>
 
 #include "ballast.h"
+#include "laws.h"
 
 #define BAL_PI 3.14159265358979323846
-
-/* Contact parameters of one pair of materials (C&S eqs 16–19, 28). */
-struct bal_pair_law {
-    double kn, ks;         /* stiffnesses of the contact */
-    double tan_phi;        /* smaller tan φ_μ of the two */
-    double cohesion;       /* smaller c of the two */
-    double cn, cs;         /* dashpots β k_n, β k_s */
-    int shear;             /* 1 if tan φ_μ > 0 or c > 0: the pair has a shear force */
-};
 
 /* A candidate list with its contact history.  Flags: bit 0 touching,
  * bit 1 sliding (|F_s| at the Coulomb limit).  The shear history (fs, ds)
@@ -63,8 +55,6 @@ static inline uint64_t pair_key(const struct bal_pairs *p, long c)
     return ((uint64_t)(uint32_t)p->i[c] << 32) | (uint32_t)p->j[c];
 }
 
-#define BAL_PAIR_TOUCHING 1u
-#define BAL_PAIR_SLIDING 2u
 
 struct bal_wall {
     char name[BAL_NAME_MAX];
@@ -330,7 +320,7 @@ void bal_pairs_free(struct bal_pairs *p);
 void bal_pairs_merge_history(struct bal_pairs *fresh, const struct bal_pairs *old);
 /* Position of `key` in the sorted list p, or -1 (binary search). */
 long bal_pairs_find(const struct bal_pairs *p, uint64_t key);
-bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping);
+bal_pair_loop_fn bal_contacts_select(int shear, int damping);
 /* Cut the disc–disc list into ranges for s->par.threads threads (the pair
  * loop calls it after each rebuild); reserve the per-chunk sums for the
  * list's capacity (after every reserve of s->pp); free it all. */

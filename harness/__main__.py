@@ -27,8 +27,8 @@ from . import catalogue, files, references, stability
 from . import sweep as sweeps
 from .compare import RunStore, evaluate_all, folder_locator
 from .gate import gate, sweep_table
-from .ini import IniError
-from .lock import Busy, reports_lock
+from .errors import Busy, CatalogueError, IniError
+from .lock import reports_lock
 from .rebaseline import rebaseline
 from .report import write_report
 from .runner import jobs_for, run_all, sigterm_as_interrupt, sweep_jobs
@@ -122,7 +122,7 @@ def cmd_validate(args):
         stab.cap, stab.tolerance = 20000, 0.01
         try:
             cmd_stability(stab)
-        except (RuntimeError, OSError, ValueError, catalogue.CatalogueError) as exc:
+        except (RuntimeError, OSError, ValueError, CatalogueError) as exc:
             # a measurement for the report: its failure is said, not fatal to the gate
             print(f"stability: not measured: {exc}")
     cmd_report(args)
@@ -191,11 +191,11 @@ def _stability(args, work):
 def sweep_variant(case, name):
     if name:
         if not case.variant(name):
-            raise catalogue.CatalogueError(f"case '{case.name}' has no variant '{name}' "
+            raise CatalogueError(f"case '{case.name}' has no variant '{name}' "
                                            f"(has: {', '.join(case.variant_names())})")
         return case.variant(name)
     if len(case.variants) > 1:
-        raise catalogue.CatalogueError(f"case '{case.name}' has several variants: pick one with --variant "
+        raise CatalogueError(f"case '{case.name}' has several variants: pick one with --variant "
                                        f"({', '.join(case.variant_names())})")
     return case.variants[0]
 
@@ -205,7 +205,7 @@ def parse_sweep(text):
     key, sep, values = text.partition("=")
     values = [v.strip() for v in values.split(",") if v.strip()]
     if not sep or not key or not values or any("/" in v for v in values):
-        raise catalogue.CatalogueError(f"--set needs KEY=V1,V2,... (no '/' in values), got '{text}'")
+        raise CatalogueError(f"--set needs KEY=V1,V2,... (no '/' in values), got '{text}'")
     return key, values
 
 
@@ -292,7 +292,7 @@ def main(argv=None):
         with sigterm_as_interrupt():          # SIGTERM stops the runs like Ctrl-C: exit 130
             with reports_lock(reports_root(), args.command) if args.writes else nullcontext():
                 return args.fn(args)
-    except (IniError, catalogue.CatalogueError) as exc:
+    except (IniError, CatalogueError) as exc:
         print(f"ballast-harness: {exc}", file=sys.stderr)
         return USAGE_ERROR
     except KeyboardInterrupt:

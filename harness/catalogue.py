@@ -31,7 +31,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import TIERS, cases_root
-from .ini import IniError, parse_file, shown
+from .errors import CatalogueError, IniError, shown
+from .ini import parse_file
 
 CASE_KEYS = {"tier", "title", "checks", "runtime"}
 VARIANT_KEYS = {"scene", "set", "command"}
@@ -52,10 +53,6 @@ PROFILE_XLABEL = "X = (x - x0) / l"
 PROFILE_YLABEL = "S (compression positive, units m g / l)"
 NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 RANGE = re.compile(rf"^\s*({NUMBER})?\s*:\s*({NUMBER})?\s*$")
-
-
-class CatalogueError(ValueError):
-    """A catalogue problem that is not tied to one line (e.g. an unknown case name)."""
 
 
 @dataclass

@@ -20,12 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .tables import RunProblem, load_run
-
-
-class EvalError(Exception):
-    """A quantity could not be evaluated to one finite number."""
-
+from .errors import EvalError, RunProblem
+from .tables import load_run
 
 @dataclass
 class Verdict:

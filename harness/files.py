@@ -14,14 +14,7 @@ import shutil
 import tempfile
 from pathlib import Path
 
-
-class WriteError(OSError):
-    """An OSError while the harness changed a file of its own.  filename is the file meant
-    (not its .tmp), so the message says what the user will look for."""
-    action = "write"
-
-    def __str__(self):
-        return f"cannot {self.action} {self.filename}: {self.strerror}"
+from .errors import WriteError
 
 
 def failure(action, path, exc):

@@ -38,15 +38,14 @@ held discs would otherwise count as errors.  Open contacts are not touching, so
 horizontal_contacts does not count them.
 
 Anything missing or malformed (a file, a column, a number, no pile in run.json, a row with
-no discs, zero weight) raises compare.EvalError, so a check built on it FAILs with the reason.
+no discs, zero weight) raises EvalError (errors.py), so a check built on it FAILs with the reason.
 """
 import math
 from pathlib import Path
 
 import numpy as np
 
-from .compare import EvalError
-from .tables import RunProblem
+from .errors import EvalError, RunProblem
 
 COMPONENTS = ("xx", "zz", "xz", "max", "min", "phi", "ratio")
 CONTACT_KINDS = ("all", "wall", "disc")

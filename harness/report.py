@@ -38,9 +38,10 @@ import numpy as np
 from . import REPO_ROOT
 from . import files, network, piles
 from .children import options as child_options
-from .compare import EvalError, evaluate, evaluate_all
+from .compare import evaluate, evaluate_all
+from .errors import EvalError, RunProblem
 from .gate import fmt_number, fmt_reference, read_summary, tally
-from .tables import RunProblem, read_harness_record, read_run_json
+from .tables import read_harness_record, read_run_json
 
 STYLE = Path(__file__).resolve().parent / "gnuplot" / "style.gp"
 SIZE = "960,540"

@@ -36,7 +36,8 @@ from pathlib import Path
 
 from . import files
 from .children import options as child_options
-from .tables import RunProblem, read_harness_record, read_run_json, run_failure, unfinished_outputs
+from .errors import RunProblem, WriteError
+from .tables import read_harness_record, read_run_json, run_failure, unfinished_outputs
 
 STDERR_TAIL = 5
 STOP_GRACE = 10.0    # seconds a terminated run has to write run.json and exit before SIGKILL
@@ -125,7 +126,7 @@ class Running:
 
 
 def fresh_folder(path):
-    """An empty folder at path (whatever was there is removed); files.WriteError if not."""
+    """An empty folder at path (whatever was there is removed); WriteError if not."""
     files.remove_tree(path)
     files.make_dirs(path)
 
@@ -142,7 +143,7 @@ def run_one(job, binary, running=None, resume=False, binary_id=None):
         return Outcome(job, True, record.get("returncode"), 0.0, skipped=True)
     try:
         fresh_folder(job.out)
-    except files.WriteError as exc:
+    except WriteError as exc:
         return Outcome(job, False, None, 0.0, f"cannot prepare the run folder: {exc}", io_error=str(exc))
     cmd = command(job, binary)
     start = time.monotonic()
@@ -161,7 +162,7 @@ def run_one(job, binary, running=None, resume=False, binary_id=None):
             cause = "interrupted: " + cause
         outcome = Outcome(job, not cause, returncode, wall, cause)
         _record(outcome, cmd, ident)
-    except files.WriteError as exc:
+    except WriteError as exc:
         # no harness.json: the folder reads as unfinished, and --resume runs it again
         return Outcome(job, False, returncode, wall, f"cannot record the run: {exc}", io_error=str(exc))
     return outcome

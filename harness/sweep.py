@@ -54,10 +54,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import files
-from .compare import EvalError, RunStore, quantity_in
-from .ini import IniError
+from .compare import RunStore, quantity_in
+from .errors import EvalError, IniError, RunProblem
 from .runner import Job
-from .tables import RunProblem, load_run, read_run_json
+from .tables import load_run, read_run_json
 
 SWEEP_KEYS = {"variant", "keys", "factors", "scale", "checks", "error", "set", "converge"}
 POINT_TOLERANCES = ("abs", "rel", "ratio")

@@ -11,9 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-
-class RunProblem(Exception):
-    """A run's outputs cannot be used: missing, failed, or malformed."""
+from .errors import RunProblem
 
 
 @dataclass

@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from harness.compare import EvalError, RunStore, evaluate, evaluate_check, folder_locator
+from harness.compare import RunStore, evaluate, evaluate_check, folder_locator
+from harness.errors import EvalError
 from harness.references import load_file
 from harness.tables import load_run
 from harness.tests.fakes import spring_columns, write_run, write_series

@@ -4,7 +4,7 @@ import pytest
 
 from harness import catalogue, references
 from harness.compare import RunStore, evaluate_check, folder_locator
-from harness.ini import IniError
+from harness.errors import IniError
 from harness.tests.fakes import spring_columns, write_run
 
 EVERY = """\

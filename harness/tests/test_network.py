@@ -5,7 +5,7 @@ import pytest
 
 from harness import network
 from harness.catalogue import load
-from harness.ini import IniError
+from harness.errors import IniError
 
 
 def _discs():

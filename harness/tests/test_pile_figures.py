@@ -8,7 +8,7 @@ import pytest
 
 from harness import catalogue, report
 from harness.compare import RunStore, folder_locator
-from harness.ini import IniError
+from harness.errors import IniError
 from harness.tests.pile_fakes import write_pile_run
 
 needs_gnuplot = pytest.mark.skipif(not shutil.which("gnuplot"), reason="gnuplot not installed")

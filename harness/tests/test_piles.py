@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from harness import piles
-from harness.compare import EvalError, RunStore, evaluate, evaluate_check, folder_locator
+from harness.compare import RunStore, evaluate, evaluate_check, folder_locator
+from harness.errors import EvalError
 from harness.references import load_file
 from harness.tables import load_run
 from harness.tests.pile_fakes import write_pile_run

@@ -8,7 +8,8 @@ import pytest
 
 from harness import catalogue, references, report, sweep
 from harness.__main__ import main
-from harness.ini import IniError, parse
+from harness.errors import IniError
+from harness.ini import parse
 from harness.tests.fakes import spring_columns, write_run, write_spring_runs
 
 needs_gnuplot = pytest.mark.skipif(not shutil.which("gnuplot"), reason="gnuplot not installed")

@@ -24,10 +24,11 @@ from pathlib import Path
 
 from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_root
 from . import catalogue, files, references, stability
+from . import families  # noqa: F401 -- registers every case family's expression functions
 from . import sweep as sweeps
 from .compare import RunStore, evaluate_all, folder_locator
-from .gate import gate, sweep_table
 from .errors import Busy, CatalogueError, IniError
+from .gate import gate, sweep_table
 from .lock import reports_lock
 from .rebaseline import rebaseline
 from .report import write_report

@@ -32,6 +32,7 @@ from pathlib import Path
 
 from . import TIERS, cases_root
 from .errors import CatalogueError, IniError, shown
+from .families.piles import COMPONENTS
 from .ini import parse_file
 
 CASE_KEYS = {"tier", "title", "checks", "runtime"}
@@ -210,7 +211,6 @@ def _series(section, common):
 
 
 def _profile(section, common):
-    from .piles import COMPONENTS
     components = section.require("y").split()
     for c in components:
         if c not in COMPONENTS:

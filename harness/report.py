@@ -10,7 +10,7 @@ data URI, PNG as fallback), so index.html opens without a server or any other fi
 
 Figure kinds: series (columns of series.tsv against x); network (force network, see
 network.py); profile (pile_S(component, row) against pile_X(row), lines with points, one
-curve per variant and component, from piles.py); principal (MLH Fig. 3(d): the discs of
+curve per variant and component, from families/piles.py); principal (MLH Fig. 3(d): the discs of
 the final state and, centred on every free disc, a line along the most compressive
 principal axis of length proportional to S_max and one across it proportional to S_min,
 compression positive, tensile values in red, the largest |S| drawn PRINCIPAL_SHARE of the
@@ -36,10 +36,12 @@ from pathlib import Path
 import numpy as np
 
 from . import REPO_ROOT
-from . import files, network, piles
+from . import files, network
 from .children import options as child_options
 from .compare import evaluate, evaluate_all
 from .errors import EvalError, RunProblem
+from .families import piles
+from .final_state import state
 from .gate import fmt_number, fmt_reference, read_summary, tally
 from .tables import read_harness_record, read_run_json
 
@@ -190,15 +192,15 @@ def _profile_script(case, figure, store, workdir, png, svg):
     clauses, notes = [], []
     for variant in figure.variants:
         try:
-            final = piles.state(store.get(case.name, variant))
-            columns = [final.pile_X(figure.row)]
+            final = state(store.get(case.name, variant))
+            columns = [piles.pile_X(final, figure.row)]
         except (RunProblem, EvalError) as problem:
             notes.append(f"{variant}: no data ({problem})")
             continue
         present = []
         for component in figure.y:
             try:
-                values = final.pile_S(component, figure.row)
+                values = piles.pile_S(final, component, figure.row)
             except EvalError as problem:
                 notes.append(f"{variant}: {component}: {problem}")
                 continue
@@ -275,8 +277,8 @@ def _principal_script(case, figure, store, workdir, png, svg):
     """Discs of the final state and the principal-axis cross of every free disc."""
     variant = figure.variants[0]
     try:
-        final = piles.state(store.get(case.name, variant))
-        axes, scaled = final.principal_axes()
+        final = state(store.get(case.name, variant))
+        axes, scaled = piles.principal_axes(final)
         discs = final.discs()
     except (RunProblem, EvalError) as problem:
         return None, [f"{variant}: no final state to draw ({problem})"]

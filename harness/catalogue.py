@@ -23,7 +23,7 @@ takes kind, title, variants and paper; variants default to all of the case's):
                xlabel, ylabel, xrange, yrange
 
 A key that the figure's kind does not use is an error, as is an unknown kind.
-[sweep NAME] sections declare the case's error-against-cost sweeps (keys in sweep.py).
+[sweep NAME] sections declare the case's error-against-cost sweeps (keys in sweep_spec.py).
 """
 import ast
 import re
@@ -34,6 +34,7 @@ from . import TIERS, cases_root
 from .errors import CatalogueError, IniError, shown
 from .families.piles import COMPONENTS
 from .ini import parse_file
+from .sweep_spec import parse as parse_sweep
 
 CASE_KEYS = {"tier", "title", "checks", "runtime"}
 VARIANT_KEYS = {"scene", "set", "command"}
@@ -96,7 +97,7 @@ class Case:
     line: int = 0
     variants: list = field(default_factory=list)
     figures: list = field(default_factory=list)
-    sweeps: list = field(default_factory=list)     # [sweep NAME] sections as sweep.Sweep (error against cost)
+    sweeps: list = field(default_factory=list)     # [sweep NAME] sections as sweep_spec.Sweep (error against cost)
 
     @property
     def source(self):
@@ -142,7 +143,6 @@ def load_file(path):
         elif section.kind == "figure":
             _add_figure(cases[-1], section)
         elif section.kind == "sweep":
-            from .sweep import parse as parse_sweep     # here: sweep.py imports the runner
             cases[-1].sweeps.append(parse_sweep(section))
         else:
             raise section.error(f"unknown section kind '{section.kind}' (known: case, variant, figure, sweep)")

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from harness import catalogue, references, report, sweep
+from harness import catalogue, references, report, sweep, sweep_spec
 from harness.__main__ import main
 from harness.errors import IniError
 from harness.ini import parse
@@ -43,7 +43,7 @@ def add_sweeps(project, text=SWEEPS):
 # ---------------------------------------------------------------- declarations
 
 def test_parse_a_full_declaration():
-    s = sweep.parse(section("variant = v\nkeys = settings.dt=0.01 stage.a.b=2\nfactors = 0.5 2 4\n"
+    s = sweep_spec.parse(section("variant = v\nkeys = settings.dt=0.01 stage.a.b=2\nfactors = 0.5 2 4\n"
                             "scale = stage.load.cycles=40\nchecks = c1 c2\nerror = e(1)\nerror = e(2)\n"))
     assert (s.name, s.variant, s.factors) == ("dt", "v", [0.5, 2.0, 4.0])
     assert s.keys == [("settings.dt", 0.01), ("stage.a.b", 2.0)] and s.scale == [("stage.load.cycles", 40.0)]
@@ -69,7 +69,7 @@ def test_parse_a_full_declaration():
 ])
 def test_parse_errors_name_file_and_line(body, message, line):
     with pytest.raises(IniError) as err:
-        sweep.parse(section(body))
+        sweep_spec.parse(section(body))
     assert message in str(err.value) and f"case.txt:{line}:" in str(err.value)
 
 
@@ -318,13 +318,13 @@ def test_report_notes_a_cost_table_older_than_the_declarations(project, capsys):
 # ---------------------------------------------------------------- fixed overrides, failed points, self-convergence
 
 def test_parse_fixed_overrides_make_factor_one_a_point_of_its_own():
-    s = sweep.parse(section("variant = v\nset = settings.integrator=gear5\nset = settings.psi=0\n"
+    s = sweep_spec.parse(section("variant = v\nset = settings.integrator=gear5\nset = settings.psi=0\n"
                             "keys = settings.dt=0.01\nfactors = 0.5\nchecks = none\nerror = e(1)\n"))
     assert s.fixed == ["settings.integrator=gear5", "settings.psi=0"] and s.no_checks and s.checks == []
     assert s.run_factors() == [1.0, 0.5]
     assert s.sets(1) == ["settings.integrator=gear5", "settings.psi=0", "settings.dt=0.01"]
     assert s.label(1) == "dt_x1"
-    plain = sweep.parse(section("variant = v\nkeys = settings.dt=0.01\nfactors = 0.5\n"))
+    plain = sweep_spec.parse(section("variant = v\nkeys = settings.dt=0.01\nfactors = 0.5\n"))
     assert plain.run_factors() == [0.5] and plain.fixed == [] and not plain.no_checks
 
 
@@ -337,7 +337,7 @@ def test_parse_fixed_overrides_make_factor_one_a_point_of_its_own():
 ])
 def test_parse_errors_of_the_new_keys(body, message, line):
     with pytest.raises(IniError) as err:
-        sweep.parse(section(body))
+        sweep_spec.parse(section(body))
     assert message in str(err.value) and f"case.txt:{line}:" in str(err.value)
 
 

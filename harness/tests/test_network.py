@@ -3,7 +3,7 @@ import math
 
 import pytest
 
-from harness import network
+from harness.report import network
 from harness.catalogue import load
 from harness.errors import IniError
 

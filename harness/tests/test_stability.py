@@ -5,7 +5,8 @@ from pathlib import Path
 import pytest
 
 from harness import stability as st
-from harness.report import stability_html, stability_markdown
+from harness.report.html_page import stability_html
+from harness.report.markdown import stability_markdown
 
 ROOT = Path(__file__).resolve().parents[2]
 BIN = ROOT / "bin" / "ballast"

@@ -6,10 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from harness import catalogue, references, report, sweep, sweep_spec
+from harness import catalogue, references, sweep, sweep_spec
 from harness.__main__ import main
 from harness.errors import IniError
 from harness.ini import parse
+from harness.report import cost_plot
 from harness.tests.fakes import spring_columns, write_run, write_spring_runs
 
 needs_gnuplot = pytest.mark.skipif(not shutil.which("gnuplot"), reason="gnuplot not installed")
@@ -270,7 +271,7 @@ def test_validate_runs_the_sweeps_unless_told_not_to(project, capsys):
 def test_cost_points_mark_the_default_and_note_what_is_not_drawn():
     rows = [row("dt", 1.0, 5e-4, 100), row("dt", 2.0, 5e-3, 50), row("dt", 0.5, 0.0, 200),
             row("k", 1.0, 5e-4, 100), row("k", 3.0, None, 80, status="unstable")]
-    curves, defaults, notes, bad = report.cost_points(rows)
+    curves, defaults, notes, bad = cost_plot.cost_points(rows)
     assert defaults == [(100, 5e-4)]
     assert curves["dt"] == [(100, 5e-4, ""), (50, 5e-3, "x2")] and curves["k"] == [(100, 5e-4, "")]
     assert any("dt x0.5: not drawn: error 0 is not positive" in n for n in notes)
@@ -376,7 +377,7 @@ def test_a_fixed_sweep_runs_factor_one_and_is_not_the_default(project, capsys):
     assert rows[0]["steps"] == 20 and rows[0]["error"] == 0.0 and rows[1]["error"] == pytest.approx(1.0)
     assert not sweep.is_default(rows[0])
     assert sweep.setting(rows[0]) == "k_fixed x1 (settings.n=20 settings.k=1)"
-    curves, defaults, _, _ = report.cost_points(rows)
+    curves, defaults, _, _ = cost_plot.cost_points(rows)
     assert defaults == [] and curves["k_fixed"] == [(40, pytest.approx(1.0), "x2")]   # error 0 is off the log scale
 
 
@@ -413,7 +414,7 @@ def test_failed_points_have_no_error_and_say_why(project, capsys):
     assert "fail: asked to fail" in gone["note"]          # the runner's cause (harness.json)
     assert all(sweep.failed(r) for r in rows)
     assert all(r is None for r in sweep.cheapest(rows).values())
-    _, _, notes, bad = report.cost_points(rows)
+    _, _, notes, bad = cost_plot.cost_points(rows)
     assert bad == {"blows_up": [(20, "x1 unstable"), (20, "x2 unstable")]}
     assert any(n.startswith("no_output x1: no run.json") and "not drawn" in n for n in notes)
 

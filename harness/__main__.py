@@ -155,15 +155,28 @@ def cmd_cost(args):
     sweeps.run_declared(selected(args, all_cases), checks, args.bin, args.jobs, runs_root(),
                         reports_root() / "sweeps", sys.stdout, functools.partial(run_all, resume=args.resume))
     return 0
+STABILITY_RUNS = "stability-runs"     # the trial runs of `stability`, under the reports root
+
+
 def cmd_stability(args):
-    """Stability limits per variant and the extreme probes (harness/stability.py)."""
-    for old in reports_root().glob("stability-runs.*"):     # left by a killed harness; we hold the lock
+    """Stability limits per variant and the extreme probes (harness/stability.py).  Their
+    runs go to reports/stability-runs/, which is emptied first (kept with --resume) and removed
+    when the command ends, except when it is interrupted: then --resume keeps what it holds."""
+    for old in reports_root().glob(STABILITY_RUNS + ".*"):  # scratch folders of an older harness
         shutil.rmtree(old, ignore_errors=True)
-    work = files.scratch_folder(reports_root(), "stability-runs.")
+    work = reports_root() / STABILITY_RUNS
+    if not args.resume:
+        files.remove_tree(work)
+    files.make_dirs(work)
+    interrupted = False
     try:
         return _stability(args, work)
+    except KeyboardInterrupt:
+        interrupted = True
+        raise
     finally:
-        shutil.rmtree(work, ignore_errors=True)
+        if not interrupted:
+            shutil.rmtree(work, ignore_errors=True)
 
 
 def _stability(args, work):
@@ -173,7 +186,8 @@ def _stability(args, work):
         cases = selected(args, load_cases())
         targets = stability.targets_for(cases, getattr(args, "one_per_case", False))
         print(f"stability: bisecting {len(targets)} variant(s)")
-        limits = stability.measure_all(args.bin, targets, work, args.jobs, args.cap, args.tolerance, sys.stdout)
+        limits = stability.measure_all(args.bin, targets, work, args.jobs, args.cap, args.tolerance, sys.stdout,
+                                       args.resume)
         rows = stability.limit_rows(limits)
         stability.merge_tsv(rows, stability.LIMIT_COLUMNS, reports_root() / "stability.tsv", ("case", "variant"))
         print(f"wrote {reports_root() / 'stability.tsv'}")
@@ -181,7 +195,7 @@ def _stability(args, work):
     if not args.no_extremes:
         probes = stability.load_probes(cases_root() / "extremes" / "extremes.txt")
         print(f"stability: {len(probes)} extreme probe(s)")
-        rows = stability.run_probes(args.bin, probes, work, args.jobs)
+        rows = stability.run_probes(args.bin, probes, work, args.jobs, sys.stdout, args.resume)
         stability.merge_tsv(rows, stability.EXTREME_COLUMNS, reports_root() / "extremes.tsv", ("probe",))
         for r in rows:
             print(f"  {r['group']}/{r['probe']}: {r['outcome']}{'' if r['as_expected'] == 'yes' else '  UNEXPECTED'}")

@@ -86,10 +86,10 @@ def _alive(pid):
 
 
 class Stopped(RuntimeError):
-    """A run was not started, or was stopped, because its batch is stopping (Ctrl-C,
-    SIGTERM: harness/runner.py).  outcome is the runner's Outcome of that run.  A task that
-    launches several runs in turn (a stability bisection) ends with it."""
+    """A run or query was not started, or was stopped, because its batch is stopping (Ctrl-C,
+    SIGTERM: harness/runner.py).  A task that launches several runs in turn (a stability
+    bisection) ends with it.  outcome: the runner's Outcome of that run (None for a query)."""
 
-    def __init__(self, outcome):
-        super().__init__(f"interrupted: {outcome.job.label}: {outcome.cause}")
+    def __init__(self, what, outcome=None):
+        super().__init__(f"interrupted: {what}")
         self.outcome = outcome

@@ -11,7 +11,6 @@ and exits with status 3 (harness/__main__.py).
 import errno
 import os
 import shutil
-import tempfile
 from pathlib import Path
 
 from .errors import WriteError
@@ -82,15 +81,6 @@ def make_dirs(path):
     except OSError as exc:
         raise failure("write", exc.filename or path, exc) from exc
     return path
-
-
-def scratch_folder(root, prefix):
-    """A new empty folder in root (made if missing) for work thrown away afterwards."""
-    root = make_dirs(root)
-    try:
-        return Path(tempfile.mkdtemp(prefix=prefix, dir=root))
-    except OSError as exc:
-        raise failure("create a folder in", root, exc) from exc
 
 
 def remove(path):

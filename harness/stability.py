@@ -36,21 +36,25 @@ The bisection brackets [stable, unstable] starting at f = 1, moving by STEP, the
 halves the bracket until hi/lo <= 1 + TOLERANCE.  The limit reported is the largest
 stable f: the measured limit over the estimate.  A safe and tight estimate has it in
 [1, 1.25].
+
+Every trial and probe is a run of the runner (harness/runner.py): a variant's bisection is
+one task of run_tasks, which launches its trials one after another into
+<work>/limits/<case>/<variant>/ (base, trial01, trial02, ...); a probe runs into
+<work>/extremes/<probe>.  So they get the runner's run folders and records, its interrupt
+handling (Ctrl-C stops the trials running and starts no other) and --resume (a trial
+whose folder holds a complete run of the same identity is not run again); -j sets how
+many variants are bisected side by side, which changes no result.
 """
 import json
 import math
-import os
 import re
-import shutil
-import subprocess
-import tempfile
-from concurrent.futures import ThreadPoolExecutor
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import files
-from .children import options as child_options
 from .ini import parse_file
+from .runner import Job, run_tasks
 
 ENERGY_GROWTH = 4.0
 ENERGY_LOSS = 1.5
@@ -86,13 +90,14 @@ def targets_for(cases, one_per_case=False):
 
 # ---------------------------------------------------------------- ballast
 
-def info(binary, scene, sets):
-    """`ballast info` of a scene: estimate (the bound), single (C&S 2 sqrt(m/k)), dt."""
-    cmd = [str(binary), "info", str(scene)] + [a for s in sets for a in ("--set", s)]
-    proc = subprocess.run(cmd, capture_output=True, text=True, **child_options())
-    if proc.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)}: exit {proc.returncode}: {proc.stderr.strip()}")
-    return parse_info(proc.stdout)
+def info(batch, scene, sets):
+    """`ballast info` of a scene (asked through the runner's batch): estimate (the bound),
+    single (C&S 2 sqrt(m/k)), dt."""
+    cmd = [str(batch.binary), "info", str(scene)] + [a for s in sets for a in ("--set", s)]
+    returncode, stdout, stderr = batch.ask(cmd)
+    if returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)}: exit {returncode}: {stderr.strip()}")
+    return parse_info(stdout)
 
 
 def parse_info(text):
@@ -153,12 +158,14 @@ class Trial:
     envelope: dict = field(default_factory=dict)   # column -> (min, max) over the series
 
 
-def run(binary, scene, sets, folder):
-    """Run ballast once and read what the criteria need."""
-    cmd = [str(binary), "run", str(scene), "--out", str(folder)] + [a for s in sets for a in ("--set", s)]
-    proc = subprocess.run(cmd, capture_output=True, text=True, **child_options())
-    t = Trial(proc.returncode, proc.stderr.strip())
+def run(batch, target, sets, folder):
+    """Run the target's scene once with sets, through the runner's batch, into folder; read
+    what the criteria need.  A folder the harness cannot write is its WriteError (exit 3)."""
     folder = Path(folder)
+    outcome = batch.launch(Job(target.case, target.variant, target.scene, list(sets), folder))
+    if outcome.io_error:
+        raise outcome.io_error
+    t = Trial(outcome.returncode, _stderr(folder))
     try:
         meta = json.loads((folder / "run.json").read_text())
         t.steps = int(meta.get("steps", 0))
@@ -169,6 +176,14 @@ def run(binary, scene, sets, folder):
     t.envelope = series_envelope(folder / "series.tsv")
     t.overlap_max = largest_overlap(folder / "discs.tsv", folder / "contacts.tsv")
     return t
+
+
+def _stderr(folder):
+    """What ballast said on stderr (the runner keeps it as ballast.stderr), stripped."""
+    try:
+        return (Path(folder) / "ballast.stderr").read_text(encoding="utf-8", errors="replace").strip()
+    except OSError:
+        return ""
 
 
 def series_energy(path):
@@ -333,81 +348,79 @@ class Limit:
         return self.limit * self.estimate / self.single
 
 
-def measure(binary, target, workdir, cap=CYCLE_CAP, tolerance=TOLERANCE):
-    """The largest stable dt fraction of one target."""
-    est = info(binary, target.scene, target.sets)
+def measure(batch, target, folder, cap=CYCLE_CAP, tolerance=TOLERANCE):
+    """The largest stable dt fraction of one target; its runs go to folder (base, trial01, ...:
+    the same names in the same order at every attempt, which is what lets --resume keep them)."""
+    est = info(batch, target.scene, target.sets)
     lim = Limit(target.case, target.variant, est["estimate"], est["single"], est["dt"])
     stages = stage_cycles(target.scene, target.sets)
-    work = Path(tempfile.mkdtemp(prefix=f"{target.case}.{target.variant}.", dir=workdir))
-    try:
-        base_sets = target.sets + scaled_cycles(stages, 1, 1, cap)
-        base = run(binary, target.scene, base_sets, work / "base")
-        if base.exit != 0:
-            lim.note = f"baseline (its own dt) fails: exit {base.exit}: {base.message}"
-            return lim
+    folder = Path(folder)
+    base_sets = target.sets + scaled_cycles(stages, 1, 1, cap)
+    base = run(batch, target, base_sets, folder / "base")
+    if base.exit != 0:
+        lim.note = f"baseline (its own dt) fails: exit {base.exit}: {base.message}"
+        return lim
 
-        def stable(f):
-            dt = f * lim.estimate
-            # force_dt: a trial above the estimate is the point of the bisection (ballast refuses
-            # such a step otherwise)
-            sets = target.sets + [f"settings.dt={dt!r}", "settings.force_dt=1"] + \
-                scaled_cycles(stages, lim.dt_case, dt, cap)
-            t = run(binary, target.scene, sets, work / "trial")
-            why = verdict(t, base)
-            lim.trials += 1
-            lim.log.append((f, why or "stable"))
-            return why
+    def stable(f):
+        dt = f * lim.estimate
+        # force_dt: a trial above the estimate is the point of the bisection (ballast refuses
+        # such a step otherwise)
+        sets = target.sets + [f"settings.dt={dt!r}", "settings.force_dt=1"] + \
+            scaled_cycles(stages, lim.dt_case, dt, cap)
+        t = run(batch, target, sets, folder / f"trial{lim.trials + 1:02d}")
+        why = verdict(t, base)
+        lim.trials += 1
+        lim.log.append((f, why or "stable"))
+        return why
 
-        f = 1.0
-        why = stable(f)
-        if not why:
-            lo, hi, cause = f, None, ""
-            while f < F_MAX:
-                f *= STEP
-                why = stable(f)
-                if why:
-                    hi, cause = f, why
-                    break
-                lo = f
-        else:
-            hi, lo, cause = f, None, why
-            while f > F_MIN:
-                f /= STEP
-                why = stable(f)
-                if not why:
-                    lo = f
-                    break
-                hi, cause = f, why
-        if lo is None or hi is None:
-            lim.limit = lo if lo is not None else float("nan")
-            lim.note = "no unstable step up to f = %g" % F_MAX if hi is None else "unstable down to f = %g" % F_MIN
-            return lim
-        while hi / lo > 1 + tolerance:
-            mid = math.sqrt(lo * hi)
-            why = stable(mid)
+    f = 1.0
+    why = stable(f)
+    if not why:
+        lo, hi, cause = f, None, ""
+        while f < F_MAX:
+            f *= STEP
+            why = stable(f)
             if why:
-                hi, cause = mid, why
-            else:
-                lo = mid
-        lim.limit, lim.unstable, lim.cause = lo, hi, cause
+                hi, cause = f, why
+                break
+            lo = f
+    else:
+        hi, lo, cause = f, None, why
+        while f > F_MIN:
+            f /= STEP
+            why = stable(f)
+            if not why:
+                lo = f
+                break
+            hi, cause = f, why
+    if lo is None or hi is None:
+        lim.limit = lo if lo is not None else float("nan")
+        lim.note = "no unstable step up to f = %g" % F_MAX if hi is None else "unstable down to f = %g" % F_MIN
         return lim
-    finally:
-        shutil.rmtree(work, ignore_errors=True)
+    while hi / lo > 1 + tolerance:
+        mid = math.sqrt(lo * hi)
+        why = stable(mid)
+        if why:
+            hi, cause = mid, why
+        else:
+            lo = mid
+    lim.limit, lim.unstable, lim.cause = lo, hi, cause
+    return lim
 
 
-def measure_all(binary, targets, workdir, jobs=None, cap=CYCLE_CAP, tolerance=TOLERANCE, out=None):
-    jobs = jobs or os.cpu_count() or 1
-    Path(workdir).mkdir(parents=True, exist_ok=True)
+def measure_all(binary, targets, workdir, jobs=None, cap=CYCLE_CAP, tolerance=TOLERANCE, out=None, resume=False):
+    """The Limit of every target, one bisection task each (runner.run_tasks, jobs side by side),
+    their runs under workdir/limits/<case>/<variant>; out gets one line per target as it ends."""
+    def task(target):
+        folder = Path(workdir) / "limits" / target.case / target.variant
+        return lambda batch: measure(batch, target, folder, cap, tolerance)
 
-    def one(t):
-        lim = measure(binary, t, workdir, cap, tolerance)
+    def done(i, lim):
         if out:
-            print(f"  {t.case}/{t.variant}: limit {lim.limit:.4g} x estimate "
+            print(f"  {lim.case}/{lim.variant}: limit {lim.limit:.4g} x estimate "
                   f"({lim.trials} trials){' ' + lim.note if lim.note else ''}", file=out, flush=True)
-        return lim
 
-    with ThreadPoolExecutor(max_workers=jobs) as pool:
-        return list(pool.map(one, targets))
+    return run_tasks([task(t) for t in targets], binary, jobs, out or sys.stdout, resume, done)
 
 
 LIMIT_COLUMNS = ("case", "variant", "dt_case", "estimate", "single_spring", "single_over_estimate",
@@ -561,15 +574,12 @@ EXTREME_COLUMNS = ("group", "probe", "what", "expect", "exit", "steps", "e_in", 
                    "overlap_max", "outcome", "as_expected")
 
 
-def run_probe(binary, probe, workdir):
-    folder = Path(tempfile.mkdtemp(prefix=f"extreme.{probe.name}.", dir=workdir))
-    try:
-        t = run(binary, probe.scene, probe.sets, folder)
-        e_in, e_out = energy_in_out(folder / "series.tsv")
-        if not math.isnan(probe.e_in):
-            e_in = probe.e_in
-    finally:
-        shutil.rmtree(folder, ignore_errors=True)
+def run_probe(batch, probe, folder):
+    """The extremes.tsv row of one probe, run into folder."""
+    t = run(batch, Target("extremes", probe.name, probe.scene, probe.sets), probe.sets, folder)
+    e_in, e_out = energy_in_out(Path(folder) / "series.tsv")
+    if not math.isnan(probe.e_in):
+        e_in = probe.e_in
     outcome, ok = judge(probe, t, e_in, e_out)
     ratio = e_out / e_in if e_in and e_in > 0 else float("nan")
     return {"group": probe.group, "probe": probe.name, "what": probe.what, "expect": probe.expect,
@@ -578,7 +588,9 @@ def run_probe(binary, probe, workdir):
             "outcome": outcome.replace("\t", " ").replace("\n", " "), "as_expected": "yes" if ok else "no"}
 
 
-def run_probes(binary, probes, workdir, jobs=None):
-    Path(workdir).mkdir(parents=True, exist_ok=True)
-    with ThreadPoolExecutor(max_workers=jobs or os.cpu_count() or 1) as pool:
-        return list(pool.map(lambda p: run_probe(binary, p, workdir), probes))
+def run_probes(binary, probes, workdir, jobs=None, out=None, resume=False):
+    """The extremes.tsv rows of the probes, in order: one runner task each, their runs in
+    workdir/extremes/<probe>."""
+    def task(probe):
+        return lambda batch: run_probe(batch, probe, Path(workdir) / "extremes" / probe.name)
+    return run_tasks([task(p) for p in probes], binary, jobs, out or sys.stdout, resume)

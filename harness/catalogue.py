@@ -63,7 +63,7 @@ class Variant:
     scene: Path
     sets: list
     command: str = "run"     # run: the DEM; exact: the exact static solver (ballast exact);
-                             # peer: the cross-check against LAMMPS (bench/peer/race.py)
+                             # peer: the cross-check against LAMMPS (harness/peer/race.py)
 
 
 @dataclass

@@ -51,7 +51,7 @@ STDERR_TAIL = 5
 STOP_GRACE = 10.0    # seconds a terminated run has to write run.json and exit before SIGKILL
 INTERRUPTED = (130, -signal.SIGINT, -signal.SIGTERM)   # how a run that was interrupted ends
 POLL = 0.1           # seconds between the main thread's looks at the runs (see run_all)
-PEER_SCRIPT = Path(__file__).resolve().parent.parent / "bench" / "peer" / "race.py"
+PEER_SCRIPT = Path(__file__).resolve().parent / "peer" / "race.py"
 
 
 @dataclass
@@ -199,7 +199,7 @@ def binary_identity(binary):
 def identity(job, binary, binary_id):
     """Everything that decides a run's outputs: the core's command, the scene (path and the
     hash of its text: scenes include no other file), the --set overrides, the executable.
-    The peer check runs bench/peer/race.py on the repository's bin/ballast: their hashes."""
+    The peer check runs harness/peer/race.py on the repository's bin/ballast: their hashes."""
     ident = {"command": job.command, "scene": str(job.scene), "scene_sha256": sha256_of(job.scene),
              "sets": list(job.sets), "binary": binary_id}
     if job.command == "peer":

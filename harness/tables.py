@@ -98,7 +98,7 @@ def run_failure(folder, info):
     return None
 
 
-# The files a complete run leaves, by the core's command (main.c, output.c, bench/peer/race.py).
+# The files a complete run leaves, by the core's command (main.c, output.c, harness/peer/race.py).
 EXPECTED_OUTPUTS = {"run": ("series.tsv", "stress.tsv", "contacts.tsv", "discs.tsv", "walls.tsv", "run.json"),
                     "exact": ("series.tsv", "contacts.tsv", "discs.tsv", "walls.tsv", "run.json"),
                     "peer": ("series.tsv", "run.json")}

@@ -23,7 +23,7 @@ from contextlib import nullcontext
 from pathlib import Path
 
 from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_root
-from . import catalogue, files, references, stability
+from . import catalogue, extremes, files, references, stability
 from . import families  # noqa: F401 -- registers every case family's expression functions
 from . import sweep as sweeps
 from .compare import RunStore, evaluate_all, folder_locator
@@ -159,7 +159,7 @@ STABILITY_RUNS = "stability-runs"     # the trial runs of `stability`, under the
 
 
 def cmd_stability(args):
-    """Stability limits per variant and the extreme probes (harness/stability.py).  Their
+    """Stability limits per variant and the extreme probes (harness/stability.py, harness/extremes.py).  Their
     runs go to reports/stability-runs/, which is emptied first (kept with --resume) and removed
     when the command ends, except when it is interrupted: then --resume keeps what it holds."""
     for old in reports_root().glob(STABILITY_RUNS + ".*"):  # scratch folders of an older harness
@@ -193,10 +193,10 @@ def _stability(args, work):
         print(f"wrote {reports_root() / 'stability.tsv'}")
         status = 0 if all(r["in_target"] == "yes" for r in rows) else 1
     if not args.no_extremes:
-        probes = stability.load_probes(cases_root() / "extremes" / "extremes.txt")
+        probes = extremes.load_probes(cases_root() / "extremes" / "extremes.txt")
         print(f"stability: {len(probes)} extreme probe(s)")
-        rows = stability.run_probes(args.bin, probes, work, args.jobs, sys.stdout, args.resume)
-        stability.merge_tsv(rows, stability.EXTREME_COLUMNS, reports_root() / "extremes.tsv", ("probe",))
+        rows = extremes.run_probes(args.bin, probes, work, args.jobs, sys.stdout, args.resume)
+        stability.merge_tsv(rows, extremes.EXTREME_COLUMNS, reports_root() / "extremes.tsv", ("probe",))
         for r in rows:
             print(f"  {r['group']}/{r['probe']}: {r['outcome']}{'' if r['as_expected'] == 'yes' else '  UNEXPECTED'}")
         print(f"wrote {reports_root() / 'extremes.tsv'}")

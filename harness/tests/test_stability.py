@@ -1,4 +1,4 @@
-"""Stability limits and extreme probes (harness/stability.py) and their report section."""
+"""Stability limits and extreme probes (harness/stability.py, harness/extremes.py) and their report section."""
 import json
 import math
 import os
@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from harness import extremes
 from harness import stability as st
 from harness.runner import Batch
 from harness.report.html_page import stability_html
@@ -162,31 +163,31 @@ expect = stop
 
 def test_load_probes_and_judge(tmp_path):
     (tmp_path / "extremes.txt").write_text(EXTREMES)
-    a, b = st.load_probes(tmp_path / "extremes.txt")
+    a, b = extremes.load_probes(tmp_path / "extremes.txt")
     assert (a.group, a.sets, a.energy_ratio, a.bounds, a.expect) == ("g1", ["material.m.kn=1"], 1.01,
                                                                       [("y", 0.0, 10.0)], "stable")
     assert b.expect == "stop" and math.isnan(b.energy_ratio)
     good = st.Trial(0, overlap_max=0.0, envelope={"y": (0.5, 1.0)})
-    assert st.judge(a, good, 1.0, 1.005) == ("ran through, within its criteria", True)
-    outcome, ok = st.judge(a, good, 1.0, 1.2)
+    assert extremes.judge(a, good, 1.0, 1.005) == ("ran through, within its criteria", True)
+    outcome, ok = extremes.judge(a, good, 1.0, 1.2)
     assert not ok and "E_out/E_in 1.2" in outcome
-    outcome, ok = st.judge(a, st.Trial(0, overlap_max=0.0, envelope={"y": (-3.0, 1.0)}), 1.0, 1.0)
+    outcome, ok = extremes.judge(a, st.Trial(0, overlap_max=0.0, envelope={"y": (-3.0, 1.0)}), 1.0, 1.0)
     assert not ok and "y in [-3" in outcome
-    assert st.judge(b, st.Trial(1, "overlap budget exceeded at step 7"), 1, 1) == \
+    assert extremes.judge(b, st.Trial(1, "overlap budget exceeded at step 7"), 1, 1) == \
         ("stopped, exit 1: overlap budget exceeded at step 7", True)
-    assert st.judge(b, good, 1.0, 1.0)[1] is False          # it should have stopped
-    outcome, ok = st.judge(a, st.Trial(0, nonfinite="cycle 3 column Ek"), 1, 1)
+    assert extremes.judge(b, good, 1.0, 1.0)[1] is False          # it should have stopped
+    outcome, ok = extremes.judge(a, st.Trial(0, nonfinite="cycle 3 column Ek"), 1, 1)
     assert not ok and outcome.startswith("NON-FINITE")
 
 
 def test_load_probes_rejects_unknown_keys(tmp_path):
     (tmp_path / "extremes.txt").write_text("[probe a]\ngroup = g\nwhat = w\nscene = s\ncolour = red\n")
     with pytest.raises(Exception, match="unknown key 'colour'"):
-        st.load_probes(tmp_path / "extremes.txt")
+        extremes.load_probes(tmp_path / "extremes.txt")
 
 
 def test_catalogue_extremes_file_loads():
-    probes = st.load_probes(ROOT / "cases" / "extremes" / "extremes.txt")
+    probes = extremes.load_probes(ROOT / "cases" / "extremes" / "extremes.txt")
     assert len({p.name for p in probes}) == len(probes)
     for p in probes:
         assert p.scene.exists(), p.scene

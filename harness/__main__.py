@@ -159,7 +159,7 @@ STABILITY_RUNS = "stability-runs"     # the trial runs of `stability`, under the
 
 
 def cmd_stability(args):
-    """Stability limits per variant and the extreme probes (harness/stability.py, harness/extremes.py).  Their
+    """Stability limits per variant and the extreme probes (stability.py, extremes.py).  Their
     runs go to reports/stability-runs/, which is emptied first (kept with --resume) and removed
     when the command ends, except when it is interrupted: then --resume keeps what it holds."""
     for old in reports_root().glob(STABILITY_RUNS + ".*"):  # scratch folders of an older harness

@@ -23,12 +23,13 @@ from contextlib import nullcontext
 from pathlib import Path
 
 from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_root
-from . import catalogue, files, references, stability
+from . import catalogue, extremes, files, references, stability
+from . import families  # noqa: F401 -- registers every case family's expression functions
 from . import sweep as sweeps
 from .compare import RunStore, evaluate_all, folder_locator
+from .errors import Busy, CatalogueError, IniError
 from .gate import gate, sweep_table
-from .ini import IniError
-from .lock import Busy, reports_lock
+from .lock import reports_lock
 from .rebaseline import rebaseline
 from .report import write_report
 from .runner import jobs_for, run_all, sigterm_as_interrupt, sweep_jobs
@@ -122,7 +123,7 @@ def cmd_validate(args):
         stab.cap, stab.tolerance = 20000, 0.01
         try:
             cmd_stability(stab)
-        except (RuntimeError, OSError, ValueError, catalogue.CatalogueError) as exc:
+        except (RuntimeError, OSError, ValueError, CatalogueError) as exc:
             # a measurement for the report: its failure is said, not fatal to the gate
             print(f"stability: not measured: {exc}")
     cmd_report(args)
@@ -154,15 +155,28 @@ def cmd_cost(args):
     sweeps.run_declared(selected(args, all_cases), checks, args.bin, args.jobs, runs_root(),
                         reports_root() / "sweeps", sys.stdout, functools.partial(run_all, resume=args.resume))
     return 0
+STABILITY_RUNS = "stability-runs"     # the trial runs of `stability`, under the reports root
+
+
 def cmd_stability(args):
-    """Stability limits per variant and the extreme probes (harness/stability.py)."""
-    for old in reports_root().glob("stability-runs.*"):     # left by a killed harness; we hold the lock
+    """Stability limits per variant and the extreme probes (stability.py, extremes.py).  Their
+    runs go to reports/stability-runs/, which is emptied first (kept with --resume) and removed
+    when the command ends, except when it is interrupted: then --resume keeps what it holds."""
+    for old in reports_root().glob(STABILITY_RUNS + ".*"):  # scratch folders of an older harness
         shutil.rmtree(old, ignore_errors=True)
-    work = files.scratch_folder(reports_root(), "stability-runs.")
+    work = reports_root() / STABILITY_RUNS
+    if not args.resume:
+        files.remove_tree(work)
+    files.make_dirs(work)
+    interrupted = False
     try:
         return _stability(args, work)
+    except KeyboardInterrupt:
+        interrupted = True
+        raise
     finally:
-        shutil.rmtree(work, ignore_errors=True)
+        if not interrupted:
+            shutil.rmtree(work, ignore_errors=True)
 
 
 def _stability(args, work):
@@ -172,16 +186,17 @@ def _stability(args, work):
         cases = selected(args, load_cases())
         targets = stability.targets_for(cases, getattr(args, "one_per_case", False))
         print(f"stability: bisecting {len(targets)} variant(s)")
-        limits = stability.measure_all(args.bin, targets, work, args.jobs, args.cap, args.tolerance, sys.stdout)
+        limits = stability.measure_all(args.bin, targets, work, args.jobs, args.cap, args.tolerance, sys.stdout,
+                                       args.resume)
         rows = stability.limit_rows(limits)
         stability.merge_tsv(rows, stability.LIMIT_COLUMNS, reports_root() / "stability.tsv", ("case", "variant"))
         print(f"wrote {reports_root() / 'stability.tsv'}")
         status = 0 if all(r["in_target"] == "yes" for r in rows) else 1
     if not args.no_extremes:
-        probes = stability.load_probes(cases_root() / "extremes" / "extremes.txt")
+        probes = extremes.load_probes(cases_root() / "extremes" / "extremes.txt")
         print(f"stability: {len(probes)} extreme probe(s)")
-        rows = stability.run_probes(args.bin, probes, work, args.jobs)
-        stability.merge_tsv(rows, stability.EXTREME_COLUMNS, reports_root() / "extremes.tsv", ("probe",))
+        rows = extremes.run_probes(args.bin, probes, work, args.jobs, sys.stdout, args.resume)
+        stability.merge_tsv(rows, extremes.EXTREME_COLUMNS, reports_root() / "extremes.tsv", ("probe",))
         for r in rows:
             print(f"  {r['group']}/{r['probe']}: {r['outcome']}{'' if r['as_expected'] == 'yes' else '  UNEXPECTED'}")
         print(f"wrote {reports_root() / 'extremes.tsv'}")
@@ -191,11 +206,11 @@ def _stability(args, work):
 def sweep_variant(case, name):
     if name:
         if not case.variant(name):
-            raise catalogue.CatalogueError(f"case '{case.name}' has no variant '{name}' "
+            raise CatalogueError(f"case '{case.name}' has no variant '{name}' "
                                            f"(has: {', '.join(case.variant_names())})")
         return case.variant(name)
     if len(case.variants) > 1:
-        raise catalogue.CatalogueError(f"case '{case.name}' has several variants: pick one with --variant "
+        raise CatalogueError(f"case '{case.name}' has several variants: pick one with --variant "
                                        f"({', '.join(case.variant_names())})")
     return case.variants[0]
 
@@ -205,7 +220,7 @@ def parse_sweep(text):
     key, sep, values = text.partition("=")
     values = [v.strip() for v in values.split(",") if v.strip()]
     if not sep or not key or not values or any("/" in v for v in values):
-        raise catalogue.CatalogueError(f"--set needs KEY=V1,V2,... (no '/' in values), got '{text}'")
+        raise CatalogueError(f"--set needs KEY=V1,V2,... (no '/' in values), got '{text}'")
     return key, values
 
 
@@ -292,7 +307,7 @@ def main(argv=None):
         with sigterm_as_interrupt():          # SIGTERM stops the runs like Ctrl-C: exit 130
             with reports_lock(reports_root(), args.command) if args.writes else nullcontext():
                 return args.fn(args)
-    except (IniError, catalogue.CatalogueError) as exc:
+    except (IniError, CatalogueError) as exc:
         print(f"ballast-harness: {exc}", file=sys.stderr)
         return USAGE_ERROR
     except KeyboardInterrupt:

@@ -23,7 +23,7 @@ takes kind, title, variants and paper; variants default to all of the case's):
                xlabel, ylabel, xrange, yrange
 
 A key that the figure's kind does not use is an error, as is an unknown kind.
-[sweep NAME] sections declare the case's error-against-cost sweeps (keys in sweep.py).
+[sweep NAME] sections declare the case's error-against-cost sweeps (keys in sweep_spec.py).
 """
 import ast
 import re
@@ -31,7 +31,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import TIERS, cases_root
-from .ini import IniError, parse_file, shown
+from .errors import CatalogueError, IniError, shown
+from .families.piles import COMPONENTS
+from .ini import parse_file
+from .sweep_spec import parse as parse_sweep
 
 CASE_KEYS = {"tier", "title", "checks", "runtime"}
 VARIANT_KEYS = {"scene", "set", "command"}
@@ -54,17 +57,13 @@ NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 RANGE = re.compile(rf"^\s*({NUMBER})?\s*:\s*({NUMBER})?\s*$")
 
 
-class CatalogueError(ValueError):
-    """A catalogue problem that is not tied to one line (e.g. an unknown case name)."""
-
-
 @dataclass
 class Variant:
     name: str
     scene: Path
     sets: list
     command: str = "run"     # run: the DEM; exact: the exact static solver (ballast exact);
-                             # peer: the cross-check against LAMMPS (bench/peer/race.py)
+                             # peer: the cross-check against LAMMPS (harness/peer/race.py)
 
 
 @dataclass
@@ -98,7 +97,7 @@ class Case:
     line: int = 0
     variants: list = field(default_factory=list)
     figures: list = field(default_factory=list)
-    sweeps: list = field(default_factory=list)     # [sweep NAME] sections as sweep.Sweep (error against cost)
+    sweeps: list = field(default_factory=list)     # [sweep NAME] sections as sweep_spec.Sweep (error against cost)
 
     @property
     def source(self):
@@ -144,7 +143,6 @@ def load_file(path):
         elif section.kind == "figure":
             _add_figure(cases[-1], section)
         elif section.kind == "sweep":
-            from .sweep import parse as parse_sweep     # here: sweep.py imports the runner
             cases[-1].sweeps.append(parse_sweep(section))
         else:
             raise section.error(f"unknown section kind '{section.kind}' (known: case, variant, figure, sweep)")
@@ -213,7 +211,6 @@ def _series(section, common):
 
 
 def _profile(section, common):
-    from .piles import COMPONENTS
     components = section.require("y").split()
     for c in components:
         if c not in COMPONENTS:

@@ -1,17 +1,13 @@
 """Checks against run outputs: expression evaluation, tolerance kinds, verdicts.
 
-A quantity is a Python expression evaluated without builtins in a namespace holding
-every series.tsv column (numpy array) and the functions of the spec (at, first, last,
-after, upto, between, mean, max, min, std, abs, sqrt, amp, run), plus series(variant,
-column) for a column of another variant of the same case, period(arr) for the mean
-number of rows between upward crossings of the mean, and settle(col, target, tol) for
-the cycle from which a column stays within tol of target; and the pile functions of
-piles.py (pile_X, pile_S, middle, horizontal_contacts, contact_error, contact_mismatch,
-weight), which read the run's final state (discs.tsv, contacts.tsv, stress.tsv) when
-called; and the collision and order functions of the block at the end (contact_start,
-contact_end, contact_duration, restitution, sine_period, sine_amplitude, of, order).  evaluate_check() turns one Check into a Verdict; anything that goes wrong
-(missing output, failed run, missing column, an expression that raises, a NaN/inf
-value) is a FAIL whose message says which, never a pass and never a skip.
+A quantity is a Python expression evaluated without builtins in a namespace holding every
+series.tsv column (numpy array) and the functions that harness/expressions.py gives for the
+run: the expression language's own (at, first, last, after, upto, between, mean, max, min,
+std, abs, sqrt, amp, run, energy) and those every case family registered there (the
+modules of harness/families: signals, variants, piles, networks, collisions).  This module
+knows no family: it asks the registry.  evaluate_check() turns one Check into a Verdict;
+anything that goes wrong (missing output, failed run, missing column, an expression that
+raises, a NaN/inf value) is a FAIL whose message says which, never a pass and never a skip.
 """
 import ast
 import math
@@ -20,11 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .tables import RunProblem, load_run
-
-
-class EvalError(Exception):
-    """A quantity could not be evaluated to one finite number."""
+from .errors import EvalError, RunProblem
+from .expressions import functions
+from .tables import load_run
 
 
 @dataclass
@@ -97,129 +91,12 @@ def namespace(run, sibling=None):
     """Columns by header name, then the expression functions (functions win a clash,
     except where the expression uses the name as a value: see _compile).
 
-    sibling(variant) gives the Run of another variant of the same case, for series(),
-    contact_error() and contact_mismatch().
+    sibling(variant) gives the Run of another variant of the same case, for the functions
+    that read one (series(), of(), contact_error(), ...).
     """
     names = dict(run.columns)
-    names.update(REDUCERS)
-    names.update(_selectors(run.columns["cycle"]))
-    names.update(_signal_functions(run.columns["cycle"]))
-    names["run"] = _run_field(run.info)
-    names["energy"] = _energy_term(run.info)
-    names["series"] = _series_of(sibling)
-    from . import piles   # here, not at the top: piles imports EvalError from this module
-    names.update(piles.functions(run, sibling))
-    names.update(_collision_functions(run, sibling))
+    names.update(functions(run, sibling))
     return names
-
-
-def _series_of(sibling):
-    """series(variant, column): a whole column of another variant of the same case."""
-    def series(variant, column):
-        if sibling is None:
-            raise EvalError("series(): no other variants are available here")
-        try:
-            other = sibling(variant)
-        except RunProblem as problem:
-            raise EvalError(f"series(): variant '{variant}': {problem}") from None
-        if column not in other.columns:
-            raise EvalError(f"series(): variant '{variant}' has no column '{column}'")
-        return other.columns[column]
-    return series
-
-
-def _signal_functions(cycle):
-    """period and settle: properties of a signal over the rows of a run."""
-    def period(arr):
-        """Mean number of cycles between upward crossings of the signal's mean."""
-        arr = _nonempty(arr, "period")
-        x = arr - arr.mean()
-        up = np.flatnonzero((x[:-1] < 0) & (x[1:] >= 0))
-        if up.size < 2:
-            raise EvalError("period(): fewer than two upward crossings of the mean")
-        return float(np.mean(np.diff(up)))
-
-    def settle(col, target, tol):
-        """First cycle from which |col - target| <= tol |target| holds to the end."""
-        col = np.asarray(col, dtype=float)
-        if col.shape != cycle.shape:
-            raise EvalError("settle(): first argument must be a whole series column")
-        outside = np.flatnonzero(np.abs(col - target) > tol * abs(target))
-        if outside.size == 0:
-            return float(cycle[0])
-        if outside[-1] == col.size - 1:
-            raise EvalError(f"settle(): still outside {tol:g} of {target:g} at the last row")
-        return float(cycle[outside[-1] + 1])
-
-    return {"period": period, "settle": settle}
-
-
-def _nonempty(arr, fname):
-    arr = np.atleast_1d(np.asarray(arr, dtype=float))
-    if arr.size == 0:
-        raise EvalError(f"{fname}(): no rows selected")
-    return arr
-
-
-def _reducer(fn, fname):
-    """fn over one array (or over several numbers, as in max(a, b)); empty is an error."""
-    def reduce(*args):
-        arr = args[0] if len(args) == 1 else np.array(args, dtype=float)
-        return float(fn(_nonempty(arr, fname)))
-    return reduce
-
-
-REDUCERS = {
-    "first": _reducer(lambda a: a[0], "first"), "last": _reducer(lambda a: a[-1], "last"),
-    "mean": _reducer(np.mean, "mean"), "max": _reducer(np.max, "max"),
-    "min": _reducer(np.min, "min"), "std": _reducer(np.std, "std"),
-    "amp": _reducer(lambda a: (a.max() - a.min()) / 2, "amp"),
-    "abs": np.abs, "sqrt": np.sqrt,
-}
-
-
-def _selectors(cycle):
-    """at, after, upto, between: rows of a whole column chosen by the cycle column."""
-    def whole(col, fname):
-        col = np.asarray(col, dtype=float)
-        if col.shape != cycle.shape:
-            raise EvalError(f"{fname}(): first argument must be a whole series column")
-        return col
-
-    def at(col, c):
-        rows = np.flatnonzero(cycle == c)
-        if rows.size == 0:
-            raise EvalError(f"at(): no row with cycle == {c:g}")
-        return float(whole(col, "at")[rows[0]])
-
-    return {
-        "at": at,
-        "after": lambda col, c: whole(col, "after")[cycle > c],
-        "upto": lambda col, c: whole(col, "upto")[cycle <= c],
-        "between": lambda col, a, b: whole(col, "between")[(cycle >= a) & (cycle <= b)],
-    }
-
-
-def _run_field(info):
-    def run(key):
-        if key not in info:
-            raise EvalError(f"run(): run.json has no field '{key}'")
-        return info[key]
-    return run
-
-
-def _energy_term(info):
-    """energy(term): a term of the run's energy audit (run.json "energy", core/energy.c)."""
-    def energy(term):
-        audit = info.get("energy")
-        if not isinstance(audit, dict):
-            raise EvalError("energy(): run.json has no energy audit")
-        if term not in audit:
-            raise EvalError(f"energy(): the audit has no term '{term}' (has: {', '.join(audit)})")
-        if audit[term] is None:
-            raise EvalError(f"energy(): the audit's '{term}' is not finite")
-        return audit[term]
-    return energy
 
 
 SHADOWED = "column_shadowed_by_function_"
@@ -386,132 +263,3 @@ def evaluate_check(check, store):
 def evaluate_all(checks, store):
     """Verdicts of the checks, in the order given."""
     return [evaluate_check(c, store) for c in checks]
-
-
-# ---------------------------------------------------------------- collisions and orders
-# (cases/collisions, reference/collisions.ref, reference/two_discs_order.ref)
-#
-# contact_start(gap), contact_end(gap), contact_duration(gap), restitution(gap): a binary
-# collision measured from the surface gap of two discs (a whole series column expression,
-# e.g. x_b - x_a - 1.75; negative while they overlap).  The first contact is the first run
-# of rows with gap < 0 (C&S eq. 8 is strict).  Its start and end are the zero crossings of
-# the gap, interpolated linearly between the rows that straddle them: the row outside
-# contact lies on the free-flight line, and so does the row inside (the scheme moves the
-# discs with v_{N-1/2}, C&S eq. 23, before the force acts), so the interpolation is exact
-# on the free-flight side.  restitution is -(chord after)/(chord before): the chords across
-# the crossings are the free-flight velocities v_{N+1/2} (C&S eq. 22), which the scheme
-# holds exactly in flight; the centred velocities of eq. 31 would mix a half step in
-# contact.  The straddling rows must be consecutive cycles (output_every = 1 there).
-#
-# sine_period(arr, level), sine_amplitude(arr, level): the period (in rows) and amplitude of
-# a sampled sinusoid about level, y_N = arr_N - level = A sin(N theta + phi), with sub-step
-# resolution: y_{N+1} + y_{N-1} = 2 cos(theta) y_N gives cos(theta) (least squares over all
-# rows), and y_N^2 - y_{N-1} y_{N+1} = A^2 sin^2(theta) gives A (mean over all rows).  Both
-# are exact for a pure sampled sinusoid, whatever the phase of the samples.
-# of(variant, expr): the value of expr in another variant of the same case.
-# order(expr, exact, v1, v2, ...): the observed order of accuracy; for two variants
-# p = log(|q_1 - exact| / |q_2 - exact|) / log(dt_1 / dt_2), q = expr in each variant, dt
-# from each run.json; for more, the least-squares slope of log|q - exact| on log dt.
-
-def _collision_functions(run, sibling):
-    cycle, time = run.columns["cycle"], run.columns["time"]
-
-    def crossings(gap, fname):
-        gap = np.asarray(gap, dtype=float)
-        if gap.shape != cycle.shape:
-            raise EvalError(f"{fname}(): argument must be a whole series column expression")
-        inside = np.flatnonzero(gap < 0)
-        if inside.size == 0:
-            raise EvalError(f"{fname}(): the gap never becomes negative (no contact)")
-        s = inside[0]
-        after = np.flatnonzero(gap[s:] >= 0)
-        if s == 0 or after.size == 0:
-            raise EvalError(f"{fname}(): the contact must start and end inside the series")
-        e = s + after[0] - 1               # last row of the first contact
-        for a in (s - 1, e):
-            if cycle[a + 1] - cycle[a] != 1:
-                raise EvalError(f"{fname}(): rows {cycle[a]:g} and {cycle[a + 1]:g} are not "
-                                "consecutive cycles (set output_every = 1)")
-        return gap, s, e
-
-    def cross_time(gap, a):
-        """Time where the line through rows a and a + 1 crosses gap = 0."""
-        return float(time[a] + (time[a + 1] - time[a]) * gap[a] / (gap[a] - gap[a + 1]))
-
-    def chord(gap, a):
-        return float((gap[a + 1] - gap[a]) / (time[a + 1] - time[a]))
-
-    def contact_start(gap):
-        gap, s, _ = crossings(gap, "contact_start")
-        return cross_time(gap, s - 1)
-
-    def contact_end(gap):
-        gap, _, e = crossings(gap, "contact_end")
-        return cross_time(gap, e)
-
-    def contact_duration(gap):
-        gap, s, e = crossings(gap, "contact_duration")
-        return cross_time(gap, e) - cross_time(gap, s - 1)
-
-    def restitution(gap):
-        gap, s, e = crossings(gap, "restitution")
-        return -chord(gap, e) / chord(gap, s - 1)
-
-    def other(variant, fname):
-        if sibling is None:
-            raise EvalError(f"{fname}(): no other variants are available here")
-        try:
-            return sibling(variant)
-        except RunProblem as problem:
-            raise EvalError(f"{fname}(): variant '{variant}': {problem}") from None
-
-    def of(variant, expr):
-        try:
-            return evaluate(expr, other(variant, "of"), sibling)
-        except EvalError as exc:
-            raise EvalError(f"of(): variant '{variant}': {exc}") from None
-
-    def order(expr, exact, *variants):
-        if len(variants) < 2:
-            raise EvalError("order(): needs at least two variants")
-        errors, steps = [], []
-        for variant in variants:
-            errors.append(abs(of(variant, expr) - exact))
-            dt = other(variant, "order").info.get("dt")
-            if not isinstance(dt, (int, float)) or not dt > 0:
-                raise EvalError(f"order(): variant '{variant}': run.json has no positive dt")
-            steps.append(float(dt))
-        if len(set(steps)) < len(steps):
-            raise EvalError(f"order(): two of {', '.join(variants)} have the same dt")
-        if not all(e > 0 for e in errors):
-            raise EvalError(f"order(): an error is zero ({', '.join(f'{e:g}' for e in errors)}): "
-                            "no order can be observed")
-        # Two variants: the pairwise order; more: the least-squares slope of log e on log dt.
-        return float(np.polyfit(np.log(steps), np.log(errors), 1)[0])
-
-    def sine_theta(arr, level, fname):
-        y = np.atleast_1d(np.asarray(arr, dtype=float)) - level
-        if y.size < 3:
-            raise EvalError(f"{fname}(): needs at least three rows")
-        mid = y[1:-1]
-        denom = 2 * np.dot(mid, mid)
-        if not denom > 0:
-            raise EvalError(f"{fname}(): the signal equals the level")
-        cos_theta = np.dot(mid, y[2:] + y[:-2]) / denom
-        if not -1 < cos_theta < 1:
-            raise EvalError(f"{fname}(): not a sampled sinusoid (cos theta = {cos_theta:g})")
-        return y, math.acos(cos_theta)
-
-    def sine_period(arr, level):
-        _, theta = sine_theta(arr, level, "sine_period")
-        return 2 * math.pi / theta
-
-    def sine_amplitude(arr, level):
-        y, theta = sine_theta(arr, level, "sine_amplitude")
-        a2 = np.mean(y[1:-1] ** 2 - y[:-2] * y[2:])
-        return math.sqrt(max(a2, 0.0)) / math.sin(theta)
-
-    return {"contact_start": contact_start, "contact_end": contact_end,
-            "sine_period": sine_period, "sine_amplitude": sine_amplitude,
-            "contact_duration": contact_duration, "restitution": restitution,
-            "of": of, "order": order}

@@ -11,17 +11,9 @@ and exits with status 3 (harness/__main__.py).
 import errno
 import os
 import shutil
-import tempfile
 from pathlib import Path
 
-
-class WriteError(OSError):
-    """An OSError while the harness changed a file of its own.  filename is the file meant
-    (not its .tmp), so the message says what the user will look for."""
-    action = "write"
-
-    def __str__(self):
-        return f"cannot {self.action} {self.filename}: {self.strerror}"
+from .errors import WriteError
 
 
 def failure(action, path, exc):
@@ -89,15 +81,6 @@ def make_dirs(path):
     except OSError as exc:
         raise failure("write", exc.filename or path, exc) from exc
     return path
-
-
-def scratch_folder(root, prefix):
-    """A new empty folder in root (made if missing) for work thrown away afterwards."""
-    root = make_dirs(root)
-    try:
-        return Path(tempfile.mkdtemp(prefix=prefix, dir=root))
-    except OSError as exc:
-        raise failure("create a folder in", root, exc) from exc
 
 
 def remove(path):

@@ -5,28 +5,16 @@
     key = value          an entry of the section above; keys may repeat
 
 parse() turns text into a list of Section objects that remember the line of every
-entry; every error raised here or by Section accessors names file:line.
+entry; every error raised here or by Section accessors is an IniError (errors.py) naming
+file:line.
 """
-import os
 import re
 from dataclasses import dataclass, field
 
+from .errors import IniError
+
 HEADER = re.compile(r"^\[\s*([A-Za-z_]\w*)\s+([A-Za-z0-9_][A-Za-z0-9_.\-]*)\s*\]$")
 KEY = re.compile(r"^[A-Za-z_][A-Za-z0-9_.]*$")
-
-
-def shown(path):
-    """path as people want to read it: relative to the working directory when inside it."""
-    relative = os.path.relpath(path)
-    return str(path) if relative.startswith("..") else relative
-
-
-class IniError(ValueError):
-    """A malformed file; str() is 'file:line: what is wrong'."""
-
-    def __init__(self, path, line, message):
-        super().__init__(f"{shown(path)}:{line}: {message}")
-        self.path, self.line, self.message = path, line, message
 
 
 @dataclass

@@ -3,7 +3,7 @@
 Two invocations on the same checkout would each empty the other's run folders, and one
 could report ok for a folder that then holds the other's failed run.  So every command
 that writes under the reports root holds an exclusive flock on <reports>/.harness.lock
-while it works.  A second one waits up to WAIT seconds, then refuses with Busy (exit
+while it works.  A second one waits up to WAIT seconds, then refuses with Busy (errors.py; exit
 status 75, harness/__main__.py), naming the process that holds the lock.
 
 The runs inherit the lock's descriptor (held_fds(), passed to every child): the lock is
@@ -21,6 +21,7 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
+from .errors import Busy
 from .files import failure, make_dirs
 
 LOCK_NAME = ".harness.lock"
@@ -28,27 +29,6 @@ WAIT = 1.0      # seconds a second invocation waits for the lock before it refus
 POLL = 0.02     # seconds between its attempts
 
 _held = []      # descriptors of the locks this process holds (given to its children)
-
-
-class Busy(Exception):
-    """Another harness holds the lock of this reports folder."""
-
-    def __init__(self, path, holder):
-        super().__init__(path, holder)
-        self.path, self.holder = Path(path), holder
-
-    def __str__(self):
-        pid, command = self.holder
-        folder = self.path.parent
-        if pid is None:
-            what = f"another harness (pid unknown) is using {folder} (lock {self.path}): wait for it to finish"
-        elif _alive(pid):
-            what = (f"another harness (pid {pid}, `{command}`) is using {folder} (lock {self.path}): "
-                    f"wait for it to finish or stop it (kill {pid})")
-        else:
-            what = (f"runs of a harness that has ended (pid {pid}, `{command}`) still hold {self.path}: "
-                    f"wait for them to end (`pgrep -f {folder}` lists them)")
-        return what + ", then run this command again"
 
 
 def held_fds():
@@ -108,12 +88,3 @@ def _holder(fd):
     except (OSError, ValueError, IndexError):
         return None, ""
 
-
-def _alive(pid):
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True

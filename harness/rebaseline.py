@@ -9,8 +9,8 @@ import re
 from pathlib import Path
 
 from . import files
-from .compare import EvalError, quantity_in
-from .tables import RunProblem
+from .compare import quantity_in
+from .errors import EvalError, RunProblem
 
 VALUE_LINE = re.compile(r"^(\s*value\s*=\s*)([^#]*?)(\s*(?:#.*)?)$")
 

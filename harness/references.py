@@ -15,7 +15,8 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from . import reference_root
-from .ini import IniError, parse_file, shown
+from .errors import IniError, shown
+from .ini import parse_file
 
 KINDS = ("analytic", "exact", "paper", "regression")
 TRENDS = ("increasing", "decreasing", "nondecreasing", "nonincreasing")

@@ -1,4 +1,12 @@
-"""Running bin/ballast: one subprocess per (case, variant), in parallel, with progress lines.
+"""Running bin/ballast: the one launcher of the harness's runs, in parallel, with progress lines.
+
+run_all() runs a list of jobs, one subprocess per (case, variant) or sweep point.  Commands
+whose runs depend on each other's results (the stability bisection: harness/stability.py)
+give run_tasks() a list of tasks instead: each task is called with the Batch and starts
+its runs one after another through Batch.launch (and asks `ballast info` through
+Batch.ask).  Either way every run goes through run_one below, so every run gets the same
+folder, record, resume and interrupt handling, and tasks run side by side on -j threads
+whose count changes no result.
 
 Each run gets a fresh folder (the old one is removed first) that is also its working
 directory, so runs share no state and their results cannot depend on -j or on order.
@@ -36,13 +44,14 @@ from pathlib import Path
 
 from . import files
 from .children import options as child_options
-from .tables import RunProblem, read_harness_record, read_run_json, run_failure, unfinished_outputs
+from .errors import RunProblem, Stopped, WriteError
+from .tables import read_harness_record, read_run_json, run_failure, unfinished_outputs
 
 STDERR_TAIL = 5
 STOP_GRACE = 10.0    # seconds a terminated run has to write run.json and exit before SIGKILL
 INTERRUPTED = (130, -signal.SIGINT, -signal.SIGTERM)   # how a run that was interrupted ends
 POLL = 0.1           # seconds between the main thread's looks at the runs (see run_all)
-PEER_SCRIPT = Path(__file__).resolve().parent.parent / "bench" / "peer" / "race.py"
+PEER_SCRIPT = Path(__file__).resolve().parent / "peer" / "race.py"
 
 
 @dataclass
@@ -68,7 +77,7 @@ class Outcome:
     wall: float
     cause: str = ""
     skipped: bool = False   # resumed: a complete run of the same identity was already there
-    io_error: str = ""      # the harness could not prepare or record the folder (see files.py)
+    io_error: WriteError = None   # the harness could not prepare or record the folder (files.py)
 
 
 def jobs_for(cases, runs_root):
@@ -125,7 +134,7 @@ class Running:
 
 
 def fresh_folder(path):
-    """An empty folder at path (whatever was there is removed); files.WriteError if not."""
+    """An empty folder at path (whatever was there is removed); WriteError if not."""
     files.remove_tree(path)
     files.make_dirs(path)
 
@@ -142,8 +151,8 @@ def run_one(job, binary, running=None, resume=False, binary_id=None):
         return Outcome(job, True, record.get("returncode"), 0.0, skipped=True)
     try:
         fresh_folder(job.out)
-    except files.WriteError as exc:
-        return Outcome(job, False, None, 0.0, f"cannot prepare the run folder: {exc}", io_error=str(exc))
+    except WriteError as exc:
+        return Outcome(job, False, None, 0.0, f"cannot prepare the run folder: {exc}", io_error=exc)
     cmd = command(job, binary)
     start = time.monotonic()
     try:
@@ -161,9 +170,9 @@ def run_one(job, binary, running=None, resume=False, binary_id=None):
             cause = "interrupted: " + cause
         outcome = Outcome(job, not cause, returncode, wall, cause)
         _record(outcome, cmd, ident)
-    except files.WriteError as exc:
+    except WriteError as exc:
         # no harness.json: the folder reads as unfinished, and --resume runs it again
-        return Outcome(job, False, returncode, wall, f"cannot record the run: {exc}", io_error=str(exc))
+        return Outcome(job, False, returncode, wall, f"cannot record the run: {exc}", io_error=exc)
     return outcome
 
 
@@ -190,7 +199,7 @@ def binary_identity(binary):
 def identity(job, binary, binary_id):
     """Everything that decides a run's outputs: the core's command, the scene (path and the
     hash of its text: scenes include no other file), the --set overrides, the executable.
-    The peer check runs bench/peer/race.py on the repository's bin/ballast: their hashes."""
+    The peer check runs harness/peer/race.py on the repository's bin/ballast: their hashes."""
     ident = {"command": job.command, "scene": str(job.scene), "scene_sha256": sha256_of(job.scene),
              "sets": list(job.sets), "binary": binary_id}
     if job.command == "peer":
@@ -229,6 +238,8 @@ def stale(job, ident):
 
 
 def _execute(cmd, cwd, running):
+    """Run cmd in cwd to its end as a child of the harness (children.py), registered in running
+    while it lives: (exit code, stdout, stderr)."""
     proc = subprocess.Popen(cmd, cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, errors="replace", **child_options())
     if running:
@@ -337,11 +348,40 @@ def sigterm_as_interrupt():
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
-def _stop(futures, pool, running, out):
-    """After an interrupt: drop the jobs not started, terminate the live runs and wait for
+class Batch:
+    """The runs of one command: the executable (hashed once), --resume, and the live processes,
+    so that an interrupt stops all of them.  launch() is how every run starts."""
+
+    def __init__(self, binary, resume=False):
+        self.binary, self.resume = binary, resume
+        self.binary_id = binary_identity(binary)
+        self.running = Running()
+        self.outcomes = []          # every launch's Outcome, in the order they ended
+        self._lock = threading.Lock()
+
+    def launch(self, job):
+        """Run one job (run_one) and return its Outcome.  Once the batch is stopping, raise
+        Stopped (holding the Outcome) instead, so a task that launches runs in turn ends."""
+        outcome = run_one(job, self.binary, self.running, self.resume, self.binary_id)
+        with self._lock:
+            self.outcomes.append(outcome)
+        if self.running.stopping:
+            raise Stopped(f"{job.label}: {outcome.cause or 'stopped with its batch'}", outcome)
+        return outcome
+
+    def ask(self, cmd):
+        """A short query of the core that writes no folder (`ballast info`): (exit code, stdout,
+        stderr).  Its process is one of the batch's, so an interrupt stops it as it stops a run."""
+        if self.running.stopping:
+            raise Stopped(" ".join(map(str, cmd)))
+        return _execute(cmd, None, self.running)
+
+
+def _stop(futures, pool, batch, out):
+    """After an interrupt: drop the tasks not started, terminate the live runs and wait for
     their threads to record them (SIGKILL after STOP_GRACE s, or at a second interrupt)."""
     pool.shutdown(wait=False, cancel_futures=True)
-    running.terminate()
+    batch.running.terminate()
     live = [f for f in futures if not f.cancelled()]     # a cancelled future never counts as done
     try:
         deadline = time.monotonic() + STOP_GRACE
@@ -350,44 +390,73 @@ def _stop(futures, pool, running, out):
     except KeyboardInterrupt:
         pass
     if wait(live, timeout=0)[1]:
-        running.kill()
+        batch.running.kill()
         wait(live)
-    results = [f.result() for f in live if f.exception() is None]
-    stopped = sum(not o.ok and o.cause.startswith("interrupted:") for o in results)
-    dropped = len(futures) - len(live) + sum(o.cause == "interrupted before it started" for o in results)
+    stopped = sum(not o.ok and o.cause.startswith("interrupted:") for o in batch.outcomes)
+    dropped = len(futures) - len(live) + sum(o.cause == "interrupted before it started" for o in batch.outcomes)
     print(f"\ninterrupted: {stopped} run(s) stopped, {dropped} not started; their folders hold no result "
           "(--resume redoes only these)", file=out, flush=True)
 
 
-def run_all(jobs, binary, workers=None, out=sys.stdout, tty=None, resume=False):
-    """Run jobs in parallel (workers defaults to os.cpu_count()); Outcomes in job order.
-    resume: keep the jobs whose folder already holds a complete run of the same identity.
-    SIGINT/SIGTERM: stop every run (see the module's docstring), then KeyboardInterrupt."""
+def run_tasks(tasks, binary, workers=None, out=sys.stdout, resume=False, done=None):
+    """Run tasks in parallel (workers defaults to os.cpu_count()): each task(batch) starts its
+    runs through batch.launch and returns a result.  Results in task order; done(i, result),
+    when given, is called in the main thread as task i ends (tasks ending together in task
+    order).  A task that raised has its exception raised when every task has ended (the
+    first by task order).  resume: keep every run whose folder already holds a complete run
+    of the same identity.  SIGINT/SIGTERM: stop every run (see the module's docstring), say
+    how many on out, then KeyboardInterrupt."""
     workers = max(1, workers or os.cpu_count() or 1)
-    progress, running = Progress(jobs, out, tty), Running()
-    binary_id = binary_identity(binary)
-    outcomes = {}
+    batch = Batch(binary, resume)
+    results, errors = {}, {}
     pool = ThreadPoolExecutor(max_workers=workers)
     futures = {}
     with sigterm_as_interrupt():
         try:
-            for i, job in enumerate(jobs):
-                futures[pool.submit(run_one, job, binary, running, resume, binary_id)] = i
+            for i, task in enumerate(tasks):
+                futures[pool.submit(task, batch)] = i
             pending = set(futures)
             while pending:
                 # Poll, not block: Python runs a signal's handler in the main thread only, and a
                 # signal the kernel gave to a worker thread would not wake a blocked main thread.
-                done, pending = wait(pending, timeout=POLL, return_when=FIRST_COMPLETED)
-                for future in sorted(done, key=futures.get):
-                    outcomes[futures[future]] = future.result()
-                    progress.finished(outcomes[futures[future]])
+                ended, pending = wait(pending, timeout=POLL, return_when=FIRST_COMPLETED)
+                for future in sorted(ended, key=futures.get):
+                    i = futures[future]
+                    if future.exception() is not None:
+                        errors[i] = future.exception()
+                        continue
+                    results[i] = future.result()
+                    if done:
+                        done(i, results[i])
         except KeyboardInterrupt:
-            _stop(list(futures), pool, running, out)
+            _stop(list(futures), pool, batch, out)
             raise
     pool.shutdown()
-    ordered = [outcomes[i] for i in range(len(jobs))]
-    progress.close(ordered)
-    return ordered
+    if errors:
+        raise errors[min(errors)]
+    return [results[i] for i in range(len(tasks))]
+
+
+def _single(job):
+    """The task of one job: its Outcome, also when the batch is stopping."""
+    def task(batch):
+        try:
+            return batch.launch(job)
+        except Stopped as stop:
+            return stop.outcome
+    return task
+
+
+def run_all(jobs, binary, workers=None, out=sys.stdout, tty=None, resume=False):
+    """Run jobs in parallel (workers defaults to os.cpu_count()); Outcomes in job order, each
+    job's progress line printed as it ends.  resume: keep the jobs whose folder already holds
+    a complete run of the same identity.  SIGINT/SIGTERM: stop every run (see the module's
+    docstring), then KeyboardInterrupt."""
+    progress = Progress(jobs, out, tty)
+    outcomes = run_tasks([_single(job) for job in jobs], binary, workers, out, resume,
+                         lambda i, outcome: progress.finished(outcome))
+    progress.close(outcomes)
+    return outcomes
 
 
 def sweep_jobs(case, variant, key, values, sweeps_root):

@@ -1,6 +1,5 @@
 """Stability limits (issue 6, item 3): the largest stable time step of every catalogue
-variant, found by bisection, against ballast's critical-step estimate; and the extreme
-probe scenes of cases/extremes/.
+variant, found by bisection, against ballast's critical-step estimate.
 
 Limit of one variant.  Every trial runs the variant's scene with its `set =` overrides,
 `settings.dt = f x estimate` (the estimate that `bin/ballast info` prints for that
@@ -36,21 +35,26 @@ The bisection brackets [stable, unstable] starting at f = 1, moving by STEP, the
 halves the bracket until hi/lo <= 1 + TOLERANCE.  The limit reported is the largest
 stable f: the measured limit over the estimate.  A safe and tight estimate has it in
 [1, 1.25].
+
+Every trial is a run of the runner (harness/runner.py): a variant's bisection is one task
+of run_tasks, which launches its trials one after another into
+<work>/limits/<case>/<variant>/ (base, trial01, trial02, ...).  So they get the runner's run folders and records, its interrupt
+handling (Ctrl-C stops the trials running and starts no other) and --resume (a trial
+whose folder holds a complete run of the same identity is not run again); -j sets how
+many variants are bisected side by side, which changes no result.
+
+The extreme probes (extremes.py) use the same runs and criteria; write_tsv, merge_tsv
+and read_tsv below keep both tables (stability.tsv, extremes.tsv).
 """
 import json
 import math
-import os
 import re
-import shutil
-import subprocess
-import tempfile
-from concurrent.futures import ThreadPoolExecutor
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import files
-from .children import options as child_options
-from .ini import parse_file
+from .runner import Job, run_tasks
 
 ENERGY_GROWTH = 4.0
 ENERGY_LOSS = 1.5
@@ -86,13 +90,14 @@ def targets_for(cases, one_per_case=False):
 
 # ---------------------------------------------------------------- ballast
 
-def info(binary, scene, sets):
-    """`ballast info` of a scene: estimate (the bound), single (C&S 2 sqrt(m/k)), dt."""
-    cmd = [str(binary), "info", str(scene)] + [a for s in sets for a in ("--set", s)]
-    proc = subprocess.run(cmd, capture_output=True, text=True, **child_options())
-    if proc.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)}: exit {proc.returncode}: {proc.stderr.strip()}")
-    return parse_info(proc.stdout)
+def info(batch, scene, sets):
+    """`ballast info` of a scene (asked through the runner's batch): estimate (the bound),
+    single (C&S 2 sqrt(m/k)), dt."""
+    cmd = [str(batch.binary), "info", str(scene)] + [a for s in sets for a in ("--set", s)]
+    returncode, stdout, stderr = batch.ask(cmd)
+    if returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)}: exit {returncode}: {stderr.strip()}")
+    return parse_info(stdout)
 
 
 def parse_info(text):
@@ -153,12 +158,14 @@ class Trial:
     envelope: dict = field(default_factory=dict)   # column -> (min, max) over the series
 
 
-def run(binary, scene, sets, folder):
-    """Run ballast once and read what the criteria need."""
-    cmd = [str(binary), "run", str(scene), "--out", str(folder)] + [a for s in sets for a in ("--set", s)]
-    proc = subprocess.run(cmd, capture_output=True, text=True, **child_options())
-    t = Trial(proc.returncode, proc.stderr.strip())
+def run(batch, target, sets, folder):
+    """Run the target's scene once with sets, through the runner's batch, into folder; read
+    what the criteria need.  A folder the harness cannot write is its WriteError (exit 3)."""
     folder = Path(folder)
+    outcome = batch.launch(Job(target.case, target.variant, target.scene, list(sets), folder))
+    if outcome.io_error:
+        raise outcome.io_error
+    t = Trial(outcome.returncode, _stderr(folder))
     try:
         meta = json.loads((folder / "run.json").read_text())
         t.steps = int(meta.get("steps", 0))
@@ -169,6 +176,14 @@ def run(binary, scene, sets, folder):
     t.envelope = series_envelope(folder / "series.tsv")
     t.overlap_max = largest_overlap(folder / "discs.tsv", folder / "contacts.tsv")
     return t
+
+
+def _stderr(folder):
+    """What ballast said on stderr (the runner keeps it as ballast.stderr), stripped."""
+    try:
+        return (Path(folder) / "ballast.stderr").read_text(encoding="utf-8", errors="replace").strip()
+    except OSError:
+        return ""
 
 
 def series_energy(path):
@@ -333,81 +348,79 @@ class Limit:
         return self.limit * self.estimate / self.single
 
 
-def measure(binary, target, workdir, cap=CYCLE_CAP, tolerance=TOLERANCE):
-    """The largest stable dt fraction of one target."""
-    est = info(binary, target.scene, target.sets)
+def measure(batch, target, folder, cap=CYCLE_CAP, tolerance=TOLERANCE):
+    """The largest stable dt fraction of one target; its runs go to folder (base, trial01, ...:
+    the same names in the same order at every attempt, which is what lets --resume keep them)."""
+    est = info(batch, target.scene, target.sets)
     lim = Limit(target.case, target.variant, est["estimate"], est["single"], est["dt"])
     stages = stage_cycles(target.scene, target.sets)
-    work = Path(tempfile.mkdtemp(prefix=f"{target.case}.{target.variant}.", dir=workdir))
-    try:
-        base_sets = target.sets + scaled_cycles(stages, 1, 1, cap)
-        base = run(binary, target.scene, base_sets, work / "base")
-        if base.exit != 0:
-            lim.note = f"baseline (its own dt) fails: exit {base.exit}: {base.message}"
-            return lim
+    folder = Path(folder)
+    base_sets = target.sets + scaled_cycles(stages, 1, 1, cap)
+    base = run(batch, target, base_sets, folder / "base")
+    if base.exit != 0:
+        lim.note = f"baseline (its own dt) fails: exit {base.exit}: {base.message}"
+        return lim
 
-        def stable(f):
-            dt = f * lim.estimate
-            # force_dt: a trial above the estimate is the point of the bisection (ballast refuses
-            # such a step otherwise)
-            sets = target.sets + [f"settings.dt={dt!r}", "settings.force_dt=1"] + \
-                scaled_cycles(stages, lim.dt_case, dt, cap)
-            t = run(binary, target.scene, sets, work / "trial")
-            why = verdict(t, base)
-            lim.trials += 1
-            lim.log.append((f, why or "stable"))
-            return why
+    def stable(f):
+        dt = f * lim.estimate
+        # force_dt: a trial above the estimate is the point of the bisection (ballast refuses
+        # such a step otherwise)
+        sets = target.sets + [f"settings.dt={dt!r}", "settings.force_dt=1"] + \
+            scaled_cycles(stages, lim.dt_case, dt, cap)
+        t = run(batch, target, sets, folder / f"trial{lim.trials + 1:02d}")
+        why = verdict(t, base)
+        lim.trials += 1
+        lim.log.append((f, why or "stable"))
+        return why
 
-        f = 1.0
-        why = stable(f)
-        if not why:
-            lo, hi, cause = f, None, ""
-            while f < F_MAX:
-                f *= STEP
-                why = stable(f)
-                if why:
-                    hi, cause = f, why
-                    break
-                lo = f
-        else:
-            hi, lo, cause = f, None, why
-            while f > F_MIN:
-                f /= STEP
-                why = stable(f)
-                if not why:
-                    lo = f
-                    break
-                hi, cause = f, why
-        if lo is None or hi is None:
-            lim.limit = lo if lo is not None else float("nan")
-            lim.note = "no unstable step up to f = %g" % F_MAX if hi is None else "unstable down to f = %g" % F_MIN
-            return lim
-        while hi / lo > 1 + tolerance:
-            mid = math.sqrt(lo * hi)
-            why = stable(mid)
+    f = 1.0
+    why = stable(f)
+    if not why:
+        lo, hi, cause = f, None, ""
+        while f < F_MAX:
+            f *= STEP
+            why = stable(f)
             if why:
-                hi, cause = mid, why
-            else:
-                lo = mid
-        lim.limit, lim.unstable, lim.cause = lo, hi, cause
+                hi, cause = f, why
+                break
+            lo = f
+    else:
+        hi, lo, cause = f, None, why
+        while f > F_MIN:
+            f /= STEP
+            why = stable(f)
+            if not why:
+                lo = f
+                break
+            hi, cause = f, why
+    if lo is None or hi is None:
+        lim.limit = lo if lo is not None else float("nan")
+        lim.note = "no unstable step up to f = %g" % F_MAX if hi is None else "unstable down to f = %g" % F_MIN
         return lim
-    finally:
-        shutil.rmtree(work, ignore_errors=True)
+    while hi / lo > 1 + tolerance:
+        mid = math.sqrt(lo * hi)
+        why = stable(mid)
+        if why:
+            hi, cause = mid, why
+        else:
+            lo = mid
+    lim.limit, lim.unstable, lim.cause = lo, hi, cause
+    return lim
 
 
-def measure_all(binary, targets, workdir, jobs=None, cap=CYCLE_CAP, tolerance=TOLERANCE, out=None):
-    jobs = jobs or os.cpu_count() or 1
-    Path(workdir).mkdir(parents=True, exist_ok=True)
+def measure_all(binary, targets, workdir, jobs=None, cap=CYCLE_CAP, tolerance=TOLERANCE, out=None, resume=False):
+    """The Limit of every target, one bisection task each (runner.run_tasks, jobs side by side),
+    their runs under workdir/limits/<case>/<variant>; out gets one line per target as it ends."""
+    def task(target):
+        folder = Path(workdir) / "limits" / target.case / target.variant
+        return lambda batch: measure(batch, target, folder, cap, tolerance)
 
-    def one(t):
-        lim = measure(binary, t, workdir, cap, tolerance)
+    def done(i, lim):
         if out:
-            print(f"  {t.case}/{t.variant}: limit {lim.limit:.4g} x estimate "
+            print(f"  {lim.case}/{lim.variant}: limit {lim.limit:.4g} x estimate "
                   f"({lim.trials} trials){' ' + lim.note if lim.note else ''}", file=out, flush=True)
-        return lim
 
-    with ThreadPoolExecutor(max_workers=jobs) as pool:
-        return list(pool.map(one, targets))
+    return run_tasks([task(t) for t in targets], binary, jobs, out or sys.stdout, resume, done)
 
 
 LIMIT_COLUMNS = ("case", "variant", "dt_case", "estimate", "single_spring", "single_over_estimate",
@@ -460,125 +473,3 @@ def read_tsv(path):
         return []
     head = lines[0].split("\t")
     return [dict(zip(head, line.split("\t"))) for line in lines[1:]]
-
-
-# ---------------------------------------------------------------- extremes
-
-EXTREME_KEYS = {"scene", "set", "group", "what", "expect", "energy_ratio", "e_in", "overlap_max", "bound"}
-EXPECTS = ("stable", "stop")
-
-
-@dataclass
-class Probe:
-    name: str
-    group: str               # which physics the row probes (rows of later physics add groups)
-    what: str
-    scene: Path
-    sets: list
-    expect: str              # stable: runs through and passes its criteria;
-                             # stop: ballast ends it with exit 1 and says why
-    energy_ratio: float      # stable: E_out/E_in (last over first row of E_k + E_el) at most this
-                             # (nan: not a criterion, e.g. under gravity)
-    overlap_max: float       # stable: largest final overlap / smaller radius at most this
-    bounds: list = field(default_factory=list)   # [(column, lo, hi)]: every row within
-    line: int = 0
-    e_in: float = float("nan")   # the energy put in, when the first row cannot give it (nan: first row)
-
-
-def load_probes(path):
-    """The probes of cases/extremes/extremes.txt ([probe NAME] sections)."""
-    probes = []
-    for sec in parse_file(path):
-        if sec.kind != "probe":
-            raise sec.error(f"unknown section kind '{sec.kind}' (known: probe)")
-        sec.check_keys(EXTREME_KEYS)
-        expect = sec.get("expect", "stable")
-        if expect not in EXPECTS:
-            raise sec.error(f"expect must be one of {', '.join(EXPECTS)}, not '{expect}'")
-        bounds = []
-        for e in sec.all("bound"):
-            parts = e.value.split()
-            try:
-                bounds.append((parts[0], float(parts[1]), float(parts[2])))
-            except (IndexError, ValueError):
-                raise sec.error(f"bound needs 'COLUMN LO HI', got '{e.value}'", e.line) from None
-        probes.append(Probe(sec.name, sec.require("group"), sec.require("what"),
-                            Path(path).parent / sec.require("scene"), [e.value for e in sec.all("set")],
-                            expect, sec.number("energy_ratio", float("nan")), sec.number("overlap_max", 0.1),
-                            bounds, sec.line, sec.number("e_in", float("nan"))))
-    return probes
-
-
-def energy_in_out(path):
-    """(E at the first row, E at the last row) of E_k + E_el in a series."""
-    nan = float("nan")
-    try:
-        lines = Path(path).read_text().splitlines()
-    except OSError:
-        return nan, nan
-    if len(lines) < 2:
-        return nan, nan
-    head = lines[0].split("\t")
-    cols = [head.index(c) for c in ("Ek", "Ee") if c in head]
-    if not cols:
-        return nan, nan
-
-    def energy(line):
-        row = line.split("\t")
-        try:
-            return sum(float(row[c]) for c in cols)
-        except (ValueError, IndexError):
-            return nan
-    return energy(lines[1]), energy(lines[-1])
-
-
-def judge(probe, trial, e_in, e_out):
-    """(outcome, ok): what happened, and whether it is what the probe accepts."""
-    if trial.exit != 0:
-        msg = trial.message or "(no message)"
-        return f"stopped, exit {trial.exit}: {msg}", probe.expect == "stop" and trial.exit == 1 and bool(trial.message)
-    if trial.nonfinite:
-        return f"NON-FINITE output with exit 0 at {trial.nonfinite}", False
-    problems = []
-    ratio = e_out / e_in if e_in > 0 else float("nan")
-    if not math.isnan(probe.energy_ratio) and not ratio <= probe.energy_ratio:
-        problems.append(f"E_out/E_in {ratio:.4g} > {probe.energy_ratio:g}")
-    if not trial.overlap_max <= probe.overlap_max and not math.isnan(trial.overlap_max):
-        problems.append(f"overlap/r {trial.overlap_max:.3g} > {probe.overlap_max:g}")
-    for col, lo, hi in probe.bounds:
-        if col not in trial.envelope:
-            problems.append(f"no column {col}")
-            continue
-        tlo, thi = trial.envelope[col]
-        if tlo < lo or thi > hi:
-            problems.append(f"{col} in [{tlo:.4g}, {thi:.4g}], outside [{lo:g}, {hi:g}]")
-    if problems:
-        return "ran through: " + "; ".join(problems), False
-    return "ran through, within its criteria", probe.expect == "stable"
-
-
-EXTREME_COLUMNS = ("group", "probe", "what", "expect", "exit", "steps", "e_in", "e_out", "e_out_over_in",
-                   "overlap_max", "outcome", "as_expected")
-
-
-def run_probe(binary, probe, workdir):
-    folder = Path(tempfile.mkdtemp(prefix=f"extreme.{probe.name}.", dir=workdir))
-    try:
-        t = run(binary, probe.scene, probe.sets, folder)
-        e_in, e_out = energy_in_out(folder / "series.tsv")
-        if not math.isnan(probe.e_in):
-            e_in = probe.e_in
-    finally:
-        shutil.rmtree(folder, ignore_errors=True)
-    outcome, ok = judge(probe, t, e_in, e_out)
-    ratio = e_out / e_in if e_in and e_in > 0 else float("nan")
-    return {"group": probe.group, "probe": probe.name, "what": probe.what, "expect": probe.expect,
-            "exit": str(t.exit), "steps": str(t.steps), "e_in": f"{e_in:.6g}", "e_out": f"{e_out:.6g}",
-            "e_out_over_in": f"{ratio:.6g}", "overlap_max": f"{t.overlap_max:.4g}",
-            "outcome": outcome.replace("\t", " ").replace("\n", " "), "as_expected": "yes" if ok else "no"}
-
-
-def run_probes(binary, probes, workdir, jobs=None):
-    Path(workdir).mkdir(parents=True, exist_ok=True)
-    with ThreadPoolExecutor(max_workers=jobs or os.cpu_count() or 1) as pool:
-        return list(pool.map(lambda p: run_probe(binary, p, workdir), probes))

@@ -11,9 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-
-class RunProblem(Exception):
-    """A run's outputs cannot be used: missing, failed, or malformed."""
+from .errors import RunProblem
 
 
 @dataclass
@@ -100,7 +98,7 @@ def run_failure(folder, info):
     return None
 
 
-# The files a complete run leaves, by the core's command (main.c, output.c, bench/peer/race.py).
+# The files a complete run leaves, by the core's command (main.c, output.c, harness/peer/race.py).
 EXPECTED_OUTPUTS = {"run": ("series.tsv", "stress.tsv", "contacts.tsv", "discs.tsv", "walls.tsv", "run.json"),
                     "exact": ("series.tsv", "contacts.tsv", "discs.tsv", "walls.tsv", "run.json"),
                     "peer": ("series.tsv", "run.json")}

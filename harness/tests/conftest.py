@@ -1,6 +1,7 @@
 """Fixtures: a fake project in a tmp dir, with the harness pointed at it by environment variables."""
 import pytest
 
+import harness.families  # noqa: F401 -- registers the families' expression functions, as the command line does
 from harness.tests.fakes import env_for, make_project
 
 

@@ -2,7 +2,7 @@
 import pytest
 
 from harness import catalogue
-from harness.ini import IniError
+from harness.errors import CatalogueError, IniError
 
 
 def test_loads_cases_variants_and_figures(project):
@@ -43,7 +43,7 @@ def test_select_by_tier_and_name(project):
     assert [c.name for c in catalogue.select(cases, tier="standard")] == ["spring"]
     assert [c.name for c in catalogue.select(cases, tier="full")] == ["slow", "spring"]
     assert [c.name for c in catalogue.select(cases, ["slow"], tier="quick")] == ["slow"]
-    with pytest.raises(catalogue.CatalogueError, match="unknown case"):
+    with pytest.raises(CatalogueError, match="unknown case"):
         catalogue.select(cases, ["nope"])
 
 

@@ -7,8 +7,9 @@ import pytest
 
 from harness.__main__ import main
 from harness.compare import RunStore, evaluate_check, folder_locator
+from harness.errors import RunProblem
 from harness.references import load
-from harness.tables import RunProblem, read_series
+from harness.tables import read_series
 from harness.tests.fakes import env_for, write_run
 
 WRAPPER = Path(__file__).resolve().parents[1] / "ballast-harness"

@@ -9,7 +9,8 @@ import re
 import numpy as np
 import pytest
 
-from harness.compare import EvalError, RunStore, evaluate, folder_locator
+from harness.compare import RunStore, evaluate, folder_locator
+from harness.errors import EvalError
 from harness.tables import load_run
 from harness.tests.fakes import write_run
 

@@ -5,9 +5,10 @@ import math
 import numpy as np
 import pytest
 
-from harness.compare import EvalError, RunStore, evaluate, evaluate_check, folder_locator
+from harness.compare import RunStore, evaluate, evaluate_check, folder_locator
+from harness.errors import EvalError
 from harness.references import load_file
-from harness.tables import load_run
+from harness.tables import Run, load_run
 from harness.tests.fakes import spring_columns, write_run, write_series
 
 
@@ -224,7 +225,6 @@ def test_store_loads_each_run_once(tmp_path, store):
 # ---------------------------------------------------------------- series, period, settle
 
 def _fake_run(columns, info=None):
-    from harness.tables import Run
     cols = {k: np.asarray(v, dtype=float) for k, v in columns.items()}
     return Run(folder=None, columns=cols, info=info or {"status": "ok"})
 

@@ -3,8 +3,9 @@ variant of every case; energy() reads the audit of run.json and refuses missing 
 import pytest
 
 from harness import catalogue, references
+from harness.__main__ import main
 from harness.compare import RunStore, evaluate_check, folder_locator
-from harness.ini import IniError
+from harness.errors import IniError
 from harness.tests.fakes import spring_columns, write_run
 
 EVERY = """\
@@ -68,7 +69,6 @@ def test_missing_or_broken_audit_is_a_failure_that_says_why(tmp_path, energy, wo
 
 
 def test_report_tabulates_each_term_of_the_audit(project, runs, capsys):
-    from harness.__main__ import main
     audit = {"kinetic0": 1.0, "elastic0": 0.0, "kinetic": 0.25, "elastic": 0.5, "work_walls": 2.0,
              "work_gravity": 0.0, "dissipated_dashpot": 1.5, "dissipated_friction": 0.625,
              "dissipated_global": 0.0, "imbalance": 0.125, "relative_imbalance": 0.0416015625}

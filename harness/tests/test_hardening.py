@@ -29,6 +29,7 @@ import pytest
 from harness import lock
 from harness.__main__ import main
 from harness.children import options as child_options
+from harness.errors import Busy
 from harness.tests.fakes import env_for, tree_snapshot
 from harness.tests.test_interrupt import comparable
 
@@ -148,7 +149,7 @@ def test_the_runs_keep_the_lock_until_they_end(tmp_path, monkeypatch):
     with lock.reports_lock(tmp_path, "run"):
         child = subprocess.Popen(["sleep", "30"], **child_options())
     try:
-        with pytest.raises(lock.Busy):
+        with pytest.raises(Busy):
             with lock.reports_lock(tmp_path, "check"):
                 pass
     finally:

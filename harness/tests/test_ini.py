@@ -1,7 +1,8 @@
 """The INI-like parser: sections, repeated keys, comments, and file:line on malformed input."""
 import pytest
 
-from harness.ini import IniError, parse, parse_file
+from harness.errors import IniError
+from harness.ini import parse, parse_file
 
 GOOD = """\
 # leading comment

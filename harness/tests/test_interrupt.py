@@ -24,8 +24,9 @@ from pathlib import Path
 import pytest
 
 from harness.__main__ import main
+from harness.errors import RunProblem
 from harness.runner import Job, binary_identity, identity, run_all, stale
-from harness.tables import RunProblem, load_run
+from harness.tables import load_run
 from harness.tests.fakes import tree_snapshot, write_fake_bin
 from harness.tests.test_runner import add_sets
 

@@ -3,9 +3,9 @@ import math
 
 import pytest
 
-from harness import network
+from harness.report import network
 from harness.catalogue import load
-from harness.ini import IniError
+from harness.errors import IniError
 
 
 def _discs():

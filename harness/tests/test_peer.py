@@ -1,4 +1,4 @@
-"""bench/peer/race.py (`make bench-peer`): its pure functions -- the ballast scene and the
+"""harness/peer/race.py (`make bench-peer`): its pure functions -- the ballast scene and the
 LAMMPS data file and input it writes, the LAMMPS logs and dumps it reads, the force and
 contact conventions of the cross-check, the figures it prints.  No LAMMPS run here; one test
 runs bin/ballast for three steps (skipped when it is not built)."""
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-_spec = importlib.util.spec_from_file_location("peer_race", ROOT / "bench" / "peer" / "race.py")
+_spec = importlib.util.spec_from_file_location("peer_race", ROOT / "harness" / "peer" / "race.py")
 race = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(race)
 

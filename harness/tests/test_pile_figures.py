@@ -8,7 +8,8 @@ import pytest
 
 from harness import catalogue, report
 from harness.compare import RunStore, folder_locator
-from harness.ini import IniError
+from harness.errors import IniError
+from harness.report import plots
 from harness.tests.pile_fakes import write_pile_run
 
 needs_gnuplot = pytest.mark.skipif(not shutil.which("gnuplot"), reason="gnuplot not installed")
@@ -107,7 +108,7 @@ def store(tmp_path):
 
 def render(tmp_path, store, figure):
     case = load(tmp_path, figure)
-    out = report.render_figure(case, case.figures[0], store, tmp_path)
+    out = plots.render_figure(case, case.figures[0], store, tmp_path)
     return out
 
 
@@ -140,7 +141,7 @@ def test_principal_renders(tmp_path, store):
 def test_principal_crosses():
     """Lengths proportional to S (largest |S| 0.9 of the largest diameter), along phi and across."""
     axes = [(0.0, 0.0, 0.5, 2.0, 1.0, 90.0), (3.0, 0.0, 0.5, 1.0, -0.5, 0.0)]
-    segments, top = report.principal_lines(axes)
+    segments, top = plots.principal_lines(axes)
     assert top == 2.0 and len(segments) == 4
     (ax0, ay0, ax1, ay1, t0), (bx0, by0, bx1, by1, t1) = segments[:2]
     assert (ax0, ax1) == pytest.approx((0.0, 0.0)) and (ay0, ay1) == pytest.approx((-0.45, 0.45))   # vertical, 0.9 d
@@ -149,7 +150,7 @@ def test_principal_crosses():
     c, d = segments[2:]
     assert math.hypot(c[2] - c[0], c[3] - c[1]) == pytest.approx(0.45) and not c[4]
     assert math.hypot(d[2] - d[0], d[3] - d[1]) == pytest.approx(0.225) and d[4]     # tensile
-    assert report.principal_lines([(0, 0, 0.5, 0.0, 0.0, 0.0)]) == ([], 0.0)
+    assert plots.principal_lines([(0, 0, 0.5, 0.0, 0.0, 0.0)]) == ([], 0.0)
 
 
 @needs_gnuplot

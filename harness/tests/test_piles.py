@@ -1,15 +1,17 @@
-"""The pile functions of the quantity expressions (piles.py) on the hand-made pile of
-pile_fakes.py: stress profiles in MLH units (compression positive), horizontal contacts,
+"""The pile and network functions of the quantity expressions (families/piles.py,
+families/networks.py) on the hand-made pile of pile_fakes.py: stress profiles in MLH units (compression positive), horizontal contacts,
 contact forces against another variant, and every missing input an EvalError (a FAIL)."""
 import math
 
 import numpy as np
 import pytest
 
-from harness import piles
-from harness.compare import EvalError, RunStore, evaluate, evaluate_check, folder_locator
+from harness.compare import RunStore, evaluate, evaluate_check, folder_locator, namespace
+from harness.errors import EvalError
+from harness.families import piles
 from harness.references import load_file
 from harness.tables import load_run
+from harness.tests import pile_fakes
 from harness.tests.pile_fakes import write_pile_run
 
 R2 = math.sqrt(2)
@@ -34,7 +36,6 @@ def value(store, expr, variant="dem"):
 
 def array(store, expr, variant="dem"):
     """An array-valued expression, through the namespace the checks use."""
-    from harness.compare import namespace
     run = store.get("pile", variant)
     names = namespace(run, lambda other: store.get("pile", other))
     return eval(expr, {**names, "__builtins__": {}})  # noqa: S307 -- test only
@@ -240,9 +241,6 @@ def test_namespace_reads_nothing_until_called(tmp_path):
 
 def test_pile_S_of_another_variant(tmp_path):
     """pile_S(component, row, variant) reads a sibling variant's final state."""
-    from harness.compare import evaluate
-    from harness.tables import load_run
-    from harness.tests import pile_fakes
     a = pile_fakes.write_pile_run(tmp_path / "a")
     b = pile_fakes.write_pile_run(tmp_path / "b")
     runs = {"b": load_run(b)}

@@ -2,7 +2,7 @@
 import pytest
 
 from harness import catalogue, references
-from harness.ini import IniError
+from harness.errors import IniError
 
 BASE = """\
 [check c]

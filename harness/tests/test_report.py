@@ -84,7 +84,7 @@ def test_report_without_any_data_draws_no_figure(project, capsys):
 
 def test_report_without_gnuplot_still_writes_the_page(project, runs, capsys, monkeypatch):
     write_spring_runs(runs)
-    monkeypatch.setattr(report.shutil, "which", lambda name: None)
+    monkeypatch.setattr(shutil, "which", lambda name: None)
     make_report(capsys)
     assert "gnuplot not found" in (project / "reports" / "index.html").read_text()
 

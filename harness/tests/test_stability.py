@@ -1,11 +1,20 @@
-"""Stability limits and extreme probes (harness/stability.py) and their report section."""
+"""Stability limits and extreme probes (harness/stability.py, harness/extremes.py) and their report section."""
+import json
 import math
+import os
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
 
+from harness import extremes
 from harness import stability as st
-from harness.report import stability_html, stability_markdown
+from harness.runner import Batch
+from harness.report.html_page import stability_html
+from harness.report.markdown import stability_markdown
 
 ROOT = Path(__file__).resolve().parents[2]
 BIN = ROOT / "bin" / "ballast"
@@ -93,35 +102,38 @@ def test_verdict():
 
 
 def _model(monkeypatch, limit_dt, estimate=1.0, dt_case=0.1):
-    """A fake ballast: stable iff dt < limit_dt (exit 1 above)."""
-    calls = []
+    """A fake ballast: stable iff dt < limit_dt (exit 1 above).  Returns the names of the
+    folders it was asked to run into, as they come."""
+    folders = []
     monkeypatch.setattr(st, "info", lambda b, s, sets: {"estimate": estimate, "single": 2 * estimate, "dt": dt_case})
     monkeypatch.setattr(st, "stage_cycles", lambda s, sets: [("run", 100)])
 
-    def run(binary, scene, sets, folder):
+    def run(batch, target, sets, folder):
+        folders.append(Path(folder).name)
         dt = next((float(x.split("=", 1)[1]) for x in sets if x.startswith("settings.dt=")), dt_case)
-        calls.append(dt)
         if dt >= limit_dt:
             return st.Trial(1, "non-finite state")
         return st.Trial(0, energy_max=1.0, kinetic_max=1.0, overlap_max=0.0)
     monkeypatch.setattr(st, "run", run)
-    return calls
+    return folders
 
 
 @pytest.mark.parametrize("limit", [0.3, 1.0 + 1e-9, 1.17, 5.5])
 def test_bisection_brackets_the_limit(monkeypatch, tmp_path, limit):
-    _model(monkeypatch, limit)
-    lim = st.measure(Path("ballast"), st.Target("c", "v", Path("x.scene"), []), tmp_path)
+    folders = _model(monkeypatch, limit)
+    lim = st.measure(None, st.Target("c", "v", Path("x.scene"), []), tmp_path)
     assert lim.limit < limit <= lim.unstable
     assert lim.unstable / lim.limit <= 1 + st.TOLERANCE
     assert lim.cause.startswith("exit 1")
     assert lim.single_ratio == pytest.approx(lim.limit / 2)
-    assert list(tmp_path.iterdir()) == []       # trial folders removed
+    # one folder per run, named by its place in the bisection: the same names at every
+    # attempt, so --resume finds the trials an interrupted attempt finished
+    assert folders == ["base"] + [f"trial{k:02d}" for k in range(1, lim.trials + 1)]
 
 
 def test_bisection_reports_a_failing_baseline(monkeypatch, tmp_path):
     _model(monkeypatch, 0.05)                    # the case's own dt 0.1 fails
-    lim = st.measure(Path("ballast"), st.Target("c", "v", Path("x.scene"), []), tmp_path)
+    lim = st.measure(None, st.Target("c", "v", Path("x.scene"), []), tmp_path)
     assert math.isnan(lim.limit) and "baseline" in lim.note
 
 
@@ -151,31 +163,31 @@ expect = stop
 
 def test_load_probes_and_judge(tmp_path):
     (tmp_path / "extremes.txt").write_text(EXTREMES)
-    a, b = st.load_probes(tmp_path / "extremes.txt")
+    a, b = extremes.load_probes(tmp_path / "extremes.txt")
     assert (a.group, a.sets, a.energy_ratio, a.bounds, a.expect) == ("g1", ["material.m.kn=1"], 1.01,
                                                                       [("y", 0.0, 10.0)], "stable")
     assert b.expect == "stop" and math.isnan(b.energy_ratio)
     good = st.Trial(0, overlap_max=0.0, envelope={"y": (0.5, 1.0)})
-    assert st.judge(a, good, 1.0, 1.005) == ("ran through, within its criteria", True)
-    outcome, ok = st.judge(a, good, 1.0, 1.2)
+    assert extremes.judge(a, good, 1.0, 1.005) == ("ran through, within its criteria", True)
+    outcome, ok = extremes.judge(a, good, 1.0, 1.2)
     assert not ok and "E_out/E_in 1.2" in outcome
-    outcome, ok = st.judge(a, st.Trial(0, overlap_max=0.0, envelope={"y": (-3.0, 1.0)}), 1.0, 1.0)
+    outcome, ok = extremes.judge(a, st.Trial(0, overlap_max=0.0, envelope={"y": (-3.0, 1.0)}), 1.0, 1.0)
     assert not ok and "y in [-3" in outcome
-    assert st.judge(b, st.Trial(1, "overlap budget exceeded at step 7"), 1, 1) == \
+    assert extremes.judge(b, st.Trial(1, "overlap budget exceeded at step 7"), 1, 1) == \
         ("stopped, exit 1: overlap budget exceeded at step 7", True)
-    assert st.judge(b, good, 1.0, 1.0)[1] is False          # it should have stopped
-    outcome, ok = st.judge(a, st.Trial(0, nonfinite="cycle 3 column Ek"), 1, 1)
+    assert extremes.judge(b, good, 1.0, 1.0)[1] is False          # it should have stopped
+    outcome, ok = extremes.judge(a, st.Trial(0, nonfinite="cycle 3 column Ek"), 1, 1)
     assert not ok and outcome.startswith("NON-FINITE")
 
 
 def test_load_probes_rejects_unknown_keys(tmp_path):
     (tmp_path / "extremes.txt").write_text("[probe a]\ngroup = g\nwhat = w\nscene = s\ncolour = red\n")
     with pytest.raises(Exception, match="unknown key 'colour'"):
-        st.load_probes(tmp_path / "extremes.txt")
+        extremes.load_probes(tmp_path / "extremes.txt")
 
 
 def test_catalogue_extremes_file_loads():
-    probes = st.load_probes(ROOT / "cases" / "extremes" / "extremes.txt")
+    probes = extremes.load_probes(ROOT / "cases" / "extremes" / "extremes.txt")
     assert len({p.name for p in probes}) == len(probes)
     for p in probes:
         assert p.scene.exists(), p.scene
@@ -192,7 +204,7 @@ def test_report_section(tmp_path):
 
 @needs_bin
 def test_ballast_info_prints_both_estimates():
-    v = st.info(BIN, ROOT / "cases" / "two_discs" / "two_discs.scene", [])
+    v = st.info(Batch(BIN), ROOT / "cases" / "two_discs" / "two_discs.scene", [])
     # two discs between walls, frictionless: omega^2 = 3 k/m exactly; the single-spring
     # value (k_s = k_n by default) is 2 sqrt(m/(2k)): sqrt(3/2) larger than the bound, whose
     # 0.95 is the estimate (BAL_DT_MARGIN, core/timestep.c)
@@ -205,3 +217,118 @@ def test_merge_tsv_replaces_rows_in_place(tmp_path):
     st.merge_tsv([{"k": "a", "v": "1"}, {"k": "b", "v": "2"}], ("k", "v"), path, ("k",))
     st.merge_tsv([{"k": "c", "v": "3"}, {"k": "a", "v": "9"}], ("k", "v"), path, ("k",))
     assert st.read_tsv(path) == [{"k": "a", "v": "9"}, {"k": "b", "v": "2"}, {"k": "c", "v": "3"}]
+
+
+# ---------------------------------------------------------------- through the runner (real bin/ballast)
+#
+# `harness stability` launches its trials through runner.py: an interrupt stops them (exit
+# 130) and keeps the trials done in reports/stability-runs; `--resume` runs only the rest
+# and writes the table an uninterrupted command writes; -j changes nothing.  A wrapper
+# around bin/ballast makes one trial long while BALLAST_TEST_HOLD names its folder, so the
+# test waits on files appearing, not on sleeps.
+
+HOLD_WRAPPER = """#!/bin/sh
+# bin/ballast; while $BALLAST_TEST_HOLD is set, the run whose --out ends in it goes on for
+# 4e8 cycles (minutes) without series rows: the trial an interrupt catches.  Every run's
+# --out is appended to $BALLAST_TEST_LOG when that is set.
+if [ -n "$BALLAST_TEST_LOG" ] && [ "$1" = run ]; then echo "$4" >> "$BALLAST_TEST_LOG"; fi
+if [ -n "$BALLAST_TEST_HOLD" ]; then
+  case "$4" in *"$BALLAST_TEST_HOLD")
+    exec "{bin}" "$@" --set settings.output_every=1000000000 --set stage.hold.cycles=400000000;;
+  esac
+fi
+exec "{bin}" "$@"
+"""
+# With -j 1 the variants are bisected in turn: two_discs/undamped is done when the run held,
+# damped's baseline (at the case's own dt: made long, it stays stable), is interrupted.
+HELD = "limits/two_discs/damped/base"
+
+
+@pytest.fixture(scope="module")
+def hold_wrapper(tmp_path_factory):
+    path = tmp_path_factory.mktemp("bin") / "ballast"
+    path.write_text(HOLD_WRAPPER.replace("{bin}", str(BIN)))
+    path.chmod(0o755)
+    return path
+
+
+def stability(reports, wrapper, *args, hold=None, log=None):
+    env = dict(os.environ, BALLAST_REPORTS=str(reports), PYTHONPATH=str(ROOT))
+    for var in ("BALLAST_CASES", "BALLAST_REFERENCE", "BALLAST_BIN", "BALLAST_TEST_HOLD", "BALLAST_TEST_LOG"):
+        env.pop(var, None)
+    if hold:
+        env["BALLAST_TEST_HOLD"] = hold
+    if log:
+        env["BALLAST_TEST_LOG"] = str(log)
+    argv = [sys.executable, "-m", "harness", "stability", "--no-extremes", "--bin", str(wrapper), *args]
+    return subprocess.Popen(argv, env=env, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True, start_new_session=True)
+
+
+def finished(proc, timeout=120):
+    out, _ = proc.communicate(timeout=timeout)
+    return proc.returncode, out
+
+
+@pytest.fixture(scope="module")
+def uninterrupted(tmp_path_factory, hold_wrapper):
+    reports = tmp_path_factory.mktemp("uninterrupted")
+    code, out = finished(stability(reports, hold_wrapper, "two_discs", "-j", "1"))
+    assert code == 0, out
+    return reports
+
+
+@needs_bin
+def test_stability_leaves_no_trial_folder(uninterrupted):
+    assert (uninterrupted / "stability.tsv").is_file()
+    assert not (uninterrupted / "stability-runs").exists()
+
+
+@needs_bin
+def test_interrupted_stability_resumes_to_the_uninterrupted_table(tmp_path, hold_wrapper, uninterrupted):
+    reports = tmp_path / "reports"
+    work = reports / "stability-runs"
+    proc = stability(reports, hold_wrapper, "two_discs", "-j", "1", hold=HELD)
+    try:
+        deadline = time.monotonic() + 120
+        while not (work / HELD / "series.tsv.tmp").exists():       # the held run is in its time-step loop
+            assert proc.poll() is None, f"stability ended early: {proc.communicate()[0]}"
+            assert time.monotonic() < deadline, "the held run never started"
+            time.sleep(0.01)
+        os.killpg(proc.pid, signal.SIGINT)
+        code, out = finished(proc, 60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    assert code == 130, out
+    assert "interrupted: 1 run(s) stopped, 5 not started" in out       # the bisections of the 5 variants left
+    assert not (reports / "stability.tsv").exists()
+    held = json.loads((work / HELD / "harness.json").read_text())
+    assert not held["ok"] and held["cause"].startswith("interrupted: exit code 130")
+    undamped = work / "limits" / "two_discs" / "undamped"
+    ok = {p.name: json.loads((p / "harness.json").read_text())["ok"] for p in sorted(undamped.iterdir())}
+    assert len(ok) == 8 and ok["base"] and ok["trial01"] and not all(ok.values())   # unstable trials: exit 1
+
+    log = tmp_path / "runs.log"
+    code, out = finished(stability(reports, hold_wrapper, "two_discs", "-j", "1", "--resume", log=log))
+    assert code == 0, out
+    assert (reports / "stability.tsv").read_text() == (uninterrupted / "stability.tsv").read_text()
+    ran = [Path(line) for line in log.read_text().splitlines()]
+    # undamped's successful runs were kept; its failed ones (the unstable trials: exit 1) ran
+    # again; damped's bisection ran from its baseline on
+    assert [p.name for p in ran if p.parent.name == "undamped"] == [name for name, good in ok.items() if not good]
+    assert [p.name for p in ran if p.parent.name == "damped"][:2] == ["base", "trial01"]
+    assert not work.exists()                                      # removed once the command ended
+
+
+@needs_bin
+def test_stability_results_do_not_depend_on_j(tmp_path, hold_wrapper):
+    tables = []
+    for jobs in ("1", "2"):
+        reports = tmp_path / f"j{jobs}"
+        code, out = finished(stability(reports, hold_wrapper, "two_discs", "collisions", "--one-per-case",
+                                       "-j", jobs))
+        assert code == 0, out
+        tables.append((reports / "stability.tsv").read_text())
+    assert tables[0] == tables[1] and tables[0].count("\n") == 3

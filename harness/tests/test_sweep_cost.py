@@ -6,9 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from harness import catalogue, references, report, sweep
+from harness import catalogue, references, sweep, sweep_spec
 from harness.__main__ import main
-from harness.ini import IniError, parse
+from harness.errors import IniError
+from harness.ini import parse
+from harness.report import cost_plot
 from harness.tests.fakes import spring_columns, write_run, write_spring_runs
 
 needs_gnuplot = pytest.mark.skipif(not shutil.which("gnuplot"), reason="gnuplot not installed")
@@ -42,7 +44,7 @@ def add_sweeps(project, text=SWEEPS):
 # ---------------------------------------------------------------- declarations
 
 def test_parse_a_full_declaration():
-    s = sweep.parse(section("variant = v\nkeys = settings.dt=0.01 stage.a.b=2\nfactors = 0.5 2 4\n"
+    s = sweep_spec.parse(section("variant = v\nkeys = settings.dt=0.01 stage.a.b=2\nfactors = 0.5 2 4\n"
                             "scale = stage.load.cycles=40\nchecks = c1 c2\nerror = e(1)\nerror = e(2)\n"))
     assert (s.name, s.variant, s.factors) == ("dt", "v", [0.5, 2.0, 4.0])
     assert s.keys == [("settings.dt", 0.01), ("stage.a.b", 2.0)] and s.scale == [("stage.load.cycles", 40.0)]
@@ -68,7 +70,7 @@ def test_parse_a_full_declaration():
 ])
 def test_parse_errors_name_file_and_line(body, message, line):
     with pytest.raises(IniError) as err:
-        sweep.parse(section(body))
+        sweep_spec.parse(section(body))
     assert message in str(err.value) and f"case.txt:{line}:" in str(err.value)
 
 
@@ -269,7 +271,7 @@ def test_validate_runs_the_sweeps_unless_told_not_to(project, capsys):
 def test_cost_points_mark_the_default_and_note_what_is_not_drawn():
     rows = [row("dt", 1.0, 5e-4, 100), row("dt", 2.0, 5e-3, 50), row("dt", 0.5, 0.0, 200),
             row("k", 1.0, 5e-4, 100), row("k", 3.0, None, 80, status="unstable")]
-    curves, defaults, notes, bad = report.cost_points(rows)
+    curves, defaults, notes, bad = cost_plot.cost_points(rows)
     assert defaults == [(100, 5e-4)]
     assert curves["dt"] == [(100, 5e-4, ""), (50, 5e-3, "x2")] and curves["k"] == [(100, 5e-4, "")]
     assert any("dt x0.5: not drawn: error 0 is not positive" in n for n in notes)
@@ -317,13 +319,13 @@ def test_report_notes_a_cost_table_older_than_the_declarations(project, capsys):
 # ---------------------------------------------------------------- fixed overrides, failed points, self-convergence
 
 def test_parse_fixed_overrides_make_factor_one_a_point_of_its_own():
-    s = sweep.parse(section("variant = v\nset = settings.integrator=gear5\nset = settings.psi=0\n"
+    s = sweep_spec.parse(section("variant = v\nset = settings.integrator=gear5\nset = settings.psi=0\n"
                             "keys = settings.dt=0.01\nfactors = 0.5\nchecks = none\nerror = e(1)\n"))
     assert s.fixed == ["settings.integrator=gear5", "settings.psi=0"] and s.no_checks and s.checks == []
     assert s.run_factors() == [1.0, 0.5]
     assert s.sets(1) == ["settings.integrator=gear5", "settings.psi=0", "settings.dt=0.01"]
     assert s.label(1) == "dt_x1"
-    plain = sweep.parse(section("variant = v\nkeys = settings.dt=0.01\nfactors = 0.5\n"))
+    plain = sweep_spec.parse(section("variant = v\nkeys = settings.dt=0.01\nfactors = 0.5\n"))
     assert plain.run_factors() == [0.5] and plain.fixed == [] and not plain.no_checks
 
 
@@ -336,7 +338,7 @@ def test_parse_fixed_overrides_make_factor_one_a_point_of_its_own():
 ])
 def test_parse_errors_of_the_new_keys(body, message, line):
     with pytest.raises(IniError) as err:
-        sweep.parse(section(body))
+        sweep_spec.parse(section(body))
     assert message in str(err.value) and f"case.txt:{line}:" in str(err.value)
 
 
@@ -375,7 +377,7 @@ def test_a_fixed_sweep_runs_factor_one_and_is_not_the_default(project, capsys):
     assert rows[0]["steps"] == 20 and rows[0]["error"] == 0.0 and rows[1]["error"] == pytest.approx(1.0)
     assert not sweep.is_default(rows[0])
     assert sweep.setting(rows[0]) == "k_fixed x1 (settings.n=20 settings.k=1)"
-    curves, defaults, _, _ = report.cost_points(rows)
+    curves, defaults, _, _ = cost_plot.cost_points(rows)
     assert defaults == [] and curves["k_fixed"] == [(40, pytest.approx(1.0), "x2")]   # error 0 is off the log scale
 
 
@@ -412,7 +414,7 @@ def test_failed_points_have_no_error_and_say_why(project, capsys):
     assert "fail: asked to fail" in gone["note"]          # the runner's cause (harness.json)
     assert all(sweep.failed(r) for r in rows)
     assert all(r is None for r in sweep.cheapest(rows).values())
-    _, _, notes, bad = report.cost_points(rows)
+    _, _, notes, bad = cost_plot.cost_points(rows)
     assert bad == {"blows_up": [(20, "x1 unstable"), (20, "x2 unstable")]}
     assert any(n.startswith("no_output x1: no run.json") and "not drawn" in n for n in notes)
 

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""bench/peer/race.py -- ballast against LAMMPS on the same physics (`make bench-peer`).
+"""harness/peer/race.py -- ballast against LAMMPS on the same physics (`make bench-peer`).
 
-    /usr/bin/python3 bench/peer/race.py [--quick]
+    /usr/bin/python3 harness/peer/race.py [--quick]
 
 1. Cross-check.  A small fill of cases/bench/dense.scene (300 discs on the
    lattice, with the scene's random velocities, nothing touching) is written
@@ -39,7 +39,7 @@ reports/bench/<host>/peer_sweep.csv; the scenes, data files, inputs and logs
 of the last run stay in reports/bench/<host>/peer/.
 
 The physics of both sides (the same in both by construction; see
-bench/peer/in.peer for LAMMPS):
+harness/peer/in.peer for LAMMPS):
   discs of unit thickness, m = density pi r^2, I = m r^2 / 2;
   F_n = k_n * overlap (ballast: normal_law = power, nu = 1, delta0 = 1;
   LAMMPS: gran/hooke/history); incremental shear spring k_t with the Coulomb
@@ -276,8 +276,8 @@ def fmt(v):
 def ballast_scene(state, box, dt, steps, title, kn=KN, kt=KT, mu=MU, g=G, density=DENSITY):
     """A ballast scene listing every disc, the box walls and one stage."""
     xlo, xhi, ylo, yhi = box
-    out = [f"# {title}", "# written by bench/peer/race.py: one [disc] per disc, the fill's box",
-           "# walls, F_n = k_n overlap, no damping (the physics of bench/peer/in.peer)",
+    out = [f"# {title}", "# written by harness/peer/race.py: one [disc] per disc, the fill's box",
+           "# walls, F_n = k_n overlap, no damping (the physics of harness/peer/in.peer)",
            "", "[settings]", f"dt = {fmt(dt)}", f"gravity = 0 {fmt(-g)}",
            "normal_law = power", "nu = 1", "delta0 = 1", "beta = 0", "alpha = 0",
            "gamma_n = 0", f"output_every = {max(1, int(steps))}",
@@ -314,7 +314,7 @@ def lammps_data(state, box, dt, g=G, margin=2.0, half_kick=True, density=DENSITY
     vx, vy, w = state["vx"], state["vy"], state["omega"]
     shift = 0.5 * dt * g if half_kick else 0.0
     n = len(x)
-    out = ["LAMMPS data file written by bench/peer/race.py", "", f"{n} atoms", "1 atom types", "",
+    out = ["LAMMPS data file written by harness/peer/race.py", "", f"{n} atoms", "1 atom types", "",
            f"{fmt(xlo - margin)} {fmt(xhi + margin)} xlo xhi",
            f"{fmt(ylo - margin)} {fmt(yhi + margin)} ylo yhi", "-0.5 0.5 zlo zhi", "",
            "Atoms # sphere", ""]

@@ -1,0 +1,17 @@
+"""The case families' expression functions.  Importing this package registers all of them in
+harness/expressions.py: each module registers its own when it is imported.
+
+    signals      period, settle, sine_period, sine_amplitude: one series as a signal
+    variants     series, of, order: another variant of the same case
+    piles        pile_X, pile_S, middle, horizontal_contacts, weight: a pile's stress (MLH 2000)
+    networks     contact_error, contact_mismatch: contact forces against another variant's
+    collisions   contact_start, contact_end, contact_duration, restitution: a binary collision
+
+A new family is one module here that calls expressions.register, and its name below.  The
+order of the imports is the order in which an unknown-function message lists the names.
+"""
+from . import signals  # noqa: F401 -- each import registers the module's functions
+from . import variants  # noqa: F401
+from . import piles  # noqa: F401
+from . import networks  # noqa: F401
+from . import collisions  # noqa: F401

@@ -1,0 +1,311 @@
+"""The report's figures, drawn by gnuplot: one script maker per figure kind of case.txt
+(SCRIPTS; kinds as in catalogue.py), and the running of gnuplot, which the error-against-cost
+diagram (cost_plot.py) shares.
+
+Figure kinds: series (columns of series.tsv against x); network (force network, see
+network.py); profile (pile_S(component, row) against pile_X(row), lines with points, one
+curve per variant and component, from families/piles.py); principal (MLH Fig. 3(d): the discs of
+the final state and, centred on every free disc, a line along the most compressive
+principal axis of length proportional to S_max and one across it proportional to S_min,
+compression positive, tensile values in red, the largest |S| drawn PRINCIPAL_SHARE of the
+largest diameter; `set arrow ... nohead` per line, square aspect); points (one point per
+variant at (x, y) = two quantity expressions, joined in the order listed and labelled
+with the variant name, optional log axes).  Whatever a figure cannot show -- a variant
+without data, an expression that fails, a non-positive value on a log axis, non-finite
+values -- is listed in its notes, never silently dropped.
+
+gnuplot draws in a scratch folder; each figure reaches reports/figures through files.py
+(a temporary file, then rename), so a killed report leaves it old or new, never cut.
+"""
+import shutil
+import subprocess
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .. import files
+from ..children import options as child_options
+from ..compare import evaluate
+from ..errors import EvalError, RunProblem
+from ..families import piles
+from ..final_state import state
+from . import network
+
+STYLE = Path(__file__).resolve().parent.parent / "gnuplot" / "style.gp"
+SIZE = "960,540"
+
+
+@dataclass
+class FigureOut:
+    name: str
+    title: str
+    paper: str = ""
+    svg: Path = None
+    png: Path = None
+    notes: list = field(default_factory=list)
+
+
+# ---------------------------------------------------------------- figures
+
+def gp_string(text):
+    """A gnuplot single-quoted string."""
+    return "'" + str(text).replace("'", "''") + "'"
+
+
+def curve_title(variant, column, figure):
+    if len(figure.variants) == 1:
+        return column
+    return variant if len(figure.y) == 1 else f"{variant}: {column}"
+
+
+def figure_data(case, figure, store, workdir):
+    """Write one data file per variant (x then the y columns it has); the plot clauses and notes."""
+    clauses, notes = [], []
+    for variant in figure.variants:
+        try:
+            columns = store.get(case.name, variant).columns
+        except RunProblem as problem:
+            notes.append(f"{variant}: no data ({problem})")
+            continue
+        present = [y for y in figure.y if y in columns]
+        missing = [c for c in [figure.x] + figure.y if c not in columns]
+        if missing:
+            notes.append(f"{variant}: column(s) missing from series.tsv: {', '.join(missing)}")
+        if figure.x not in columns or not present:
+            continue
+        path = Path(workdir) / f"{variant}.dat"
+        _write_columns(path, [columns[figure.x]] + [columns[y] for y in present])
+        clauses += [f"{gp_string(path)} using 1:{i + 2} with lines title {gp_string(curve_title(variant, y, figure))}"
+                    for i, y in enumerate(present)]
+    return clauses, notes
+
+
+def _write_columns(path, arrays):
+    files.write_text(path, "".join("\t".join(repr(float(x)) for x in row) + "\n" for row in zip(*arrays)))
+
+
+def gnuplot_script(figure, clauses, png, svg, settings=()):
+    """The script rendering one figure to png then svg (settings: extra lines before plot)."""
+    return "\n".join([
+        f"set terminal pngcairo size {SIZE} noenhanced font 'sans,10'",
+        f"set output {gp_string(png)}",
+        f"load {gp_string(STYLE)}",
+        f"set title {gp_string(figure.title)}",
+        f"set xlabel {gp_string(figure.xlabel)}",
+        f"set ylabel {gp_string(figure.ylabel)}",
+        f"set xrange [{figure.xrange or '*:*'}]",
+        f"set yrange [{figure.yrange or '*:*'}]",
+        *settings,
+        "plot " + ", \\\n     ".join(clauses),
+        f"set terminal svg size {SIZE} noenhanced font 'sans,10' background '#ffffff'",
+        f"set output {gp_string(svg)}",
+        "replot",
+        "unset output",
+        ""])
+
+
+# ---- one script maker per figure kind: (gnuplot script or None, notes)
+
+
+def _series_script(case, figure, store, workdir, png, svg):
+    clauses, notes = figure_data(case, figure, store, workdir)
+    if not clauses:
+        return None, notes + ["nothing to plot"]
+    return gnuplot_script(figure, clauses, png, svg), notes
+
+
+def _network_script(case, figure, store, workdir, png, svg):
+    try:
+        return network.script(store.locate(case.name, figure.variants[0]), figure.title, png, svg), []
+    except (OSError, ValueError, KeyError) as exc:
+        return None, [f"{figure.variants[0]}: no final state to draw ({exc})"]
+
+
+def _profile_script(case, figure, store, workdir, png, svg):
+    """pile_S(component, row) against pile_X(row): one curve per (variant, component)."""
+    clauses, notes = [], []
+    for variant in figure.variants:
+        try:
+            final = state(store.get(case.name, variant))
+            columns = [piles.pile_X(final, figure.row)]
+        except (RunProblem, EvalError) as problem:
+            notes.append(f"{variant}: no data ({problem})")
+            continue
+        present = []
+        for component in figure.y:
+            try:
+                values = piles.pile_S(final, component, figure.row)
+            except EvalError as problem:
+                notes.append(f"{variant}: {component}: {problem}")
+                continue
+            bad = int(np.sum(~np.isfinite(values)))
+            if bad:
+                notes.append(f"{variant}: {component}: {bad} non-finite value(s) not drawn")
+            columns.append(values)
+            present.append(component)
+        if not present:
+            continue
+        path = Path(workdir) / f"{variant}.dat"
+        _write_columns(path, columns)
+        clauses += [f"{gp_string(path)} using 1:{i + 2} with linespoints pt 7 ps 0.6 "
+                    f"title {gp_string(curve_title(variant, c, figure))}" for i, c in enumerate(present)]
+    if not clauses:
+        return None, notes + ["nothing to plot"]
+    return gnuplot_script(figure, clauses, png, svg), notes
+
+
+def _points_script(case, figure, store, workdir, png, svg):
+    """One point (x, y) per variant, joined in the order listed, labelled with its name."""
+    rows, notes = [], []
+    sibling = lambda other: store.get(case.name, other)
+    for variant in figure.variants:
+        try:
+            run = store.get(case.name, variant)
+            point = [evaluate(expr, run, sibling) for expr in (figure.x, figure.y[0])]
+        except (RunProblem, EvalError) as problem:
+            notes.append(f"{variant}: not drawn: {problem}")
+            continue
+        off_axis = [f"{axis} = {value:.6g}" for axis, value in zip("xy", point)
+                    if axis in figure.logscale and value <= 0]
+        if off_axis:
+            notes.append(f"{variant}: not drawn: {', '.join(off_axis)} is not positive (log scale)")
+            continue
+        rows.append((*point, variant))
+    if not rows:
+        return None, notes + ["nothing to plot"]
+    path = Path(workdir) / "points.dat"
+    files.write_text(path, "".join(f"{x!r}\t{y!r}\t{name}\n" for x, y, name in rows))
+    settings = [f"set logscale {figure.logscale}"] if figure.logscale else []
+    clauses = [f"{gp_string(path)} using 1:2 with linespoints pt 7 ps 1 notitle",
+               f"{gp_string(path)} using 1:2:3 with labels left offset char 0.8,0.6 notitle"]
+    return gnuplot_script(figure, clauses, png, svg, settings), notes
+
+
+PRINCIPAL_SHARE = 0.9         # the largest principal value is drawn this share of the largest diameter
+PRINCIPAL_COLOURS = {"compressive": "#1f3a93", "tensile": "#d62728"}
+
+
+def principal_lines(axes):
+    """The crosses of MLH Fig. 3(d): per free disc a line along phi (length ~ S_max) and one
+    across it (length ~ S_min), the largest |S| drawn PRINCIPAL_SHARE of the largest diameter.
+
+    axes: (x, y, r, S_max, S_min, phi) per free disc, compression positive.  Returns the
+    segments (x0, y0, x1, y1, tensile) and the largest S_max.
+    """
+    largest = max((max(abs(a[3]), abs(a[4])) for a in axes), default=0.0)
+    if not largest > 0 or not np.isfinite(largest):
+        return [], largest
+    unit = PRINCIPAL_SHARE * 2 * max(a[2] for a in axes) / largest
+    segments = []
+    for x, y, _, s_max, s_min, phi in axes:
+        for value, angle in ((s_max, phi), (s_min, phi + 90.0)):
+            half = 0.5 * unit * abs(value)
+            if not half > 0:
+                continue
+            dx, dy = half * np.cos(np.radians(angle)), half * np.sin(np.radians(angle))
+            segments.append((x - dx, y - dy, x + dx, y + dy, value < 0))
+    return segments, max(a[3] for a in axes)
+
+
+def _principal_script(case, figure, store, workdir, png, svg):
+    """Discs of the final state and the principal-axis cross of every free disc."""
+    variant = figure.variants[0]
+    try:
+        final = state(store.get(case.name, variant))
+        axes, scaled = piles.principal_axes(final)
+        discs = final.discs()
+    except (RunProblem, EvalError) as problem:
+        return None, [f"{variant}: no final state to draw ({problem})"]
+    if not axes:
+        return None, [f"{variant}: no free disc to draw"]
+    segments, top = principal_lines(axes)
+    unit = "m g / l" if scaled else "(stress, unscaled: run.json has no pile)"
+    lines = ["set terminal pngcairo size 800,800 noenhanced font 'sans,10'", f"set output {gp_string(png)}",
+             "set size ratio -1", "unset key",
+             f"set title {gp_string(f'{figure.title} (largest S_max {top:.4g} {unit}; red: tensile)')}"]
+    x, y, r = discs["x"], discs["y"], discs["r"]
+    rmax = float(np.max(r))
+    lines += [f"set xrange [{float(np.min(x)) - 2 * rmax!r}:{float(np.max(x)) + 2 * rmax!r}]",
+              f"set yrange [{float(np.min(y)) - 2 * rmax!r}:{float(np.max(y)) + 2 * rmax!r}]"]
+    k = 0
+    for w in _walls(final.folder):
+        k += 1
+        lines.append(f"set arrow {k} from {w[0]!r},{w[1]!r} to {w[2]!r},{w[3]!r} nohead lw 3 lc rgb '#444444'")
+    for x0, y0, x1, y1, tensile in segments:
+        k += 1
+        colour = PRINCIPAL_COLOURS["tensile" if tensile else "compressive"]
+        lines.append(f"set arrow {k} from {x0!r},{y0!r} to {x1!r},{y1!r} nohead lw 1.5 lc rgb '{colour}' front")
+    free = discs["free"]
+    for name, chosen in (("free", free), ("held", ~free)):
+        data = "\n".join(f"{a!r} {b!r} {c!r}" for a, b, c in zip(x[chosen], y[chosen], r[chosen]))
+        lines += [f"${name} << EOD", data or "NaN NaN NaN", "EOD"]
+    lines += ["plot $free using 1:2:3 with circles lc rgb '#7f8c8d' lw 1, "
+              "$held using 1:2:3 with circles fill solid 0.3 lc rgb '#7f8c8d'",
+              "set terminal svg size 800,800 noenhanced font 'sans,10' background '#ffffff'",
+              f"set output {gp_string(svg)}", "replot", "unset output", ""]
+    return "\n".join(lines), []
+
+
+def _walls(folder):
+    """(ax, ay, bx, by) of every wall in walls.tsv; none when the file is absent or unreadable."""
+    try:
+        return [(float(w["ax"]), float(w["ay"]), float(w["bx"]), float(w["by"]))
+                for w in network.read_table(Path(folder) / "walls.tsv")]
+    except (OSError, ValueError, KeyError):
+        return []
+
+
+SCRIPTS = {"series": _series_script, "network": _network_script, "profile": _profile_script,
+           "principal": _principal_script, "points": _points_script}
+
+
+def render_figure(case, figure, store, figures_dir):
+    """Render one [figure] into figures_dir/<case>_<figure>.png/.svg; a FigureOut with notes."""
+    out = FigureOut(figure.name, figure.title, figure.paper)
+    png, svg = (Path(figures_dir) / f"{case.name}_{figure.name}.{ext}" for ext in ("png", "svg"))
+    for old in (png, svg):
+        files.remove(old)
+    if not shutil.which("gnuplot"):
+        out.notes.append("gnuplot not found: figure not rendered")
+        return out
+    with tempfile.TemporaryDirectory(prefix="ballast-fig-") as workdir:
+        drawn = drawings(workdir)
+        text, out.notes = SCRIPTS[figure.kind](case, figure, store, workdir, *drawn)
+        if text is None:
+            return out
+        error = run_gnuplot(text, workdir)
+        out.png, out.svg = publish(drawn, (png, svg))
+    if error:
+        out.notes.append(f"gnuplot failed: {error}")
+    return out
+
+
+def drawings(workdir):
+    """Where gnuplot draws a figure: the scratch folder (its data files end in .dat)."""
+    return Path(workdir) / "figure.png", Path(workdir) / "figure.svg"
+
+
+def publish(drawn, final):
+    """Copy each non-empty drawing to its place in reports/figures (whole, by files.copy);
+    the places filled, None for a drawing gnuplot did not make."""
+    out = []
+    for source, path in zip(drawn, final):
+        made = source.is_file() and source.stat().st_size > 0
+        if made:
+            files.copy(source, path)
+        out.append(path if made else None)
+    return out
+
+
+def run_gnuplot(script, workdir):
+    """Run gnuplot on script; '' on success, else its complaint."""
+    path = Path(workdir) / "figure.gp"
+    files.write_text(path, script)
+    try:
+        done = subprocess.run(["gnuplot", str(path)], capture_output=True, text=True, timeout=120,
+                              **child_options(keep_lock=False))
+    except (OSError, subprocess.SubprocessError) as exc:
+        return str(exc)
+    return "" if done.returncode == 0 else (done.stderr.strip().splitlines() or ["exit %d" % done.returncode])[-1]

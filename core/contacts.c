@@ -1,7 +1,7 @@
 /*
- * contacts.c — candidate lists with contact history, and the
- * force–displacement law at every contact (Cundall & Strack eqs 8–19,
- * 24–28; Matuttis, Luding & Herrmann eq. 2).
+ * contacts.c — the force–displacement law at every contact (Cundall &
+ * Strack eqs 8–19, 24–28; Matuttis, Luding & Herrmann eq. 2), over the
+ * candidate lists of pairs.c.
  *
  * For a contact between bodies x and y (x = the lower index; for a disc–wall
  * contact x is the disc and y the wall):
@@ -45,89 +45,6 @@
 #include "sim.h"
 
 /* ------------------------------------------------------------------ */
-/* Candidate lists                                                     */
-/* ------------------------------------------------------------------ */
-
-static int grow_array(void **a, size_t cap, size_t size)
-{
-    void *q = realloc(*a, cap * size);
-    if (!q)
-        return 0;
-    *a = q;
-    return 1;
-}
-
-enum bal_status bal_pairs_reserve(struct bal_pairs *p, long cap)
-{
-    if (cap <= p->cap)
-        return BAL_OK;
-    const size_t c = (size_t)cap;
-    int ok = grow_array((void **)&p->i, c, sizeof *p->i) &&
-             grow_array((void **)&p->j, c, sizeof *p->j) &&
-             grow_array((void **)&p->fn, c, sizeof *p->fn) &&
-             grow_array((void **)&p->flags, c, sizeof *p->flags);
-    if (ok && p->shear)
-        ok = grow_array((void **)&p->fs, c, sizeof *p->fs);
-    if (ok && p->damping)
-        ok = grow_array((void **)&p->dn, c, sizeof *p->dn) &&
-             grow_array((void **)&p->ds, c, sizeof *p->ds);
-    if (!ok)
-        return BAL_ENOMEM;
-    p->cap = cap;
-    return BAL_OK;
-}
-
-void bal_pairs_free(struct bal_pairs *p)
-{
-    const uint8_t shear = p->shear, damping = p->damping;
-    free(p->i);
-    free(p->j);
-    free(p->fn);
-    free(p->fs);
-    free(p->dn);
-    free(p->ds);
-    free(p->flags);
-    memset(p, 0, sizeof *p);
-    p->shear = shear;
-    p->damping = damping;
-}
-
-long bal_pairs_find(const struct bal_pairs *p, uint64_t key)
-{
-    long lo = 0, hi = p->n;
-    while (lo < hi) {
-        const long mid = lo + (hi - lo) / 2;
-        if (pair_key(p, mid) < key)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < p->n && pair_key(p, lo) == key ? lo : -1;
-}
-
-/* Copy the history of every contact of `old` whose key is also in `fresh`.
- * Both lists are sorted by key, so one linear pass suffices.  Contacts of
- * `fresh` that are new start with zero history. */
-void bal_pairs_merge_history(struct bal_pairs *fresh, const struct bal_pairs *old)
-{
-    long a = 0;
-    for (long c = 0; c < fresh->n; c++) {
-        const uint64_t k = pair_key(fresh, c);
-        while (a < old->n && pair_key(old, a) < k)
-            a++;
-        const int same = a < old->n && pair_key(old, a) == k;
-        fresh->fn[c] = same ? old->fn[a] : 0;
-        fresh->flags[c] = same ? old->flags[a] : 0;
-        if (fresh->shear)
-            fresh->fs[c] = same ? old->fs[a] : 0;
-        if (fresh->damping) {
-            fresh->dn[c] = same ? old->dn[a] : 0;
-            fresh->ds[c] = same ? old->ds[a] : 0;
-        }
-    }
-}
-
-/* ------------------------------------------------------------------ */
 /* Disc–disc force–displacement law                                    */
 /* ------------------------------------------------------------------ */
 
@@ -152,8 +69,9 @@ static inline double viscous(const struct bal_sim *s, double delta)
     return s->gamma_n * pow(delta / s->delta0, s->psi);
 }
 
-/* Candidates per chunk of the pair loop (below). */
-#define CLEAR_CHUNK 256
+/* Candidates per chunk of the pair loop (below; pairs.c sizes the per-chunk
+ * sums). */
+#define CLEAR_CHUNK BAL_PAIRS_CHUNK
 
 /* Zero the force sums of discs from..to (inclusive). */
 static inline __attribute__((always_inline)) void
@@ -232,20 +150,6 @@ void bal_par_plan(struct bal_sim *s)
         }
     }
     par->ranges = ranges;
-}
-
-enum bal_status bal_par_reserve_chunks(struct bal_sim *s)
-{
-    struct bal_par *par = &s->par;
-    const long need = chunks_of(s->pp.cap) + 1;
-    if (need <= par->chunk_cap)
-        return BAL_OK;
-    double *q = realloc(par->chunk_sums, (size_t)need * sizeof *q);
-    if (!q)
-        return BAL_ENOMEM;
-    par->chunk_sums = q;
-    par->chunk_cap = need;
-    return BAL_OK;
 }
 
 void bal_par_free(struct bal_par *par)

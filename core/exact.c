@@ -173,7 +173,7 @@ static const char *scene_path(const struct bal_sim *s)
 
 static void disc_name(const struct bal_sim *s, int slot, char *buf, size_t size)
 {
-    bal_output_disc_name(s, s->id[slot], buf, size);
+    bal_specimen_disc_name(s->scene, s->id[slot], buf, size);
 }
 
 /* Room for a disc name ("NAME" or "FILL.k") or "wall 'NAME'". */

@@ -216,7 +216,7 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
             while (bad < n - 1 && isfinite(s->x[bad] + s->y[bad]))
                 bad++;
             char name[2 * BAL_NAME_MAX];
-            bal_output_disc_name(s, s->id[bad], name, sizeof name);
+            bal_specimen_disc_name(s->scene, s->id[bad], name, sizeof name);
             return bal_error(err, BAL_EUNSTABLE,
                              "%s: disc %s: its position is not finite at step %ld (neighbour grid)",
                              s->scene->path, name, s->step);
@@ -304,7 +304,7 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
                     k += keep;
                     if (k == MAX_NEIGHBOURS + 1) {
                         char name[2 * BAL_NAME_MAX];
-                        bal_output_disc_name(s, s->id[i], name, sizeof name);
+                        bal_specimen_disc_name(s->scene, s->id[i], name, sizeof name);
                         return bal_error(err, BAL_EUNSTABLE,
                                          "%s: disc %s has more than %d neighbours within "
                                          "reach at step %ld (piled up?)",
@@ -329,7 +329,7 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
     }
     if (install(s, &s->pp, rs, count, 0, err))
         return err->code;
-    if (bal_par_reserve_chunks(s))
+    if (bal_pairs_reserve_chunks(s))
         return bal_error(err, BAL_ENOMEM, "neighbour list: out of memory for %ld pairs",
                          s->pp.cap);
 

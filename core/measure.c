@@ -84,7 +84,7 @@ double bal_measure_elastic(const struct bal_sim *s)
                 continue;
             double rmin;
             const struct bal_pair_law *L;
-            const double delta = bal_sim_overlap(s, walls, c, &rmin, &L);
+            const double delta = bal_pairs_overlap(s, walls, c, &rmin, &L);
             e += bal_measure_normal_energy(s, L, p->fn[c], delta);
             e += shear_energy(L, pair_fs(p, c));
         }
@@ -190,7 +190,7 @@ double bal_measure_probe(const struct bal_sim *s, int probe)
     case BAL_PROBE_CONTACT_FS:
     case BAL_PROBE_CONTACT_SLIDING: {
         const struct bal_pairs *list = NULL;
-        const long c = bal_sim_find_contact(s, p->a_wall, p->a, p->b_wall, p->b, &list);
+        const long c = bal_pairs_find_contact(s, p->a_wall, p->a, p->b_wall, p->b, &list);
         if (c < 0 || !(list->flags[c] & BAL_PAIR_TOUCHING))
             return 0;
         if (p->kind == BAL_PROBE_CONTACT_FN)

@@ -34,28 +34,7 @@
 
 void bal_output_disc_name(const struct bal_sim *s, int id, char *buf, size_t size)
 {
-    const struct bal_scene *sc = s->scene;
-    if (id < sc->n_discs) {
-        snprintf(buf, size, "%s", sc->discs[id].name);
-        return;
-    }
-    long k = id - sc->n_discs;
-    for (int f = 0; f < sc->n_fills; f++) {
-        if (k < sc->fills[f].n) {
-            snprintf(buf, size, "%s.%ld", sc->fills[f].name, k);
-            return;
-        }
-        k -= sc->fills[f].n;
-    }
-    for (int p = 0; p < sc->n_piles; p++) {
-        const long n = bal_sim_pile_count(&sc->piles[p]);
-        if (k < n) {
-            snprintf(buf, size, "%s.%ld", sc->piles[p].name, k);
-            return;
-        }
-        k -= n;
-    }
-    snprintf(buf, size, "?%d", id);
+    bal_specimen_disc_name(s->scene, id, buf, size);
 }
 
 void bal_output_series_header(const struct bal_sim *s, FILE *f)
@@ -424,12 +403,12 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
         for (int p = 0; p < sc->n_piles; p++) {
             const struct bal_pile_def *pd = &sc->piles[p];
             const double s0 = pd->bottom == 1 ? pd->d * (1 + pd->c) : pd->d;
-            const long rows = bal_sim_pile_rows(pd);
+            const long rows = bal_specimen_pile_rows(pd);
             fprintf(f, "%s\n    {\"name\": ", p ? "," : "");
             json_string(f, pd->name);
             fprintf(f, ", \"L\": %ld, \"rows\": %ld, \"discs\": %ld, \"d\": %.17g, \"x0\": %.17g, "
                        "\"width\": %.17g}",
-                    pd->L, rows, bal_sim_pile_count(pd), pd->d, pd->origin[0],
+                    pd->L, rows, bal_specimen_pile_count(pd), pd->d, pd->origin[0],
                     (double)(pd->L - 1) * s0 + pd->d);
         }
         fputs("\n  ]", f);

@@ -44,21 +44,6 @@
  * fewer rebuilds but more candidate pairs to test every cycle. */
 #define SKIN_SHARE_OF_RMAX 0.2
 
-/* A small, seedable generator (SplitMix64) kept in a local variable: no
- * global state, the same seed gives the same discs on every platform. */
-static uint64_t splitmix64(uint64_t *state)
-{
-    uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
-static double uniform01(uint64_t *state)
-{
-    return (double)(splitmix64(state) >> 11) * (1.0 / 9007199254740992.0);
-}
-
 static double *alloc_doubles(size_t n, int *ok)
 {
     double *p = calloc(n ? n : 1, sizeof *p);
@@ -120,14 +105,6 @@ static void add_wall(struct bal_sim *s, const char *name, double px, double py,
     w->material = material;
 }
 
-static int wall_index(const struct bal_sim *s, const char *name)
-{
-    for (int k = 0; k < s->n_walls; k++)
-        if (strcmp(s->walls[k].name, name) == 0)
-            return k;
-    return -1;
-}
-
 /* Fill the material-pair table (C&S eqs 19, 28).  Stiffnesses of two
  * different materials combine as springs in series scaled so that equal
  * materials give their own value: k = 2 k_a k_b / (k_a + k_b). */
@@ -151,151 +128,6 @@ static void build_laws(struct bal_sim *s, const struct bal_scene *sc)
     }
 }
 
-/* Discs in scene order before sorting: [disc] sections, then each [fill],
- * then each [pile]. */
-struct disc_init {
-    double *x, *y, *r, *vx, *vy, *th, *w;
-    int32_t *mat;
-    uint8_t *fixed;
-    int32_t *row;
-};
-
-/* Discs in row M of a pile (0 when the pile has no row M). */
-static long pile_row_count(const struct bal_pile_def *p, long M)
-{
-    const long n = p->L - (p->slope == 0 ? 3 : 1) * M;
-    return n > 0 ? n : 0;
-}
-
-long bal_sim_pile_rows(const struct bal_pile_def *p)
-{
-    long rows = 0;
-    while (pile_row_count(p, rows) > 0)
-        rows++;
-    return rows;
-}
-
-long bal_sim_pile_count(const struct bal_pile_def *p)
-{
-    long n = 0;
-    for (long M = 0; pile_row_count(p, M) > 0; M++)
-        n += pile_row_count(p, M);
-    return n;
-}
-
-/* Lay out a pile (struct bal_pile_def documents the rules) into the arrays
- * from index k on; returns the index after the last disc. */
-static int lay_pile(const struct bal_pile_def *p, int mat, struct disc_init *d, int k)
-{
-    const double dd = p->d, r = 0.5 * dd;
-    const double s0 = p->bottom == 1 ? dd * (1 + p->c) : dd;
-    const double s = p->bottom == 1 ? dd * fmax(1.0, 1 + p->c) : dd;
-    const double xc = p->origin[0] + r + 0.5 * (double)(p->L - 1) * s0;
-    int below = k;                   /* first disc of the previous row */
-    long n_below = 0;
-    for (long M = 0; pile_row_count(p, M) > 0; M++) {
-        const long n = pile_row_count(p, M);
-        const double spacing = M == 0 ? s0 : s;
-        double y = p->origin[1] + r;
-        if (M > 0) {
-            /* The lowest height at which no disc of this row overlaps one of
-             * the row below: touching in the hollows, exactly. */
-            y = -INFINITY;
-            for (long a = 0; a < n; a++) {
-                const double x = xc + ((double)a - 0.5 * (double)(n - 1)) * spacing;
-                for (long b = 0; b < n_below; b++) {
-                    const double dx = fabs(x - d->x[below + b]);
-                    if (dx < dd)
-                        y = fmax(y, d->y[below + b] + sqrt(dd * dd - dx * dx));
-                }
-            }
-            if (!isfinite(y))
-                y = d->y[below] + dd;
-        }
-        const int first = k;
-        for (long a = 0; a < n; a++, k++) {
-            d->x[k] = xc + ((double)a - 0.5 * (double)(n - 1)) * spacing;
-            d->y[k] = y;
-            d->r[k] = r;
-            d->mat[k] = mat;
-            d->row[k] = (int32_t)M;
-            d->fixed[k] = M == 0 && (p->bottom == 1 || a == 0 || a == n - 1);
-        }
-        below = first;
-        n_below = n;
-    }
-    return k;
-}
-
-static enum bal_status gather_discs(const struct bal_scene *sc, int n, struct disc_init *d,
-                                    struct bal_error *err)
-{
-    int ok = 1;
-    d->x = alloc_doubles((size_t)n, &ok);
-    d->y = alloc_doubles((size_t)n, &ok);
-    d->r = alloc_doubles((size_t)n, &ok);
-    d->vx = alloc_doubles((size_t)n, &ok);
-    d->vy = alloc_doubles((size_t)n, &ok);
-    d->th = alloc_doubles((size_t)n, &ok);
-    d->w = alloc_doubles((size_t)n, &ok);
-    d->mat = calloc((size_t)(n ? n : 1), sizeof *d->mat);
-    d->fixed = calloc((size_t)(n ? n : 1), sizeof *d->fixed);
-    d->row = malloc((size_t)(n ? n : 1) * sizeof *d->row);
-    if (!ok || !d->mat || !d->fixed || !d->row)
-        return bal_error(err, BAL_ENOMEM, "%s: out of memory for %d discs", sc->path, n);
-    for (int i = 0; i < n; i++)
-        d->row[i] = -1;
-    int k = 0;
-    for (int i = 0; i < sc->n_discs; i++, k++) {
-        const struct bal_disc_def *dd = &sc->discs[i];
-        d->x[k] = dd->x[0];
-        d->y[k] = dd->x[1];
-        d->r[k] = dd->r;
-        d->vx[k] = dd->v[0];
-        d->vy[k] = dd->v[1];
-        d->th[k] = dd->theta * (BAL_PI / 180);
-        d->w[k] = dd->omega;
-        d->mat[k] = bal_scene_find(sc, BAL_SEC_MATERIAL, dd->material);
-        d->fixed[k] = (uint8_t)(dd->fixed != 0);
-    }
-    for (int f = 0; f < sc->n_fills; f++) {
-        const struct bal_fill_def *fd = &sc->fills[f];
-        uint64_t rng = (uint64_t)fd->seed;
-        const int m = bal_scene_find(sc, BAL_SEC_MATERIAL, fd->material);
-        const double pitch = 2 * fd->rmax;
-        for (long q = 0; q < fd->n; q++, k++) {
-            const long row = q / fd->columns, col = q % fd->columns;
-            d->x[k] = fd->origin[0] + fd->rmax + (double)col * pitch;
-            d->y[k] = fd->origin[1] + fd->rmax + (double)row * pitch;
-            d->r[k] = fd->rmin + (fd->rmax - fd->rmin) * uniform01(&rng);
-            if (fd->vmax > 0) {
-                const double speed = fd->vmax * uniform01(&rng);
-                const double dir = 2 * BAL_PI * uniform01(&rng);
-                d->vx[k] = speed * cos(dir);
-                d->vy[k] = speed * sin(dir);
-            }
-            d->mat[k] = m;
-        }
-    }
-    for (int p = 0; p < sc->n_piles; p++)
-        k = lay_pile(&sc->piles[p], bal_scene_find(sc, BAL_SEC_MATERIAL, sc->piles[p].material), d, k);
-    return BAL_OK;
-}
-
-static void free_init(struct disc_init *d)
-{
-    free(d->x);
-    free(d->y);
-    free(d->r);
-    free(d->vx);
-    free(d->vy);
-    free(d->th);
-    free(d->w);
-    free(d->mat);
-    free(d->fixed);
-    free(d->row);
-}
-
 static enum bal_status resolve_body(const struct bal_sim *s, const struct bal_scene *sc,
                                     const char *name, int *is_wall, int *index)
 {
@@ -305,7 +137,7 @@ static enum bal_status resolve_body(const struct bal_sim *s, const struct bal_sc
         *index = s->slot[i];
         return BAL_OK;
     }
-    int k = wall_index(s, name);
+    int k = bal_walls_find(s, name);
     if (k >= 0) {
         *is_wall = 1;
         *index = k;
@@ -347,53 +179,6 @@ static double start_energy(const struct bal_sim *s, const struct bal_scene *sc)
     return e > 0 ? e : 0;
 }
 
-void bal_sim_disc_origin(const struct bal_scene *sc, int id, enum bal_disc_prop prop, char *buf,
-                         size_t size)
-{
-    /* The key of each property in a [disc], a [fill] and a [pile] section. */
-    static const char *const keys[][3] = {
-        [BAL_DISC_PLACE] = {"x", "origin", "origin"},
-        [BAL_DISC_SIZE] = {"r", "rmin", "d"},
-        [BAL_DISC_SPEED] = {"v", "vmax", "d"},
-        [BAL_DISC_SPIN] = {"omega", "vmax", "d"},
-    };
-    if (id < sc->n_discs) {
-        const struct bal_disc_def *d = &sc->discs[id];
-        const char *key = keys[prop][0];
-        const int ki = bal_scene_key_index(BAL_SEC_DISC, key);
-        const int line = ki >= 0 && d->key_line[ki] > 0 ? d->key_line[ki] : d->line;
-        snprintf(buf, size, "%s:%d: %s: disc %s", sc->path, line, key, d->name);
-        return;
-    }
-    long k = id - sc->n_discs;
-    for (int f = 0; f < sc->n_fills; f++, k -= sc->fills[f - 1].n) {
-        const struct bal_fill_def *fd = &sc->fills[f];
-        if (k >= fd->n)
-            continue;
-        const char *key = keys[prop][1];
-        const int ki = bal_scene_key_index(BAL_SEC_FILL, key);
-        const int line = ki >= 0 && fd->key_line[ki] > 0 ? fd->key_line[ki] : fd->line;
-        snprintf(buf, size, "%s:%d: %s: disc %s.%ld of [fill %s]", sc->path, line, key, fd->name,
-                 k, fd->name);
-        return;
-    }
-    for (int p = 0; p < sc->n_piles; p++) {
-        const struct bal_pile_def *pd = &sc->piles[p];
-        const long n = bal_sim_pile_count(pd);
-        if (k >= n) {
-            k -= n;
-            continue;
-        }
-        const char *key = keys[prop][2];
-        const int ki = bal_scene_key_index(BAL_SEC_PILE, key);
-        const int line = ki >= 0 && pd->key_line[ki] > 0 ? pd->key_line[ki] : pd->line;
-        snprintf(buf, size, "%s:%d: %s: disc %s.%ld of [pile %s]", sc->path, line, key, pd->name,
-                 k, pd->name);
-        return;
-    }
-    snprintf(buf, size, "%s: disc %d", sc->path, id);
-}
-
 /* Everything the run derives from a disc's data must be a finite double:
  * its mass and moment of inertia (positive, with finite inverses), its
  * kinetic energy, its weight and its share of the gravity potential, and
@@ -431,7 +216,7 @@ static enum bal_status check_derived(const struct bal_sim *s, struct bal_error *
                    "overflows a double",
             prop = BAL_DISC_PLACE;
         if (what) {
-            bal_sim_disc_origin(sc, s->id[i], prop, where, sizeof where);
+            bal_specimen_disc_origin(sc, s->id[i], prop, where, sizeof where);
             return bal_error(err, BAL_EINVAL, "%s: %s", where, what);
         }
         ek += e + spin;
@@ -457,16 +242,16 @@ static enum bal_status check_overlaps(const struct bal_sim *s, struct bal_error 
                 continue;
             double rmin;
             const struct bal_pair_law *law;
-            const double delta = bal_sim_overlap(s, walls, c, &rmin, &law);
+            const double delta = bal_pairs_overlap(s, walls, c, &rmin, &law);
             if (delta <= 1e-9 * rmin)
                 continue;
             char a[2 * BAL_NAME_MAX], b[3 * BAL_NAME_MAX];
-            bal_sim_pair_names(s, walls, c, a, sizeof a, b, sizeof b);
+            bal_pairs_names(s, walls, c, a, sizeof a, b, sizeof b);
             if (s->fixed[i]) /* name the free disc first */
                 snprintf(b, sizeof b, "disc %s", a);
             /* Where the (free) disc was placed is where the overlap was written. */
             char where[3 * BAL_NAME_MAX + 600];
-            bal_sim_disc_origin(s->scene, s->id[s->fixed[i] ? j : i], BAL_DISC_PLACE, where,
+            bal_specimen_disc_origin(s->scene, s->id[s->fixed[i] ? j : i], BAL_DISC_PLACE, where,
                                 sizeof where);
             return bal_error(err, BAL_EINVAL,
                              "%s: overlaps %s by %.6g (%.3g of the smaller radius) at the start; "
@@ -502,11 +287,7 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
     s->gamma_n = st->gamma_n;
     s->psi = st->psi;
 
-    long n_total = sc->n_discs;
-    for (int f = 0; f < sc->n_fills; f++)
-        n_total += sc->fills[f].n;
-    for (int p = 0; p < sc->n_piles; p++)
-        n_total += bal_sim_pile_count(&sc->piles[p]);
+    const long n_total = bal_specimen_count(sc);
     if (n_total > BAL_MAX_DISCS) {
         /* The generator that passes the limit, for its line. */
         long seen = sc->n_discs;
@@ -518,7 +299,7 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
                          sc->fills[f].key_line[bal_scene_key_index(BAL_SEC_FILL, "n")],
                          sc->fills[f].name);
         for (int p = 0; p < sc->n_piles && seen <= BAL_MAX_DISCS; p++)
-            if ((seen += bal_sim_pile_count(&sc->piles[p])) > BAL_MAX_DISCS)
+            if ((seen += bal_specimen_pile_count(&sc->piles[p])) > BAL_MAX_DISCS)
                 snprintf(where, sizeof where, "%s:%d: L: [pile %s]", sc->path,
                          sc->piles[p].key_line[bal_scene_key_index(BAL_SEC_PILE, "L")],
                          sc->piles[p].name);
@@ -585,9 +366,9 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
     }
 
     /* Discs, in cell order when the grid is used. */
-    struct disc_init d = {0};
-    if (gather_discs(sc, n, &d, err)) {
-        free_init(&d);
+    struct bal_specimen d = {0};
+    if (bal_specimen_generate(sc, n, &d, err)) {
+        bal_specimen_free(&d);
         bal_sim_free(s);
         return err->code;
     }
@@ -632,14 +413,14 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
     if (!ok || !s->id || !s->slot || !s->mat || !s->fixed || !s->grid.cell || !s->grid.list ||
         (sc->n_piles && !s->row) || (stress_rule && (!s->moment || !s->moment_prev)) || !s->log ||
         !s->new2old) {
-        free_init(&d);
+        bal_specimen_free(&d);
         bal_sim_free(s);
         return bal_error(err, BAL_ENOMEM, "%s: out of memory for %d discs", sc->path, n);
     }
     if (s->use_grid) {
         struct bal_cell_key *keys = malloc((size_t)n * sizeof *keys);
         if (!keys) {
-            free_init(&d);
+            bal_specimen_free(&d);
             bal_sim_free(s);
             return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
         }
@@ -666,7 +447,7 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         s->inv_m[i] = 1 / bal_mass(s, i);
         s->inv_i[i] = 1 / bal_inertia(s, i);
     }
-    free_init(&d);
+    bal_specimen_free(&d);
     s->disc_law = n > 0 ? &s->law[s->mat[0] * s->n_mat + s->mat[0]] : NULL;
     for (int i = 1; i < n && s->disc_law; i++)
         if (s->mat[i] != s->mat[0])
@@ -691,7 +472,7 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         const struct bal_material_def *m = &sc->materials[s->mat[s->slot[id]]];
         const int ki = bal_scene_key_index(BAL_SEC_MATERIAL, "kn");
         char disc[2 * BAL_NAME_MAX];
-        bal_output_disc_name(s, id, disc, sizeof disc);
+        bal_specimen_disc_name(sc, id, disc, sizeof disc);
         const double dt = s->dt; /* read before the free (fuzzing found the use after it) */
         bal_sim_free(s);
         return bal_error(err, BAL_EINVAL,
@@ -771,7 +552,7 @@ void bal_sim_set_stage(struct bal_sim *s, int stage)
         s->walls[k].omega = 0;
     }
     for (int m = 0; m < g->n_moves; m++) {
-        const int k = wall_index(s, g->moves[m].wall);
+        const int k = bal_walls_find(s, g->moves[m].wall);
         if (k < 0)
             continue; /* refused by bal_scene_validate */
         s->walls[k].v[0] = g->moves[m].v[0];
@@ -864,7 +645,7 @@ static enum bal_status check_finite(const struct bal_sim *s, struct bal_error *e
         const double e = bal_mass(s, i) * v2 + bal_inertia(s, i) * s->w[i] * s->w[i];
         if (!isfinite(s->x[i] + s->y[i] + e)) {
             char name[2 * BAL_NAME_MAX];
-            bal_output_disc_name(s, s->id[i], name, sizeof name);
+            bal_specimen_disc_name(s->scene, s->id[i], name, sizeof name);
             return bal_error(err, BAL_EUNSTABLE,
                              "%s: disc %s: its %s is not finite at step %ld (time step too "
                              "large for the stiffness, or values near the limits of a double?)",
@@ -976,21 +757,6 @@ void bal_sim_info(const struct bal_sim *s, struct bal_run_info *info)
     info->n_candidates = s->pp.n;
 }
 
-long bal_sim_find_contact(const struct bal_sim *s, int a_wall, int a, int b_wall, int b,
-                          const struct bal_pairs **list)
-{
-    if (a_wall && b_wall)
-        return -1;
-    if (a_wall || b_wall) {
-        const int disc = a_wall ? b : a, wall = a_wall ? a : b;
-        *list = &s->pw;
-        return bal_pairs_find(&s->pw, ((uint64_t)(uint32_t)disc << 32) | (uint32_t)wall);
-    }
-    const int lo = a < b ? a : b, hi = a < b ? b : a;
-    *list = &s->pp;
-    return bal_pairs_find(&s->pp, ((uint64_t)(uint32_t)lo << 32) | (uint32_t)hi);
-}
-
 int bal_sim_disc_id(const struct bal_sim *s, int i)
 {
     return s->id[i];
@@ -999,36 +765,6 @@ int bal_sim_disc_id(const struct bal_sim *s, int i)
 const char *bal_sim_wall_name(const struct bal_sim *s, int k)
 {
     return s->walls[k].name;
-}
-
-double bal_sim_overlap(const struct bal_sim *s, int walls, long c, double *rmin,
-                       const struct bal_pair_law **law)
-{
-    const struct bal_pairs *p = walls ? &s->pw : &s->pp;
-    const int i = p->i[c], j = p->j[c];
-    if (walls) {
-        double cx, cy;
-        *rmin = s->r[i];
-        *law = &s->law[s->mat[i] * s->n_mat + s->walls[j].material];
-        return s->r[i] - sqrt(bal_walls_closest(&s->walls[j], s->x[i], s->y[i], &cx, &cy));
-    }
-    *rmin = fmin(s->r[i], s->r[j]);
-    *law = &s->law[s->mat[i] * s->n_mat + s->mat[j]];
-    return s->r[i] + s->r[j] - hypot(s->x[j] - s->x[i], s->y[j] - s->y[i]);
-}
-
-void bal_sim_pair_names(const struct bal_sim *s, int walls, long c, char *a, size_t na, char *b,
-                        size_t nb)
-{
-    const struct bal_pairs *p = walls ? &s->pw : &s->pp;
-    bal_output_disc_name(s, s->id[p->i[c]], a, na);
-    if (walls) {
-        snprintf(b, nb, "wall %s", s->walls[p->j[c]].name);
-        return;
-    }
-    char d[2 * BAL_NAME_MAX];
-    bal_output_disc_name(s, s->id[p->j[c]], d, sizeof d);
-    snprintf(b, nb, "disc %s", d);
 }
 
 void bal_sim_contact_point(const struct bal_sim *s, int i, int is_wall, int j, double *px,

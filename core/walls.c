@@ -14,8 +14,9 @@
  * ends, so discs also collide with the wall's corners.  Walls are two-sided.
  */
 #include <math.h>
+#include <string.h>
 
-#include "sim.h"
+#include "walls.h"
 
 double bal_walls_closest(const struct bal_wall *w, double x, double y,
                          double *cx, double *cy)
@@ -30,6 +31,14 @@ double bal_walls_closest(const struct bal_wall *w, double x, double y,
     *cy = w->p[1] + h * w->e[1];
     const double dx = x - *cx, dy = y - *cy;
     return dx * dx + dy * dy;
+}
+
+int bal_walls_find(const struct bal_sim *s, const char *name)
+{
+    for (int k = 0; k < s->n_walls; k++)
+        if (strcmp(s->walls[k].name, name) == 0)
+            return k;
+    return -1;
 }
 
 void bal_walls_move(struct bal_sim *s)

@@ -577,11 +577,11 @@ START_TEST(scene_pile_counts)
         p.L = L;
         p.d = 0.83;
         p.slope = 0;
-        ck_assert_msg(bal_sim_pile_count(&p) == pile_n30(L), "slope 30, L = %ld: %ld discs", L,
-                      bal_sim_pile_count(&p));
+        ck_assert_msg(bal_specimen_pile_count(&p) == pile_n30(L), "slope 30, L = %ld: %ld discs", L,
+                      bal_specimen_pile_count(&p));
         p.slope = 1;
-        ck_assert_msg(bal_sim_pile_count(&p) == L * (L + 1) / 2, "slope 60, L = %ld: %ld discs", L,
-                      bal_sim_pile_count(&p));
+        ck_assert_msg(bal_specimen_pile_count(&p) == L * (L + 1) / 2, "slope 60, L = %ld: %ld discs", L,
+                      bal_specimen_pile_count(&p));
     }
 }
 END_TEST

@@ -1,0 +1,336 @@
+/*
+ * state.h — internal: the state of a simulation, struct bal_sim and its
+ * parts, with the few inline helpers that read it.  Every module of the
+ * step includes it; it has no functions of its own to call, so it sits
+ * below them all.  The behaviour lives in the modules, each with its own
+ * header (pairs.h, grid.h, contacts.h, walls.h, integrate.h, ...).  Not
+ * part of the public API; the Check tests and the benchmark include it.
+ *
+ * Layout.  Discs are struct-of-arrays in cell order: sorted along a
+ * row-major cell grid at creation and again every BAL_REORDER_EVERY
+ * rebuilds (grid.c), so that neighbours are near each other in memory.  The
+ * sums the pair loop adds to (force and moment; the dashpots' share) keep a
+ * disc's three together, so that in a packing larger than the cache the
+ * loop has fewer streams to wait on.  `id[i]` is the disc's index in scene
+ * order (discs of [disc] sections first, then those of each [fill] and
+ * [pile]: specimen.c); outputs are written in that order.  A re-sort
+ * renumbers the discs and the keys of the candidate lists with them
+ * (new2old).
+ *
+ * Contacts.  Two flat candidate lists, disc–disc and disc–wall, each sorted
+ * by key = (lo << 32) | hi (pair_key(); not stored: it is i and j).  A
+ * candidate carries the contact's history (F_n for the incremental law,
+ * F_s) in parallel arrays; a candidate whose bodies do not overlap has zero
+ * history.  When the neighbour list is rebuilt, the new candidate list is
+ * merged with the old one in one linear pass, so history survives rebuilds
+ * (pairs.c, grid.c).
+ */
+#ifndef BAL_STATE_H
+#define BAL_STATE_H
+
+#include <stdint.h>
+
+#include "ballast.h"
+
+struct bal_integrator_type; /* a law of motion: integrate.h */
+
+#define BAL_PI 3.14159265358979323846
+
+/* Contact parameters of one pair of materials (C&S eqs 16–19, 28). */
+struct bal_pair_law {
+    double kn, ks;         /* stiffnesses of the contact */
+    double tan_phi;        /* smaller tan φ_μ of the two */
+    double cohesion;       /* smaller c of the two */
+    double cn, cs;         /* dashpots β k_n, β k_s */
+    int shear;             /* 1 if tan φ_μ > 0 or c > 0: the pair has a shear force */
+};
+
+/* A candidate list with its contact history.  Flags: bit 0 touching,
+ * bit 1 sliding (|F_s| at the Coulomb limit).  The shear history (fs, ds)
+ * exists only when `shear` is set and the normal dashpot (dn) only when
+ * `damping` is: a frictionless, undamped scene carries neither, and its
+ * rebuilds do not copy them.  The disc–disc list never stores its dashpot
+ * forces (they are recomputed for reports: bal_contact_dashpots); the wall
+ * list does.  Read F_s through pair_fs(). */
+struct bal_pairs {
+    long n, cap;
+    uint8_t shear, damping; /* which optional columns exist */
+    int32_t *i, *j;        /* disc index; j: disc index or wall index; sorted by
+                            * pair_key() ascending */
+    double *fn, *fs;       /* F_n (history of the incremental law), F_s */
+    double *dn, *ds;       /* dashpot forces D_n, D_s of the last cycle */
+    uint8_t *flags;
+};
+
+static inline double pair_fs(const struct bal_pairs *p, long c) { return p->fs ? p->fs[c] : 0.0; }
+
+/* The sort key of candidate c, (i << 32) | j. */
+static inline uint64_t pair_key(const struct bal_pairs *p, long c)
+{
+    return ((uint64_t)(uint32_t)p->i[c] << 32) | (uint32_t)p->j[c];
+}
+
+#define BAL_PAIR_TOUCHING 1u
+#define BAL_PAIR_SLIDING 2u
+
+struct bal_wall {
+    char name[BAL_NAME_MAX];
+    double p[2];           /* point P */
+    double alpha;          /* direction of e, radians */
+    double e[2];           /* (cos α, sin α) */
+    double h1, h2;         /* end multipliers */
+    int material;
+    double v[2], omega;    /* current motion (from the stage) */
+    /* Resultant of the contact forces exerted by the discs on the wall,
+     * accumulated in the last cycle. */
+    double f[2];           /* F1, F2 */
+    double moment;         /* about P, counter-clockwise */
+    double fn_sum;         /* Σ F_n over its contacts */
+    double fn_s_sum;       /* Σ F_n s, s = position of the contact along e from P */
+    double disp;           /* largest displacement of any of its points since rebuild */
+    double f_prev[2], moment_prev; /* f and moment of the cycle before (energy audit) */
+};
+
+struct bal_grid {
+    double x0, y0, h;      /* origin and cell size */
+    int nx, ny;
+    long cells_cap;        /* allocated length of `start` */
+    int32_t *start;        /* nx*ny + 1 offsets into `list` */
+    int32_t *list;         /* disc indices sorted by cell */
+    int32_t *cell;         /* cell of each disc (scratch) */
+};
+
+typedef void (*bal_pair_loop_fn)(struct bal_sim *s);
+
+/* A disc's cell and its array slot, for sorting discs into cell order. */
+struct bal_cell_key {
+    long cell;
+    int32_t slot;
+};
+
+/* Scratch of a rebuild: the new candidate list (its keys), where each new
+ * pair sat in the old list, and one history column at a time while it is
+ * carried over.  About 21 bytes per candidate, instead of a second copy of
+ * the whole list. */
+struct bal_rebuild_scratch {
+    long cap;
+    long col_cap;          /* `col` may be longer: the re-sort uses it as its buffer */
+    uint64_t *key;         /* (i << 32) | j of each new pair */
+    int32_t *map;          /* position of the same pair in the old list, or -1 */
+    double *col;           /* one double column being gathered */
+    uint8_t *bytes;        /* the flags column being gathered */
+};
+
+/* How a stage ended. */
+struct bal_stage_log {
+    long cycles;           /* cycles run */
+    int stopped;           /* 1: its stop rule was met; 0: it ran all its cycles */
+    double ke_over_ee;     /* E_k / E_el at the last check (-1: never checked) */
+    double stress_change;  /* largest change of a disc's stress moment between the
+                            * last two checks, over the largest (-1: never) */
+};
+
+/* Running sums of the energy audit (energy.c), from the first cycle. */
+struct bal_audit {
+    int started;           /* the baseline has been taken */
+    int gravity;           /* the scene has gravity */
+    long start_step;       /* step of the baseline */
+    double ek0, ee0;       /* E_k and E_el at the baseline */
+    double w_walls;        /* work of the walls on the discs */
+    double w_gravity;      /* work of gravity up to the last change of g_fac */
+    double g_last;         /* Σ m g·x of the free discs at the last change of g_fac */
+    double gfac_last;      /* g_fac since then */
+    int gravity_step;      /* this cycle changes g_fac: close it after the update */
+    double d_dashpot;      /* dissipated by contact dashpots (disc pairs and walls) */
+    double d_dashpot_last; /* ... in the latest cycle */
+    double wall_dash;      /* Σ D·v_wall of the wall contacts' dashpots in this cycle */
+    double glob_sum;       /* Σ (m v_N² + I ω_N²) of this cycle (centred integrator) */
+    double dash_sum;       /* Σ (F^D·v_N + M^D ω_N) of this cycle (centred integrator) */
+    double d_friction;     /* dissipated by sliding at the Coulomb limit */
+    double d_global;       /* dissipated by global damping */
+    double d_global_last;  /* ... in the latest cycle */
+};
+
+/* A probe with its bodies resolved: kind, and for each body whether it is a
+ * wall and its array slot (disc) or wall index. */
+struct bal_probe_ref {
+    int kind;
+    int a_wall, a;
+    int b_wall, b;
+};
+
+/* Several threads in one cycle (OpenMP), with results bitwise those of one
+ * thread (contacts.c, integrate.c):
+ * - the disc–disc list is cut into ranges of whole chunks, one per thread.
+ *   Range t adds directly to the sums of the discs above zone[t], the
+ *   highest j of the ranges before it, which no earlier range touches; what
+ *   it adds to the others it logs, and the logs are replayed in range order
+ *   after the loop.  Every disc's sums thus add the same terms in the same
+ *   order as one thread going through the whole list;
+ * - the sums over candidates (the friction loss) and over discs (the audit's
+ *   sums of the velocity update) add up fixed blocks, then the blocks in
+ *   order, whatever the number of threads. */
+struct bal_sum_log {             /* what range t adds to disc k, logged */
+    double fx, fy, tq;
+    float dfx, dfy, dtq;
+    int32_t k;
+};
+struct bal_par {
+    int threads;                 /* asked for (bal_sim_set_threads); 1: serial */
+    int ranges;                  /* ranges of the current disc–disc list */
+    long planned;                /* s->rebuilds when the list was cut, -1: never */
+    long start[BAL_MAX_THREADS + 1]; /* first candidate of each range */
+    int zone[BAL_MAX_THREADS];   /* range t logs its sums for discs <= zone[t] */
+    int over[BAL_MAX_THREADS];   /* range t saw an overlap past the sieve */
+    struct bal_sum_log *log[BAL_MAX_THREADS];
+    long log_n[BAL_MAX_THREADS], log_cap[BAL_MAX_THREADS];
+    double *chunk_sums;          /* per chunk of candidates: the friction loss */
+    long chunk_cap;
+    double *block_sums;          /* per block of discs, 2 each: a pass's sums (integrate.c) */
+};
+#define BAL_DISC_BLOCK 4096          /* discs per block */
+
+/* Blocks of n discs; at least one, so that block_sums always exists. */
+static inline int bal_disc_blocks(int n)
+{
+    return n > 0 ? (n + BAL_DISC_BLOCK - 1) / BAL_DISC_BLOCK : 1;
+}
+
+/* One past the last disc of block b of n discs (its first is b BAL_DISC_BLOCK). */
+static inline int bal_block_end(int n, int b)
+{
+    const int to = (b + 1) * BAL_DISC_BLOCK;
+    return to < n ? to : n;
+}
+
+struct bal_sim {
+    const struct bal_scene *scene;
+
+    /* discs */
+    int n;
+    int32_t *id;                 /* scene-order index of array slot i */
+    int32_t *slot;               /* array slot of scene-order index */
+    double *x, *y, *th;          /* position, rotation */
+    double *vx, *vy, *w;         /* velocities at t_{N-1/2} (t_{N+1/2} after a step) */
+    double *r, *inv_m, *inv_i;   /* radius, 1/m, 1/I (m and I: bal_mass, bal_inertia) */
+    double *f;                   /* force and moment sums of the last cycle, 3 per disc:
+                                  * F_x, F_y, M (one array: one stream in the pair loop) */
+    float *dash;                 /* the dashpots' part of them, 3 per disc: x, y, moment
+                                  * (only with damping: the energy audit; float: it
+                                  * needs 1e-6, not 1e-16; one array, not three: the
+                                  * pair loop of a large packing reads fewer streams) */
+    double *x_ref, *y_ref;       /* positions at the last rebuild */
+    int32_t *mat;
+    uint8_t *fixed;
+    double r_max;
+
+    /* walls */
+    int n_walls;
+    struct bal_wall *walls;
+
+    /* materials */
+    double *density;             /* per material: mass per area */
+    int n_mat;
+    struct bal_pair_law *law;    /* n_mat × n_mat */
+    const struct bal_pair_law *disc_law; /* the law of every disc pair when all discs
+                                  * are of one material (the pair loop then reads no
+                                  * material column), else NULL */
+
+    /* contacts and neighbours */
+    struct bal_pairs pp, pw;     /* disc–disc, disc–wall candidates */
+    struct bal_par par;          /* threads */
+    struct bal_rebuild_scratch rs; /* the new list of a rebuild, one column at a time */
+    struct bal_grid grid;
+    int use_grid;
+    double skin;
+    long rebuilds;
+    int need_rebuild;
+    bal_pair_loop_fn pair_loop;
+
+    /* settings */
+    double dt, dt_estimate;
+    double start_energy;         /* E_k at the start of a scene nothing feeds (no gravity,
+                                  * no moving wall, no allowed overlap), else 0: bounds the
+                                  * power law's overlap for the estimate (timestep.c) */
+    double alpha, beta;
+    double g[2];
+    int normal_law;
+    double nu, delta0;
+    double gamma_n, psi;         /* viscous normal damping of MLH eq. (3) */
+    int has_shear;               /* any material pair with k_s and a non-zero cap */
+    int has_damping;             /* β > 0 */
+
+    /* pile rows and stresses */
+    int32_t *row;                /* row M of a pile disc, -1 otherwise; NULL without piles */
+    double *moment;              /* 4 per disc: Σ_c f ⊗ l (xx, xy, yx, yy); only with a
+                                  * stress stop rule (output allocates its own) */
+    double *moment_prev;         /* the same at the previous check of a stop rule */
+
+    /* stages */
+    double gfac;                 /* share of gravity applied now (the ramp) */
+    struct bal_stage_log *log;   /* one per stage of the scene */
+
+    /* probes */
+    int n_probes;
+    struct bal_probe_ref *probes;
+    double *row_values;          /* n_probes: a series row measured before it is written */
+    int have_old;                /* a cycle has run with a staggered integrator: the
+                                  * stored velocities are v_{N+1/2}, v_{N-1/2} can be
+                                  * recovered, measurements average them (eq. 31) */
+
+    /* law of motion (integrate.c) */
+    const struct bal_integrator_type *integ;
+    double *gear;                /* gear5 only, else NULL: BAL_GEAR_COLUMNS columns of n */
+    int gear_started;            /* gear5: the start-up derivatives are set */
+
+    /* where the time goes (wall-clock seconds per phase of the cycle) */
+    struct bal_timers {
+        double positions, neighbours, contacts, walls, velocities;
+    } timers;
+    long reorders;               /* times the discs were re-sorted into cell order */
+    int32_t *new2old;            /* n entries: the permutation of the last re-sort */
+    int reordered;               /* 1: the lists still number discs as before the re-sort */
+
+    /* energy audit and guards */
+    struct bal_audit audit;
+    double overlap_budget;       /* share of the smaller radius; INFINITY = off */
+    double overlap_sieve;        /* overlap_budget x the smallest radius of the scene */
+    int over_budget;             /* a contact loop saw an overlap beyond the budget */
+
+    /* progress */
+    long step;
+    double time;
+    int stage;
+    double wall_seconds;
+};
+
+/* Mass and moment of inertia of disc i: the same expressions as at creation
+ * (m = density π r², I = m r²/2), so they are bitwise the stored values of
+ * old; storing them would cost 16 bytes a disc. */
+static inline double bal_mass(const struct bal_sim *s, int i)
+{
+    return s->density[s->mat[i]] * BAL_PI * s->r[i] * s->r[i];
+}
+
+static inline double bal_inertia(const struct bal_sim *s, int i)
+{
+    return 0.5 * bal_mass(s, i) * s->r[i] * s->r[i];
+}
+
+/* The cell, 0 to n - 1, of a point c cell sizes from a grid's origin: the
+ * conversion to int is range-checked (a point beyond the grid, or not a
+ * number, takes the nearest edge cell; a double beyond INT_MAX converted
+ * without the check is undefined behaviour). */
+static inline int bal_cell_index(double c, int n)
+{
+    return c >= 0 ? (c < n ? (int)c : n - 1) : 0;
+}
+
+/* Squared displacement of disc i since the lists were built. */
+static inline double bal_moved_sq(const struct bal_sim *s, int i)
+{
+    const double dx = s->x[i] - s->x_ref[i], dy = s->y[i] - s->y_ref[i];
+    return dx * dx + dy * dy;
+}
+
+#endif /* BAL_STATE_H */

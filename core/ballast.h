@@ -350,8 +350,9 @@ void bal_sim_dt_detail(const struct bal_sim *sim, struct bal_dt_detail *d);
 /* Measurements                                                        */
 /* ------------------------------------------------------------------ */
 
-/* The value of one probe of the scene at the current cycle. */
-double bal_measure_probe(const struct bal_sim *sim, int probe);
+/* The value of probe k of the scene (its index in file order) at the
+ * current cycle (probes.c). */
+double bal_probes_value(const struct bal_sim *sim, int k);
 double bal_measure_kinetic(const struct bal_sim *sim);
 double bal_measure_elastic(const struct bal_sim *sim);
 /* ΔF/F of C&S Tables 1–3: largest force sum on any free disc over the

@@ -565,31 +565,9 @@ void bal_contacts_walls(struct bal_sim *s)
     s->audit.d_friction += lost_fric;
 }
 
-void bal_contact_dashpots(const struct bal_sim *s, const struct bal_pairs *p, long c,
-                          double *dn, double *ds)
+/* The viscous coefficient of MLH eq. (3) for the dashpots that reports
+ * recompute (measure.c): the loops' own expression. */
+double bal_contacts_viscous(const struct bal_sim *s, double delta)
 {
-    *dn = *ds = 0;
-    if (!(p->flags[c] & BAL_PAIR_TOUCHING))
-        return;
-    if (p != &s->pp) {
-        *dn = p->dn ? p->dn[c] : 0;
-        *ds = p->ds ? p->ds[c] : 0;
-        return;
-    }
-    if (!s->has_damping)
-        return;
-    const int i = p->i[c], j = p->j[c];
-    const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + s->mat[j]];
-    const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
-    const double dist = sqrt(dx * dx + dy * dy), ex = dx / dist, ey = dy / dist;
-    double vxi, vyi, wi, vxj, vyj, wj;
-    bal_integrate_previous(s, i, &vxi, &vyi, &wi);
-    bal_integrate_previous(s, j, &vxj, &vyj, &wj);
-    const double rvx = vxi - vxj, rvy = vyi - vyj;
-    const double ndot = rvx * ex + rvy * ey;
-    *dn = (L->cn + viscous(s, s->r[i] + s->r[j] - dist)) * ndot;
-    if (s->has_shear && L->shear && !(p->flags[c] & BAL_PAIR_SLIDING)) {
-        const double sdot = rvx * ey - rvy * ex - (wi * s->r[i] + wj * s->r[j]);
-        *ds = L->cs * sdot;
-    }
+    return viscous(s, delta);
 }

@@ -51,7 +51,7 @@ enum bal_status bal_output_series_row(const struct bal_sim *s, FILE *f, struct b
      * that is not finite stops the run before anything of the row is
      * written. */
     for (int p = 0; p < s->n_probes; p++) {
-        const double v = bal_measure_probe(s, p);
+        const double v = bal_probes_value(s, p);
         if (!isfinite(v)) {
             const struct bal_probe_def *pd = &s->scene->probes[p];
             const int ki = bal_scene_key_index(BAL_SEC_PROBE, "quantity");
@@ -127,7 +127,7 @@ static void write_contacts(const struct bal_sim *s, FILE *f)
         body_name(s, 0, i, a, sizeof a);
         body_name(s, 0, j, b, sizeof b);
         double dn, ds;
-        bal_contact_dashpots(s, &s->pp, c, &dn, &ds);
+        bal_measure_dashpots(s, &s->pp, c, &dn, &ds);
         fprintf(f, "%s\t%s\tdisc\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d\n", a,
                 b, s->x[i] + at * ex, s->y[i] + at * ey, ex, ey, s->pp.fn[c], pair_fs(&s->pp, c),
                 dn, ds, (s->pp.flags[c] & BAL_PAIR_SLIDING) != 0);

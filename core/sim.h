@@ -17,12 +17,9 @@ bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping);
 void bal_par_plan(struct bal_sim *s);
 void bal_par_free(struct bal_par *par);
 void bal_contacts_walls(struct bal_sim *s);
-/* The dashpot forces D_n, D_s of contact c of list p in the last cycle:
- * stored for walls, recomputed for disc pairs from the geometry at t_N and
- * the velocities v_{N-1/2} (recovered), exactly as the cycle computed them.
- * Zero for a contact that is not touching. */
-void bal_contact_dashpots(const struct bal_sim *s, const struct bal_pairs *p, long c,
-                          double *dn, double *ds);
+/* The coefficient γ_n (δ/δ0)^ψ of MLH eq. (3) at overlap δ, as the loops
+ * compute it (for the dashpots that measure.c recomputes). */
+double bal_contacts_viscous(const struct bal_sim *s, double delta);
 
 /* grid.c */
 enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err);
@@ -111,6 +108,12 @@ double bal_timestep_single_spring(const struct bal_sim *s);
 void bal_timestep_detail(const struct bal_sim *s, struct bal_dt_detail *d);
 
 /* measure.c */
+/* The dashpot forces D_n, D_s of contact c of list p in the last cycle:
+ * stored for walls, recomputed for disc pairs from the geometry at t_N and
+ * the velocities v_{N-1/2} (recovered), exactly as the cycle computed them.
+ * Zero for a contact that is not touching. */
+void bal_measure_dashpots(const struct bal_sim *s, const struct bal_pairs *p, long c, double *dn,
+                          double *ds);
 /* Velocities of disc i at t_N (eq. 31), recovered after a cycle. */
 void bal_measure_velocity(const struct bal_sim *s, int i, double *vx, double *vy, double *w);
 /* Per disc, Σ_c f^c ⊗ l^c over its contacts (MLH eq. 8 without 1/V), into

@@ -50,7 +50,7 @@ struct bal_pair_law {
  * exists only when `shear` is set and the normal dashpot (dn) only when
  * `damping` is: a frictionless, undamped scene carries neither, and its
  * rebuilds do not copy them.  The disc–disc list never stores its dashpot
- * forces (they are recomputed for reports: bal_contact_dashpots); the wall
+ * forces (they are recomputed for reports: bal_measure_dashpots); the wall
  * list does.  Read F_s through pair_fs(). */
 struct bal_pairs {
     long n, cap;

@@ -27,14 +27,14 @@
 static double t_dn(const struct tfx *f, const struct bal_pairs *L, long c)
 {
     double dn, ds;
-    bal_contact_dashpots(f->sim, L, c, &dn, &ds);
+    bal_measure_dashpots(f->sim, L, c, &dn, &ds);
     return dn;
 }
 
 static double t_ds(const struct tfx *f, const struct bal_pairs *L, long c)
 {
     double dn, ds;
-    bal_contact_dashpots(f->sim, L, c, &dn, &ds);
+    bal_measure_dashpots(f->sim, L, c, &dn, &ds);
     return ds;
 }
 

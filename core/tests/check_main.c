@@ -119,7 +119,7 @@ int t_probe(const struct tfx *f, const char *name)
 
 double t_probe_value(const struct tfx *f, const char *name)
 {
-    return bal_measure_probe(f->sim, t_probe(f, name));
+    return bal_probes_value(f->sim, t_probe(f, name));
 }
 
 static void resolve(const struct tfx *f, const char *name, int *is_wall, int *index)

@@ -156,7 +156,7 @@ static void simulate(struct bal_scene *sc, struct outcome *out)
     for (int k = 0; st == BAL_OK && k < 3; k++)
         st = bal_sim_step(sim, &err);
     for (int p = 0; p < sc->n_probes; p++)
-        (void)bal_measure_probe(sim, p);
+        (void)bal_probes_value(sim, p);
     (void)bal_measure_unbalanced(sim);
     bal_energy_report(sim, &out->e);
     struct bal_run_info info;

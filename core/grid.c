@@ -6,9 +6,9 @@
  * once and never rebuilt, and the step pays nothing for a grid.  With many
  * discs a cell grid finds the pairs whose gap is below a Verlet skin, and
  * the lists are rebuilt only when some disc (or wall) has moved far enough
- * to close that skin (integrate.c tracks the displacements; when the two
- * largest could have closed it, bal_grid_lists_broken looks at the discs
- * that moved most).  The cross-over
+ * to close that skin (bal_grid_due, from the displacements the position
+ * pass of integrate.c returns; when the two largest could have closed it,
+ * it looks at the discs that moved most).  The cross-over
  * BAL_GRID_CROSSOVER was measured with `make bench-grid` (see README).
  *
  * Cells are square with side 2 r_max + skin, so every candidate of a disc
@@ -415,7 +415,7 @@ static int mover_can_touch(const struct bal_sim *s, int m, double dm)
  * moved at least skin/2: those discs (the movers) lie in blocks whose
  * largest displacement is at least that, and each is checked against the
  * discs around it. */
-int bal_grid_lists_broken(const struct bal_sim *s, double d1)
+static int lists_broken(const struct bal_sim *s, double d1)
 {
     const double skin = s->skin, half_sq = 0.25 * skin * skin;
     if (d1 >= skin)
@@ -551,4 +551,23 @@ enum bal_status bal_grid_reorder(struct bal_sim *s, struct bal_error *err)
         s->reorders++;
     }
     return bal_grid_rebuild(s, err);
+}
+
+/* A pair left out of the list had a gap of at least the skin when it was
+ * built, and the gap of discs i and j closes by at most d_i + d_j <= d_1 +
+ * d_2 (the two largest displacements of distinct discs), so the list holds
+ * every contact until d_1 + d_2 reaches the skin.  (The usual 2 d_1 rebuilds
+ * twice as often when a single rattler moves.)  Then the movers are looked
+ * at one by one (lists_broken): two rattlers far apart cannot touch, and in
+ * a large packing there are always some.  A disc and a wall: d_1 + the
+ * wall's largest displacement. */
+int bal_grid_due(const struct bal_sim *s, struct bal_moves moved)
+{
+    if (!s->use_grid)
+        return 0;
+    const double d1 = sqrt(moved.d1_sq), d2 = sqrt(moved.d2_sq);
+    double wmax = 0;
+    for (int k = 0; k < s->n_walls; k++)
+        wmax = fmax(wmax, s->walls[k].disp);
+    return d1 + wmax >= s->skin || (d1 + d2 >= s->skin && lists_broken(s, d1));
 }

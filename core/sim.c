@@ -10,7 +10,7 @@
  * One calculation cycle (C&S p. 49: the force–displacement law and the law
  * of motion, alternately), cycle N:
  *
- *   1. positions   x_N = x_{N−1} + v_{N−1/2} Δt; walls move (integrate.c)
+ *   1. positions   x_N = x_{N−1} + v_{N−1/2} Δt (integrate.c); walls move
  *   2. neighbours  rebuild the candidate lists if the skin is used up (grid.c)
  *   3. contacts    force–displacement law at t_N from v_{N−1/2} (contacts.c)
  *   4. motion      v_{N+1/2} from the force sums (integrate.c)
@@ -587,8 +587,11 @@ enum bal_status bal_sim_cycle(struct bal_sim *s, struct bal_error *err)
     if (!s->audit.started)
         bal_energy_begin(s); /* the energy audit's baseline at t_0 (energy.c) */
     bal_energy_gravity_before(s);
-    /* 1. positions x_N from v_{N-1/2}; walls move */
-    bal_integrate_positions(s);
+    /* 1. positions x_N from v_{N-1/2}; walls move; are the lists still whole? */
+    const struct bal_moves moved = bal_integrate_positions(s);
+    bal_walls_move(s);
+    if (bal_grid_due(s, moved))
+        s->need_rebuild = 1;
     t1 = seconds_now();
     s->timers.positions += t1 - t0;
     /* 2. neighbours (re-sorting the discs into cell order now and then) */

@@ -23,12 +23,11 @@ double bal_contacts_viscous(const struct bal_sim *s, double delta);
 
 /* grid.c */
 enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err);
-/* Called when the two largest displacements since the last rebuild, d_1
- * >= d_2, reach the skin together: is there a pair outside the list that
- * can touch now?  1 if so (or if it cannot tell cheaply), 0 if the lists
- * still hold every contact.  Reads the displacement maxima of each block of
- * discs from par.block_sums (the position pass's). */
-int bal_grid_lists_broken(const struct bal_sim *s, double d1);
+/* Do the lists still hold every contact, after the discs moved by `moved`
+ * (the position pass's; each block's in par.block_sums) and the walls by
+ * their `disp`?  1: a rebuild is due (or the search cannot tell cheaply);
+ * always 0 without the grid, whose one list holds every pair. */
+int bal_grid_due(const struct bal_sim *s, struct bal_moves moved);
 /* Re-sort the discs into cell order of their current positions, carrying
  * every per-disc array and the probes along, then rebuild the lists (their
  * history found through the permutation). */
@@ -59,7 +58,7 @@ void bal_grid_free(struct bal_grid *g);
  * `previous` (C&S eq. 31); otherwise the stored velocities are v_N. */
 struct bal_integrator_type {
     const char *name;
-    void (*positions)(struct bal_sim *s);
+    struct bal_moves (*positions)(struct bal_sim *s);
     void (*velocities)(struct bal_sim *s);
     void (*previous)(const struct bal_sim *s, int i, double *vx, double *vy, double *w);
     int staggered;
@@ -75,8 +74,9 @@ void bal_integrate_reordered(struct bal_sim *s);
 /* Per-disc columns of gear5: scaled derivatives r2..r5 of x, y, θ (12), the
  * predicted velocities the contact law read (3), one scratch column. */
 #define BAL_GEAR_COLUMNS 16
-/* The two halves of the law of motion of s->integ (one dispatch each). */
-void bal_integrate_positions(struct bal_sim *s);
+/* The two halves of the law of motion of s->integ (one dispatch each); the
+ * first returns how far the discs have moved since the lists were built. */
+struct bal_moves bal_integrate_positions(struct bal_sim *s);
 void bal_integrate_velocities(struct bal_sim *s);
 /* The velocities of disc i that the contact law read in the last cycle:
  * centred and verlet v_{N-1/2} (recovered from the stored velocities and

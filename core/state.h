@@ -190,6 +190,14 @@ struct bal_par {
 };
 #define BAL_DISC_BLOCK 4096          /* discs per block */
 
+/* The two largest squared displacements of any disc since the lists were
+ * built, d1_sq >= d2_sq (zero without the grid): what the position pass of
+ * a cycle returns (integrate.c) and the neighbour search judges (grid.c,
+ * bal_grid_due).  Each block's are in par.block_sums. */
+struct bal_moves {
+    double d1_sq, d2_sq;
+};
+
 /* Blocks of n discs; at least one, so that block_sums always exists. */
 static inline int bal_disc_blocks(int n)
 {

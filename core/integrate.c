@@ -2,7 +2,7 @@
  * integrate.c — the law of motion, three ways, chosen per scene by
  * settings.integrator.  Each is a `struct bal_integrator_type` of two
  * halves: `positions` runs before the force evaluation of a cycle and
- * `velocities` after it (sim.c, bal_sim_cycle).  Forces include the body
+ * `velocities` after it (sim.c, the cycle).  Forces include the body
  * force m g scaled by the gravity ramp of the current stage (text after
  * C&S eq. 23a) and global damping C = α m, C* = α I (eq. 34), i.e. an
  * acceleration −α v, −α ω.  Held discs keep zero velocity and never move.

@@ -340,23 +340,22 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
     fputs(",\n  \"message\": ", f);
     json_string(f, message ? message : "");
     if (s) {
-        struct bal_run_info in;
-        bal_sim_info(s, &in);
-        fprintf(f, ",\n  \"steps\": %ld,\n  \"time\": ", in.steps);
-        json_number(f, in.time);
+        /* The counters of bal_sim_info, read from the state (output.c sits
+         * below the life cycle in sim.c, which writes series rows here). */
+        fprintf(f, ",\n  \"steps\": %ld,\n  \"time\": ", s->step);
+        json_number(f, s->time);
         fputs(",\n  \"dt\": ", f);
-        json_number(f, in.dt);
+        json_number(f, s->dt);
         fputs(",\n  \"dt_estimate\": ", f);
-        json_number(f, in.dt_estimate);
+        json_number(f, s->dt_estimate);
         fputs(",\n  \"dt_fraction\": ", f);
-        json_number(f, in.dt_fraction);
+        json_number(f, s->dt / s->dt_estimate);
         fputs(",\n  \"wall_seconds\": ", f);
-        json_number(f, in.wall_seconds);
+        json_number(f, s->wall_seconds);
         fprintf(f, ",\n  \"n_discs\": %d,\n  \"n_walls\": %d,\n  \"grid\": %s,\n"
                    "  \"rebuilds\": %ld,\n  \"candidates\": %ld,\n  \"particle_steps_per_s\": ",
-                in.n_discs, in.n_walls, in.grid_used ? "true" : "false", in.rebuilds,
-                in.n_candidates);
-        json_number(f, in.wall_seconds > 0 ? (double)in.steps * in.n_discs / in.wall_seconds : 0);
+                s->n, s->n_walls, s->use_grid ? "true" : "false", s->rebuilds, s->pp.n);
+        json_number(f, s->wall_seconds > 0 ? (double)s->step * s->n / s->wall_seconds : 0);
         fprintf(f, ",\n  \"gravity\": [%.17g, %.17g]", s->g[0], s->g[1]);
         fprintf(f, ",\n  \"threads\": %d", s->par.threads);
         fprintf(f, ",\n  \"timers\": {\"positions\": %.6g, \"neighbours\": %.6g, \"contacts\": %.6g, "

@@ -137,6 +137,5 @@ void bal_sim_contact_point(const struct bal_sim *s, int i, int is_wall, int j, d
 /* Bytes the simulation holds while it steps (every array at its allocated
  * capacity), split into what scales with discs and with candidate pairs. */
 void bal_sim_memory(const struct bal_sim *s, double *disc_bytes, double *pair_bytes);
-enum bal_status bal_sim_cycle(struct bal_sim *s, struct bal_error *err);
 
 #endif /* BAL_SIM_H */

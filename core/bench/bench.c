@@ -88,7 +88,7 @@ static double timed_steps(struct bal_sim *sim, long steps, struct bal_error *err
 {
     const double t0 = now();
     for (long k = 0; k < steps; k++)
-        if (bal_sim_cycle(sim, err))
+        if (bal_sim_step(sim, err))
             return -1;
     return now() - t0;
 }
@@ -173,7 +173,7 @@ static int prepare(const char *path, long n, const struct options *o, struct pre
     for (int g = 0; g + 1 < sc->n_stages; g++) {
         bal_sim_set_stage(sim, g);
         for (long c = 0; c < sc->stages[g].cycles; c++, p->settled++)
-            if (bal_sim_cycle(sim, &err)) {
+            if (bal_sim_step(sim, &err)) {
                 fprintf(stderr, "bench: settling: %s\n", err.msg);
                 prepared_free(p);
                 return 1;
@@ -187,7 +187,7 @@ static int prepare(const char *path, long n, const struct options *o, struct pre
     while (!o->flowing && bal_measure_kinetic(sim) > SETTLED_EK_OVER_EE * bal_measure_elastic(sim) &&
            extra < settle_blocks_cap(n) * sc->stages[0].cycles) {
         for (long c = 0; c < sc->stages[0].cycles; c++, extra++, p->settled++)
-            if (bal_sim_cycle(sim, &err)) {
+            if (bal_sim_step(sim, &err)) {
                 fprintf(stderr, "bench: settling: %s\n", err.msg);
                 prepared_free(p);
                 return 1;
@@ -518,12 +518,12 @@ static int settle_packing(const char *path, long n, double **xyt, int *n_out)
     for (int g = 0; rc == 0 && g + 1 < sc.n_stages; g++) {
         bal_sim_set_stage(ref, g);
         for (long c = 0; rc == 0 && c < sc.stages[g].cycles; c++, settle++)
-            rc = bal_sim_cycle(ref, &err) != BAL_OK;
+            rc = bal_sim_step(ref, &err) != BAL_OK;
     }
     while (rc == 0 && bal_measure_kinetic(ref) > SETTLED_EK_OVER_EE * bal_measure_elastic(ref) &&
            settle < (MAX_SETTLE_BLOCKS + 1) * sc.stages[0].cycles)
         for (long c = 0; rc == 0 && c < sc.stages[0].cycles; c++, settle++)
-            rc = bal_sim_cycle(ref, &err) != BAL_OK;
+            rc = bal_sim_step(ref, &err) != BAL_OK;
     *xyt = rc ? NULL : malloc(3 * sizeof **xyt * (size_t)ref->n);
     if (rc == 0 && *xyt == NULL) {
         snprintf(err.msg, sizeof err.msg, "out of memory");

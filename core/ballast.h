@@ -332,6 +332,17 @@ enum bal_status bal_sim_run(struct bal_sim *sim, FILE *series,
                             volatile const sig_atomic_t *stop, struct bal_error *err);
 
 void bal_sim_info(const struct bal_sim *sim, struct bal_run_info *info);
+/* Bytes the simulation holds while it steps (every array at its allocated
+ * capacity), split into what scales with discs and with candidate pairs. */
+void bal_sim_memory(const struct bal_sim *sim, double *disc_bytes, double *pair_bytes);
+/* For callers that see the simulation only through this header (the
+ * command writing the exact solver's contacts): the scene-order index of
+ * the disc in array slot i; the name of wall k; the C&S contact point of
+ * disc i with disc j, or with wall j when is_wall (as in contacts.tsv). */
+int bal_sim_disc_id(const struct bal_sim *sim, int i);
+const char *bal_sim_wall_name(const struct bal_sim *sim, int k);
+void bal_sim_contact_point(const struct bal_sim *sim, int i, int is_wall, int j, double *px,
+                           double *py);
 
 /* The critical-step estimate and how it was reached (timestep.c). */
 struct bal_dt_detail {

@@ -28,8 +28,13 @@
 #include <string.h>
 
 #include "build.h"
+#include "contacts.h"
+#include "grid.h"
+#include "pairs.h"
 #include "scene.h"
-#include "sim.h"
+#include "specimen.h"
+#include "timestep.h"
+#include "walls.h"
 
 /* Default Verlet skin as a share of the largest radius: a wider skin means
  * fewer rebuilds but more candidate pairs to test every cycle. */

@@ -42,7 +42,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sim.h"
+#include "contacts.h"
+#include "pairs.h"
+#include "walls.h"
 
 /* ------------------------------------------------------------------ */
 /* Disc–disc force–displacement law                                    */
@@ -169,7 +171,7 @@ struct range_state {
 };
 
 /* A range of the disc–disc list (all of it on one thread; see struct
- * bal_par in sim.h for several).  The loop starts the cycle's force sums.
+ * bal_par in state.h for several).  The loop starts the cycle's force sums.
  * It runs in chunks of CLEAR_CHUNK candidates; before a chunk, the sums of
  * every disc up to the chunk's highest j are zeroed (pairs are sorted by i
  * and j > i, so no disc above the highest j seen has been touched yet), the

@@ -36,7 +36,11 @@
 #include <math.h>
 #include <stdio.h>
 
-#include "sim.h"
+#include "energy.h"
+#include "integrate.h"
+#include "measure.h"
+#include "pairs.h"
+#include "specimen.h"
 
 /* Σ m g·x over the free discs (held discs do not move). */
 static double gravity_potential(const struct bal_sim *s)

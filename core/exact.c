@@ -79,6 +79,8 @@
 
 #include "exact.h"
 #include "scene.h"
+#include "specimen.h"
+#include "walls.h"
 
 /* Most solves (factorisations of K) of the whole iteration.  Phase 1 takes
  * a handful; phase 2 about one per contact it has to change. */

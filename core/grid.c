@@ -33,7 +33,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sim.h"
+#include "grid.h"
+#include "pairs.h"
+#include "specimen.h"
+#include "walls.h"
 
 /* Most candidates one disc can have in a rebuild; a disc of radius r_min
  * cannot have more non-overlapping neighbours within 2 r_max + skin.  The

@@ -74,7 +74,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sim.h"
+#include "integrate.h"
 
 /* The two largest squared displacements since the last rebuild, kept in
  * the position loops: m1 >= m2.  Written as comparisons (min/max
@@ -113,7 +113,7 @@ static struct bal_moves moved_scan(struct bal_sim *s)
 
 /* The centred passes go through the discs in blocks of BAL_DISC_BLOCK; a
  * block's sums are its own, added up block after block, so that they are
- * the same on any number of threads (struct bal_par, sim.h). */
+ * the same on any number of threads (struct bal_par, state.h). */
 
 /* Run body(s, b) for every block b, on s->par.threads threads. */
 #define FOR_BLOCKS(s, b, body)                                                          \

@@ -30,7 +30,11 @@
 #include <math.h>
 #include <string.h>
 
-#include "sim.h"
+#include "contacts.h"
+#include "integrate.h"
+#include "measure.h"
+#include "pairs.h"
+#include "walls.h"
 
 /* Velocities of disc i at t_N: the mean of v_{N-1/2} and v_{N+1/2} (eq. 31);
  * before the first cycle, the initial ones. */

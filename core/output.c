@@ -25,8 +25,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "measure.h"
 #include "scene.h"
-#include "sim.h"
+#include "specimen.h"
+#include "walls.h"
 
 #ifndef BAL_BUILD_FLAGS
 #define BAL_BUILD_FLAGS "unknown"

@@ -19,7 +19,8 @@
  */
 #include <math.h>
 
-#include "sim.h"
+#include "measure.h"
+#include "pairs.h"
 
 /* Contacts whose flags include `flag` (touching, or sliding). */
 static long count_contacts(const struct bal_sim *s, uint8_t flag)

@@ -18,7 +18,7 @@
 #define BIG DBL_MAX
 #define LBIG 2147483647.0
 /* Largest stiffness: two materials combine as 2 k_a k_b / (k_a + k_b)
- * (sim.c), whose product overflows to inf/inf = NaN above about 9e153
+ * (build.c), whose product overflows to inf/inf = NaN above about 9e153
  * (found by fuzzing: kn = 1e155 gave a NaN time step). */
 #define KBIG 1e150
 

@@ -38,8 +38,14 @@
 #include <time.h>
 
 #include "build.h"
-#include "scene.h"
-#include "sim.h"
+#include "contacts.h"
+#include "energy.h"
+#include "grid.h"
+#include "integrate.h"
+#include "measure.h"
+#include "pairs.h"
+#include "specimen.h"
+#include "walls.h"
 
 /* How often (in cycles) the run checks that the state is finite between
  * output rows.  A blown-up run is caught within this many cycles. */

@@ -89,7 +89,8 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "sim.h"
+#include "timestep.h"
+#include "walls.h"
 
 /* The estimate is this share of the bound 2/(ω (√(1+ζ²) + ζ)).  At the
  * bound itself the centred scheme is only marginally stable: its conserved

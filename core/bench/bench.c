@@ -45,7 +45,7 @@
 #include <unistd.h>
 
 #include "ballast.h"
-#include "sim.h"
+#include "state.h"
 
 #define REPEATS 5
 #define TARGET_SECONDS 2.0
@@ -164,7 +164,7 @@ static int prepare(const char *path, long n, const struct options *o, struct pre
     struct bal_sim *sim = p->sim;
     const struct bal_scene *sc = &p->sc;
     /* Settle on every core: the packing is bitwise the one a single thread
-     * settles (struct bal_par, sim.h), in less time.  Timed on one thread
+     * settles (struct bal_par, state.h), in less time.  Timed on one thread
      * (or as the caller then sets). */
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     cores = cores < 1 ? 1 : cores > BAL_MAX_THREADS ? BAL_MAX_THREADS : cores;

@@ -32,7 +32,8 @@
 #include <string.h>
 
 #include "ballast.h"
-#include "sim.h"
+#include "specimen.h"
+#include "state.h"
 
 #define FUZZ_MAX_DISCS 2000
 #define FUZZ_MAX_DISCS_ALL_PAIRS 200
@@ -170,7 +171,8 @@ static void simulate(struct bal_scene *sc, struct outcome *out)
     for (int i = 0; i < info.n_discs && i < 4; i++)
         bal_output_disc_name(sim, i, name, sizeof name);
     if (series) {
-        bal_output_series_row(sim, series);
+        struct bal_error ignored;
+        (void)bal_output_series_row(sim, series, &ignored);
         fclose(series);
     }
     bal_sim_free(sim);

@@ -1,0 +1,25 @@
+/*
+ * contacts.h — internal: the force–displacement law at every contact, and
+ * the threads that share the disc–disc loop (contacts.c).
+ */
+#ifndef BAL_CONTACTS_H
+#define BAL_CONTACTS_H
+
+#include "state.h"
+
+/* The disc–disc loop compiled for this normal law (enum bal_normal_law),
+ * with or without shear and damping; chosen once per simulation. */
+bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping);
+/* The disc–wall contacts of the cycle: their forces on the discs' sums and
+ * the resultants on the walls (after the disc–disc loop started the sums). */
+void bal_contacts_walls(struct bal_sim *s);
+/* The coefficient γ_n (δ/δ0)^ψ of MLH eq. (3) at overlap δ, as the loops
+ * compute it (for the dashpots that measure.c recomputes). */
+double bal_contacts_viscous(const struct bal_sim *s, double delta);
+
+/* Cut the disc–disc list into ranges for s->par.threads threads (the pair
+ * loop calls it after each rebuild); free what the threads hold. */
+void bal_par_plan(struct bal_sim *s);
+void bal_par_free(struct bal_par *par);
+
+#endif /* BAL_CONTACTS_H */

@@ -78,7 +78,7 @@
 #include <gsl/gsl_vector.h>
 
 #include "exact.h"
-#include "scene.h"
+#include "scene_keys.h"
 #include "specimen.h"
 #include "walls.h"
 

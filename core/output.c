@@ -26,7 +26,7 @@
 #include <string.h>
 
 #include "measure.h"
-#include "scene.h"
+#include "scene_keys.h"
 #include "specimen.h"
 #include "walls.h"
 

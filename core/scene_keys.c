@@ -11,9 +11,10 @@
  */
 #include <float.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <string.h>
 
-#include "scene.h"
+#include "scene_keys.h"
 
 #define BIG DBL_MAX
 #define LBIG 2147483647.0
@@ -224,4 +225,40 @@ const struct bal_key *bal_scene_key_at(enum bal_section_kind sec, int k)
             return &bal_scene_keys[i];
     }
     return NULL;
+}
+
+/* The key list of `ballast keys` and the README: one Markdown table per
+ * section kind. */
+void bal_scene_print_keys(FILE *out)
+{
+    static const char *const type_names[] = {"number", "integer", "two numbers", "name",
+                                             "word", "WALL v1 v2 omega"};
+    for (int k = 0; k < BAL_SEC_COUNT; k++) {
+        const struct bal_section_info *sec = &bal_scene_sections[k];
+        fprintf(out, "\n`[%s%s]` — %s\n\n", sec->name, sec->named ? " NAME" : "", sec->doc);
+        fprintf(out, "| key | type | default | range | meaning |\n|---|---|---|---|---|\n");
+        for (int i = 0;; i++) {
+            const struct bal_key *key = bal_scene_key_at((enum bal_section_kind)k, i);
+            if (!key)
+                break;
+            char range[96] = "";
+            /* A word's choices are printed whole (the probe quantities are
+             * longer than any fixed buffer kept for a numeric range). */
+            const char *shown = range;
+            if (key->type == BAL_KEY_ENUM)
+                shown = key->choices;
+            else if (key->type == BAL_KEY_DOUBLE || key->type == BAL_KEY_LONG) {
+                char lo[32] = "", hi[32] = "";
+                if (key->min > -1e300)
+                    snprintf(lo, sizeof lo, "%g", key->min);
+                if (key->max < 1e300)
+                    snprintf(hi, sizeof hi, "%g", key->max);
+                if (*lo || *hi)
+                    snprintf(range, sizeof range, "[%s, %s]", *lo ? lo : "-inf", *hi ? hi : "inf");
+            }
+            fprintf(out, "| `%s` | %s | %s | %s | %s |\n", key->name, type_names[key->type],
+                    key->def ? (*key->def ? key->def : "(none)") : (key->required ? "required" : "(none)"),
+                    shown, key->doc);
+        }
+    }
 }

@@ -187,11 +187,20 @@ struct bal_pile_def {
     BAL_SECTION_TAIL;
 };
 
+/* How a stage drives a wall: its controller (walls.c), named by the stage
+ * key that gives the wall's line. */
+enum bal_wall_control {
+    BAL_CONTROL_PRESCRIBED = 0  /* `move`: P moves with v, the wall turns about P with omega */
+};
+
+/* A stage's line for one wall: its controller and the controller's
+ * parameters, in the order its key takes them after the wall's name. */
 struct bal_move_def {
     char wall[BAL_NAME_MAX];  /* wall name */
     int line;
-    double v[2];              /* velocity of P */
-    double omega;             /* angular velocity about P, rad/time */
+    int control;              /* enum bal_wall_control (prescribed) */
+    double v[2];              /* prescribed: velocity of P */
+    double omega;             /* prescribed: angular velocity about P, rad/time */
 };
 
 struct bal_stage_def {
@@ -202,7 +211,7 @@ struct bal_stage_def {
     double stop_ke;           /* stop when E_k <= stop_ke E_el (0: off) */
     double stop_stress;       /* ... and the stresses change by <= this (0: off) */
     long check_every;         /* cycles between checks of the stop rule (100) */
-    int n_moves;
+    int n_moves;              /* walls the stage drives; the others stay at rest */
     struct bal_move_def moves[BAL_MAX_MOVES];
     BAL_SECTION_TAIL;
 };
@@ -318,7 +327,8 @@ void bal_sim_add_seconds(struct bal_sim *sim, double seconds);
  * velocities to t_{N+1/2}.  The scene must outlive the simulation. */
 enum bal_status bal_sim_step(struct bal_sim *sim, struct bal_error *err);
 
-/* Select the wall motions of stage `stage` (index into the scene's stages). */
+/* Select stage `stage` (index into the scene's stages): its walls'
+ * controllers and their parameters. */
 void bal_sim_set_stage(struct bal_sim *sim, int stage);
 /* Run the cycles on this many threads (1, the default, to BAL_MAX_THREADS;
  * OpenMP).  The results are bitwise those of one thread. */

@@ -332,7 +332,8 @@ enum bal_status bal_build_discs(struct bal_sim *s, struct bal_error *err)
 
 /* The kinetic energy at the start when nothing can feed the scene more
  * (no gravity, no wall moved in any stage, no overlap allowed at the
- * start), else 0 (no bound). */
+ * start), else 0 (no bound).  A wall that a controller other than the
+ * prescribed one drives may move. */
 static double start_energy(const struct bal_sim *s, const struct bal_scene *sc)
 {
     if (s->g[0] != 0 || s->g[1] != 0 || sc->settings.allow_overlap)
@@ -340,7 +341,8 @@ static double start_energy(const struct bal_sim *s, const struct bal_scene *sc)
     for (int g = 0; g < sc->n_stages; g++)
         for (int m = 0; m < sc->stages[g].n_moves; m++) {
             const struct bal_move_def *mv = &sc->stages[g].moves[m];
-            if (mv->v[0] != 0 || mv->v[1] != 0 || mv->omega != 0)
+            if (mv->control != BAL_CONTROL_PRESCRIBED || mv->v[0] != 0 || mv->v[1] != 0 ||
+                mv->omega != 0)
                 return 0;
         }
     double e = 0, px = 0, py = 0, m = 0;

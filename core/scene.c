@@ -238,19 +238,31 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
         snprintf(msg, sizeof msg, "expected one of {%s}, got '%s'", key->choices, value);
         return where_error(err, w, key->name, "%s", msg);
     }
-    case BAL_KEY_MOVE: {
+    case BAL_KEY_CONTROL: {
+        /* A wall's name, then as many numbers as the key's form has words
+         * after "WALL" (key->choices: "WALL v1 v2 omega"). */
+        static const char *const counts[BAL_CONTROL_VALUES_MAX + 1] = {
+            "no", "one", "two", "three", "four", "five", "six", "seven", "eight"};
         struct bal_stage_def *st = item;
-        char wall[BAL_NAME_MAX + 1];
+        int n_values = 0;
+        for (const char *c = key->choices; (c = strchr(c, ' ')) != NULL; c++)
+            n_values++;
+        double values[BAL_CONTROL_VALUES_MAX];
+        char wall[BAL_NAME_MAX + 1], msg[BAL_MSG_MAX];
         int n_read = 0;
-        if (sscanf(value, "%48s%n", wall, &n_read) != 1 || !valid_name(wall))
-            return where_error(err, w, key->name,
-                               "expected 'WALL v1 v2 omega', got '%s'", value);
+        if (sscanf(value, "%48s%n", wall, &n_read) != 1 || !valid_name(wall)) {
+            snprintf(msg, sizeof msg, "expected '%s', got '%s'", key->choices, value);
+            return where_error(err, w, key->name, "%s", msg);
+        }
         p = value + n_read;
-        if (!parse_number(&p, &v[0]) || !parse_number(&p, &v[1]) ||
-            !parse_number(&p, &v[2]) || !at_end(p))
-            return where_error(err, w, key->name,
-                               "expected 'WALL v1 v2 omega' with three finite numbers, got '%s'",
-                               value);
+        int ok = 1;
+        for (int k = 0; k < n_values && ok; k++)
+            ok = parse_number(&p, &values[k]);
+        if (!ok || !at_end(p)) {
+            snprintf(msg, sizeof msg, "expected '%s' with %s finite numbers, got '%s'",
+                     key->choices, counts[n_values], value);
+            return where_error(err, w, key->name, "%s", msg);
+        }
         /* In a file a wall is moved once per stage; --set (line 0) replaces
          * the wall's motion, so a variant can change a loading speed. */
         struct bal_move_def *m = NULL;
@@ -268,9 +280,8 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
         }
         strcpy(m->wall, wall);
         m->line = w.line;
-        m->v[0] = v[0];
-        m->v[1] = v[1];
-        m->omega = v[2];
+        m->control = bal_scene_control_of(key->name);
+        memcpy((char *)m + key->offset, values, (size_t)n_values * sizeof(double));
         return BAL_OK;
     }
     }
@@ -374,7 +385,7 @@ static enum bal_status assign(void *item, enum bal_section_kind k,
     }
     const struct bal_key *key = bal_scene_key_at(k, ki);
     uint32_t *given = bal_scene_item_given(item, k);
-    if ((*given & (1u << ki)) && key->type != BAL_KEY_MOVE && w.line > 0) {
+    if ((*given & (1u << ki)) && key->type != BAL_KEY_CONTROL && w.line > 0) {
         char first[32];
         snprintf(first, sizeof first, "%d", bal_scene_item_key_line(item, k)[ki]);
         return where_error(err, w, key_name, "given twice in this section (first on line %s)",

@@ -31,6 +31,11 @@
 #define G(field) offsetof(struct bal_stage_def, field)
 #define Q(field) offsetof(struct bal_pile_def, field)
 #define P(field) offsetof(struct bal_probe_def, field)
+#define MV(field) offsetof(struct bal_move_def, field)
+
+/* `move` stores its three numbers from v on: v[0], v[1], omega. */
+_Static_assert(offsetof(struct bal_move_def, omega) == MV(v) + 2 * sizeof(double),
+               "the numbers of `move` are consecutive doubles of struct bal_move_def");
 
 const struct bal_key bal_scene_keys[] = {
     /* [settings] */
@@ -169,7 +174,10 @@ const struct bal_key bal_scene_keys[] = {
      "... and the disc stresses change by <= this share of the largest between checks"},
     {BAL_SEC_STAGE, "check_every", BAL_KEY_LONG, G(check_every), "100", 0, 1, 1e15, NULL,
      "cycles between checks of the stop rule"},
-    {BAL_SEC_STAGE, "move", BAL_KEY_MOVE, G(moves), NULL, 0, -BIG, BIG, NULL,
+    /* A wall controller's key (walls.c; bal_scene_controls says which): its
+     * numbers go, in order, to consecutive doubles of struct bal_move_def
+     * from `offset` on. */
+    {BAL_SEC_STAGE, "move", BAL_KEY_CONTROL, MV(v), NULL, 0, -BIG, BIG, "WALL v1 v2 omega",
      "repeatable: WALL v1 v2 omega; velocity of P and angular velocity about P (C&S p. 53); "
      "walls not named are at rest; --set replaces the named wall's motion"},
 
@@ -188,6 +196,13 @@ const struct bal_key bal_scene_keys[] = {
 };
 
 const size_t bal_scene_n_keys = sizeof bal_scene_keys / sizeof bal_scene_keys[0];
+
+/* Each wall controller's stage key (a BAL_KEY_CONTROL row above). */
+const struct bal_control_key bal_scene_controls[] = {
+    {"move", BAL_CONTROL_PRESCRIBED},
+};
+
+const size_t bal_scene_n_controls = sizeof bal_scene_controls / sizeof bal_scene_controls[0];
 
 #define SEC(type) sizeof(struct type), offsetof(struct type, given), \
     offsetof(struct type, key_line)
@@ -216,6 +231,22 @@ int bal_scene_key_index(enum bal_section_kind sec, const char *name)
     return -1;
 }
 
+int bal_scene_control_of(const char *key)
+{
+    for (size_t i = 0; i < bal_scene_n_controls; i++)
+        if (strcmp(bal_scene_controls[i].key, key) == 0)
+            return bal_scene_controls[i].control;
+    return -1;
+}
+
+const char *bal_scene_control_key(int control)
+{
+    for (size_t i = 0; i < bal_scene_n_controls; i++)
+        if (bal_scene_controls[i].control == control)
+            return bal_scene_controls[i].key;
+    return NULL;
+}
+
 const struct bal_key *bal_scene_key_at(enum bal_section_kind sec, int k)
 {
     for (size_t i = 0; i < bal_scene_n_keys; i++) {
@@ -232,7 +263,7 @@ const struct bal_key *bal_scene_key_at(enum bal_section_kind sec, int k)
 void bal_scene_print_keys(FILE *out)
 {
     static const char *const type_names[] = {"number", "integer", "two numbers", "name",
-                                             "word", "WALL v1 v2 omega"};
+                                             "word", NULL};
     for (int k = 0; k < BAL_SEC_COUNT; k++) {
         const struct bal_section_info *sec = &bal_scene_sections[k];
         fprintf(out, "\n`[%s%s]` — %s\n\n", sec->name, sec->named ? " NAME" : "", sec->doc);
@@ -256,7 +287,9 @@ void bal_scene_print_keys(FILE *out)
                 if (*lo || *hi)
                     snprintf(range, sizeof range, "[%s, %s]", *lo ? lo : "-inf", *hi ? hi : "inf");
             }
-            fprintf(out, "| `%s` | %s | %s | %s | %s |\n", key->name, type_names[key->type],
+            /* A controller's key shows its form ("WALL v1 v2 omega") as its type. */
+            const char *type = key->type == BAL_KEY_CONTROL ? key->choices : type_names[key->type];
+            fprintf(out, "| `%s` | %s | %s | %s | %s |\n", key->name, type,
                     key->def ? (*key->def ? key->def : "(none)") : (key->required ? "required" : "(none)"),
                     shown, key->doc);
         }

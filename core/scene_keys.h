@@ -23,7 +23,8 @@ enum bal_key_type {
     BAL_KEY_VEC2,     /* two finite numbers */
     BAL_KEY_NAME,     /* a name of another section (resolved in validate) */
     BAL_KEY_ENUM,     /* one word of `choices` (space separated), stored as int */
-    BAL_KEY_MOVE      /* repeatable: "WALL vx vy omega" appended to a stage */
+    BAL_KEY_CONTROL   /* repeatable: a wall controller's line of a stage, "WALL" and its
+                       * numbers (struct bal_move_def; see struct bal_key) */
 };
 
 enum bal_section_kind {
@@ -39,9 +40,20 @@ struct bal_key {
     const char *def;        /* default as text; NULL = required (or empty) */
     int required;           /* 1: validate refuses a section without it */
     double min, max;        /* inclusive range for numbers */
-    const char *choices;    /* for BAL_KEY_ENUM */
+    const char *choices;    /* BAL_KEY_ENUM: the words; BAL_KEY_CONTROL: the form,
+                             * "WALL" and one word per number, which go to consecutive
+                             * doubles of struct bal_move_def from `offset` on */
     const char *doc;        /* one line for `ballast keys` and the README */
 };
+
+/* The wall controller that each BAL_KEY_CONTROL key of a stage names. */
+struct bal_control_key {
+    const char *key;        /* the stage key */
+    int control;            /* enum bal_wall_control */
+};
+
+/* Most numbers a wall controller's key takes after the wall's name. */
+#define BAL_CONTROL_VALUES_MAX 8
 
 struct bal_section_info {
     const char *name;       /* as written between the brackets */
@@ -55,10 +67,16 @@ struct bal_section_info {
 extern const struct bal_key bal_scene_keys[];
 extern const size_t bal_scene_n_keys;
 extern const struct bal_section_info bal_scene_sections[BAL_SEC_COUNT];
+extern const struct bal_control_key bal_scene_controls[];
+extern const size_t bal_scene_n_controls;
 
 /* Index of key `name` within its section kind, or -1. */
 int bal_scene_key_index(enum bal_section_kind sec, const char *name);
 /* The k-th key of a section kind (k = index within that kind). */
 const struct bal_key *bal_scene_key_at(enum bal_section_kind sec, int k);
+/* The controller a BAL_KEY_CONTROL key names, or -1; the key of a
+ * controller, or NULL. */
+int bal_scene_control_of(const char *key);
+const char *bal_scene_control_key(int control);
 
 #endif /* BAL_SCENE_KEYS_H */

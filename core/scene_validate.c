@@ -209,8 +209,9 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
         for (int m = 0; m < g->n_moves; m++) {
             int is_wall = 0;
             if (!body_exists(s, g->moves[m].wall, &is_wall) || !is_wall)
-                return bal_error(err, BAL_EINVAL, "%s:%d: move: no wall named '%s'", s->path,
-                                 g->moves[m].line, g->moves[m].wall);
+                return bal_error(err, BAL_EINVAL, "%s:%d: %s: no wall named '%s'", s->path,
+                                 g->moves[m].line, bal_scene_control_key(g->moves[m].control),
+                                 g->moves[m].wall);
         }
     }
     for (int i = 0; i < s->n_probes; i++) {

@@ -17,7 +17,8 @@
  *   2. neighbours  rebuild them if the skin is used up, now and then
  *                  re-sorting the discs into cell order (grid.c)
  *   3. contacts    force–displacement law at t_N from v_{N−1/2} (contacts.c)
- *   4. walls       the disc–wall contacts (contacts.c); their work (energy.c)
+ *   4. walls       the disc–wall contacts (contacts.c); their work (energy.c);
+ *                  each wall's controller sets its next velocity (walls.c)
  *   5. motion      v_{N+1/2} from the force sums (integrate.c)
  *   6. audit       the losses of this cycle; the overlap guard (energy.c)
  *
@@ -27,8 +28,8 @@
  * swaps them for velocity Verlet or Gear's predictor-corrector (integrate.c).
  *
  * bal_sim_run() runs the stages of the loading protocol in order (each
- * stage sets the walls' motion and the gravity ramp, and may stop early on
- * its stop rule), writes a series row every output_every cycles (output.c),
+ * stage gives its walls their controllers and sets the gravity ramp, and
+ * may stop early on its stop rule), writes a series row every output_every cycles (output.c),
  * and stops, with a status, on a signal, a state that is no longer finite
  * or an energy runaway (energy.c).
  */
@@ -110,19 +111,7 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
 
 void bal_sim_set_stage(struct bal_sim *s, int stage)
 {
-    const struct bal_stage_def *g = &s->scene->stages[stage];
-    for (int k = 0; k < s->n_walls; k++) {
-        s->walls[k].v[0] = s->walls[k].v[1] = 0;
-        s->walls[k].omega = 0;
-    }
-    for (int m = 0; m < g->n_moves; m++) {
-        const int k = bal_walls_find(s, g->moves[m].wall);
-        if (k < 0)
-            continue; /* refused by bal_scene_validate */
-        s->walls[k].v[0] = g->moves[m].v[0];
-        s->walls[k].v[1] = g->moves[m].v[1];
-        s->walls[k].omega = g->moves[m].omega;
-    }
+    bal_walls_stage(s, &s->scene->stages[stage]);
     s->stage = stage;
 }
 
@@ -173,9 +162,11 @@ static enum bal_status cycle(struct bal_sim *s, struct bal_error *err)
     s->pair_loop(s);
     t1 = seconds_now();
     s->timers.contacts += t1 - t0;
-    /* 4. walls: their contacts, the work of their motion */
+    /* 4. walls: their contacts, the work of their motion, then their
+     * controllers set the velocity of their next move */
     bal_contacts_walls(s);
     bal_energy_walls(s);
+    bal_walls_control(s);
     t0 = seconds_now();
     s->timers.walls += t0 - t1;
     /* 5. motion: v_{N+1/2} */

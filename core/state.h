@@ -32,7 +32,8 @@
 
 #include "ballast.h"
 
-struct bal_integrator_type; /* a law of motion: integrate.h */
+struct bal_integrator_type;      /* a law of motion: integrate.h */
+struct bal_wall_controller_type; /* how a stage drives a wall: walls.h */
 
 #define BAL_PI 3.14159265358979323846
 
@@ -80,7 +81,12 @@ struct bal_wall {
     double e[2];           /* (cos α, sin α) */
     double h1, h2;         /* end multipliers */
     int material;
-    double v[2], omega;    /* current motion (from the stage) */
+    double v[2], omega;    /* velocity of P and angular velocity about P for the next
+                            * move, set by its controller */
+    const struct bal_wall_controller_type *controller; /* the current stage's, or NULL:
+                            * the stage leaves the wall at rest (walls.c) */
+    const struct bal_move_def *move; /* the stage's line for the wall: the controller's
+                            * parameters (scene data), or NULL */
     /* Resultant of the contact forces exerted by the discs on the wall,
      * accumulated in the last cycle. */
     double f[2];           /* F1, F2 */
@@ -235,6 +241,8 @@ struct bal_sim {
     /* walls */
     int n_walls;
     struct bal_wall *walls;
+    int walls_controlled;        /* walls of this stage whose controller acts in every
+                                  * cycle: 0 lets a cycle skip them all (walls.c) */
 
     /* materials */
     double *density;             /* per material: mass per area */

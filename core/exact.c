@@ -3,6 +3,9 @@
  * (Matuttis, Luding & Herrmann 2000, Sec. 4.2); the interface and the
  * problem are described in exact.h.
  *
+ * Kept whole (about 870 lines): one algorithm, the active-set and damped
+ * Newton solve of one banded system, whose parts serve only each other.
+ *
  * The network.  Every candidate pair of the simulation (s->pp, s->pw) whose
  * gap is at most BAL_EXACT_TOUCH r_max (overlaps included) and that has at
  * least one free body is a contact.  Pairs of two held bodies are left out:

@@ -1,6 +1,10 @@
 /*
  * timestep.c — the critical time-step estimate.
  *
+ * Kept whole (about 670 lines, 90 of them the derivation below): one
+ * estimate — the contacts at the start, the two bounds on the network and
+ * the coordination bound — whose parts serve only each other.
+ *
  * 1. The paper's estimate (C&S p. 53), kept for comparison.  BALL estimates
  *    the critical step from a single degree of freedom, a mass m on a spring
  *    k: Δt = 2 √(m/k).  bal_timestep_single_spring() takes, for every disc,

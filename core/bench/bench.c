@@ -1,6 +1,9 @@
 /*
  * bench.c — the dense-packing benchmark behind `make bench`.
  *
+ * Kept whole (about 1000 lines): one benchmark program, whose modes share
+ * the packing, the settling, the timing and the reporting.
+ *
  * For each N it loads the benchmark scene through the ordinary scene
  * machinery (setting fill.pack.n and fill.pack.columns), runs every stage
  * but the last untimed (the packing falls and settles under gravity), then

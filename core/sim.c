@@ -56,6 +56,37 @@
  * guard costs < 0.5 %. */
 #define ENERGY_CHECK_EVERY 256
 
+/* ------------------------------------------------------------------ */
+/* Life cycle                                                          */
+/* ------------------------------------------------------------------ */
+
+enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
+                               struct bal_error *err)
+{
+    *out = NULL;
+    if (bal_scene_validate(sc, err))
+        return err->code;
+    struct bal_sim *s = calloc(1, sizeof *s);
+    if (!s)
+        return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
+    /* The state from the scene, step by step; each reads what those before
+     * it made (build.c). */
+    if (bal_build_settings(s, sc, err) ||  /* scalars; how many discs */
+        bal_build_materials(s, err) ||     /* pair laws */
+        bal_build_walls(s, err) ||         /* [wall], fill boxes, pile floors */
+        bal_build_discs(s, err) ||         /* generated, in cell order */
+        bal_build_timestep(s, err) ||      /* dt from the estimate */
+        bal_integrate_setup(s, err) ||     /* the law of motion */
+        bal_build_lists(s, err) ||         /* the first candidate lists */
+        bal_build_probes(s, err) ||        /* probe bodies */
+        bal_build_stages(s, err)) {        /* the stages' log; none begun */
+        bal_sim_free(s);
+        return err->code;
+    }
+    *out = s;
+    return BAL_OK;
+}
+
 void bal_sim_free(struct bal_sim *s)
 {
     if (!s)
@@ -88,26 +119,9 @@ void bal_sim_free(struct bal_sim *s)
     free(s);
 }
 
-enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
-                               struct bal_error *err)
-{
-    *out = NULL;
-    if (bal_scene_validate(sc, err))
-        return err->code;
-    struct bal_sim *s = calloc(1, sizeof *s);
-    if (!s)
-        return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
-    /* Each step reads what those before it made (build.c). */
-    if (bal_build_settings(s, sc, err) || bal_build_materials(s, err) ||
-        bal_build_walls(s, err) || bal_build_discs(s, err) || bal_build_timestep(s, err) ||
-        bal_integrate_setup(s, err) || bal_build_lists(s, err) || bal_build_probes(s, err) ||
-        bal_build_stages(s, err)) {
-        bal_sim_free(s);
-        return err->code;
-    }
-    *out = s;
-    return BAL_OK;
-}
+/* ------------------------------------------------------------------ */
+/* Stages and threads                                                  */
+/* ------------------------------------------------------------------ */
 
 void bal_sim_set_stage(struct bal_sim *s, int stage)
 {
@@ -124,6 +138,10 @@ enum bal_status bal_sim_set_threads(struct bal_sim *s, int threads, struct bal_e
     s->par.planned = -1; /* cut the list again */
     return BAL_OK;
 }
+
+/* ------------------------------------------------------------------ */
+/* The calculation cycle                                               */
+/* ------------------------------------------------------------------ */
 
 static double seconds_now(void)
 {
@@ -194,6 +212,10 @@ enum bal_status bal_sim_step(struct bal_sim *s, struct bal_error *err)
         bal_sim_set_stage(s, 0);
     return cycle(s, err);
 }
+
+/* ------------------------------------------------------------------ */
+/* The staged run                                                      */
+/* ------------------------------------------------------------------ */
 
 /* Is every position and velocity finite, and every disc's kinetic energy
  * (which the audit and the probes sum)?  Names the first disc that is not. */

@@ -280,7 +280,7 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
         }
         strcpy(m->wall, wall);
         m->line = w.line;
-        m->control = bal_scene_control_of(key->name);
+        m->control = bal_scene_key_control(key->name);
         memcpy((char *)m + key->offset, values, (size_t)n_values * sizeof(double));
         return BAL_OK;
     }

@@ -231,7 +231,7 @@ int bal_scene_key_index(enum bal_section_kind sec, const char *name)
     return -1;
 }
 
-int bal_scene_control_of(const char *key)
+int bal_scene_key_control(const char *key)
 {
     for (size_t i = 0; i < bal_scene_n_controls; i++)
         if (strcmp(bal_scene_controls[i].key, key) == 0)
@@ -239,7 +239,7 @@ int bal_scene_control_of(const char *key)
     return -1;
 }
 
-const char *bal_scene_control_key(int control)
+const char *bal_scene_key_for_control(int control)
 {
     for (size_t i = 0; i < bal_scene_n_controls; i++)
         if (bal_scene_controls[i].control == control)

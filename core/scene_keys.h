@@ -76,7 +76,7 @@ int bal_scene_key_index(enum bal_section_kind sec, const char *name);
 const struct bal_key *bal_scene_key_at(enum bal_section_kind sec, int k);
 /* The controller a BAL_KEY_CONTROL key names, or -1; the key of a
  * controller, or NULL. */
-int bal_scene_control_of(const char *key);
-const char *bal_scene_control_key(int control);
+int bal_scene_key_control(const char *key);
+const char *bal_scene_key_for_control(int control);
 
 #endif /* BAL_SCENE_KEYS_H */

@@ -207,11 +207,11 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
     for (int i = 0; i < s->n_stages; i++) {
         struct bal_stage_def *g = &s->stages[i];
         for (int m = 0; m < g->n_moves; m++) {
+            const struct bal_move_def *mv = &g->moves[m];
             int is_wall = 0;
-            if (!body_exists(s, g->moves[m].wall, &is_wall) || !is_wall)
+            if (!body_exists(s, mv->wall, &is_wall) || !is_wall)
                 return bal_error(err, BAL_EINVAL, "%s:%d: %s: no wall named '%s'", s->path,
-                                 g->moves[m].line, bal_scene_control_key(g->moves[m].control),
-                                 g->moves[m].wall);
+                                 mv->line, bal_scene_key_for_control(mv->control), mv->wall);
         }
     }
     for (int i = 0; i < s->n_probes; i++) {

@@ -160,9 +160,9 @@ START_TEST(scene_control_keys)
         if (key->type != BAL_KEY_CONTROL)
             continue;
         keys++;
-        const int control = bal_scene_control_of(key->name);
+        const int control = bal_scene_key_control(key->name);
         ck_assert_msg(control >= 0, "stage key %s names no controller", key->name);
-        ck_assert_str_eq(bal_scene_control_key(control), key->name);
+        ck_assert_str_eq(bal_scene_key_for_control(control), key->name);
         ck_assert_msg(strncmp(key->choices, "WALL ", 5) == 0, "%s: form '%s'", key->name,
                       key->choices);
         size_t n = 0;

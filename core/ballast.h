@@ -187,11 +187,20 @@ struct bal_pile_def {
     BAL_SECTION_TAIL;
 };
 
+/* How a stage drives a wall: its controller (walls.c), named by the stage
+ * key that gives the wall's line. */
+enum bal_wall_control {
+    BAL_CONTROL_PRESCRIBED = 0  /* `move`: P moves with v, the wall turns about P with omega */
+};
+
+/* A stage's line for one wall: its controller and the controller's
+ * parameters, in the order its key takes them after the wall's name. */
 struct bal_move_def {
     char wall[BAL_NAME_MAX];  /* wall name */
     int line;
-    double v[2];              /* velocity of P */
-    double omega;             /* angular velocity about P, rad/time */
+    int control;              /* enum bal_wall_control (prescribed) */
+    double v[2];              /* prescribed: velocity of P */
+    double omega;             /* prescribed: angular velocity about P, rad/time */
 };
 
 struct bal_stage_def {
@@ -202,7 +211,7 @@ struct bal_stage_def {
     double stop_ke;           /* stop when E_k <= stop_ke E_el (0: off) */
     double stop_stress;       /* ... and the stresses change by <= this (0: off) */
     long check_every;         /* cycles between checks of the stop rule (100) */
-    int n_moves;
+    int n_moves;              /* walls the stage drives; the others stay at rest */
     struct bal_move_def moves[BAL_MAX_MOVES];
     BAL_SECTION_TAIL;
 };
@@ -318,7 +327,8 @@ void bal_sim_add_seconds(struct bal_sim *sim, double seconds);
  * velocities to t_{N+1/2}.  The scene must outlive the simulation. */
 enum bal_status bal_sim_step(struct bal_sim *sim, struct bal_error *err);
 
-/* Select the wall motions of stage `stage` (index into the scene's stages). */
+/* Select stage `stage` (index into the scene's stages): its walls'
+ * controllers and their parameters. */
 void bal_sim_set_stage(struct bal_sim *sim, int stage);
 /* Run the cycles on this many threads (1, the default, to BAL_MAX_THREADS;
  * OpenMP).  The results are bitwise those of one thread. */
@@ -332,6 +342,17 @@ enum bal_status bal_sim_run(struct bal_sim *sim, FILE *series,
                             volatile const sig_atomic_t *stop, struct bal_error *err);
 
 void bal_sim_info(const struct bal_sim *sim, struct bal_run_info *info);
+/* Bytes the simulation holds while it steps (every array at its allocated
+ * capacity), split into what scales with discs and with candidate pairs. */
+void bal_sim_memory(const struct bal_sim *sim, double *disc_bytes, double *pair_bytes);
+/* For callers that see the simulation only through this header (the
+ * command writing the exact solver's contacts): the scene-order index of
+ * the disc in array slot i; the name of wall k; the C&S contact point of
+ * disc i with disc j, or with wall j when is_wall (as in contacts.tsv). */
+int bal_sim_disc_id(const struct bal_sim *sim, int i);
+const char *bal_sim_wall_name(const struct bal_sim *sim, int k);
+void bal_sim_contact_point(const struct bal_sim *sim, int i, int is_wall, int j, double *px,
+                           double *py);
 
 /* The critical-step estimate and how it was reached (timestep.c). */
 struct bal_dt_detail {
@@ -350,8 +371,9 @@ void bal_sim_dt_detail(const struct bal_sim *sim, struct bal_dt_detail *d);
 /* Measurements                                                        */
 /* ------------------------------------------------------------------ */
 
-/* The value of one probe of the scene at the current cycle. */
-double bal_measure_probe(const struct bal_sim *sim, int probe);
+/* The value of probe k of the scene (its index in file order) at the
+ * current cycle (probes.c). */
+double bal_probes_value(const struct bal_sim *sim, int k);
 double bal_measure_kinetic(const struct bal_sim *sim);
 double bal_measure_elastic(const struct bal_sim *sim);
 /* ΔF/F of C&S Tables 1–3: largest force sum on any free disc over the

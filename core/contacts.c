@@ -1,7 +1,7 @@
 /*
- * contacts.c — candidate lists with contact history, and the loops that run
- * the force–displacement law (the kernels of laws.h) at every contact
- * (Cundall & Strack eqs 8–19, 24–28; Matuttis, Luding & Herrmann eqs 2–3).
+ * contacts.c — the loops that run the force–displacement law (the kernels of
+ * laws.h) at every contact, over the candidate lists of pairs.c (Cundall &
+ * Strack eqs 8–19, 24–28; Matuttis, Luding & Herrmann eqs 2–3).
  *
  * For a contact between bodies x and y (x = the lower index; for a disc–wall
  * contact x is the disc and y the wall):
@@ -46,97 +46,17 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sim.h"
-
-/* ------------------------------------------------------------------ */
-/* Candidate lists                                                     */
-/* ------------------------------------------------------------------ */
-
-static int grow_array(void **a, size_t cap, size_t size)
-{
-    void *q = realloc(*a, cap * size);
-    if (!q)
-        return 0;
-    *a = q;
-    return 1;
-}
-
-enum bal_status bal_pairs_reserve(struct bal_pairs *p, long cap)
-{
-    if (cap <= p->cap)
-        return BAL_OK;
-    const size_t c = (size_t)cap;
-    int ok = grow_array((void **)&p->i, c, sizeof *p->i) &&
-             grow_array((void **)&p->j, c, sizeof *p->j) &&
-             grow_array((void **)&p->fn, c, sizeof *p->fn) &&
-             grow_array((void **)&p->flags, c, sizeof *p->flags);
-    if (ok && p->shear)
-        ok = grow_array((void **)&p->fs, c, sizeof *p->fs);
-    if (ok && p->damping)
-        ok = grow_array((void **)&p->dn, c, sizeof *p->dn) &&
-             grow_array((void **)&p->ds, c, sizeof *p->ds);
-    if (!ok)
-        return BAL_ENOMEM;
-    p->cap = cap;
-    return BAL_OK;
-}
-
-void bal_pairs_free(struct bal_pairs *p)
-{
-    const uint8_t shear = p->shear, damping = p->damping;
-    free(p->i);
-    free(p->j);
-    free(p->fn);
-    free(p->fs);
-    free(p->dn);
-    free(p->ds);
-    free(p->flags);
-    memset(p, 0, sizeof *p);
-    p->shear = shear;
-    p->damping = damping;
-}
-
-long bal_pairs_find(const struct bal_pairs *p, uint64_t key)
-{
-    long lo = 0, hi = p->n;
-    while (lo < hi) {
-        const long mid = lo + (hi - lo) / 2;
-        if (pair_key(p, mid) < key)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < p->n && pair_key(p, lo) == key ? lo : -1;
-}
-
-/* Copy the history of every contact of `old` whose key is also in `fresh`.
- * Both lists are sorted by key, so one linear pass suffices.  Contacts of
- * `fresh` that are new start with zero history. */
-void bal_pairs_merge_history(struct bal_pairs *fresh, const struct bal_pairs *old)
-{
-    long a = 0;
-    for (long c = 0; c < fresh->n; c++) {
-        const uint64_t k = pair_key(fresh, c);
-        while (a < old->n && pair_key(old, a) < k)
-            a++;
-        const int same = a < old->n && pair_key(old, a) == k;
-        fresh->fn[c] = same ? old->fn[a] : 0;
-        fresh->flags[c] = same ? old->flags[a] : 0;
-        if (fresh->shear)
-            fresh->fs[c] = same ? old->fs[a] : 0;
-        if (fresh->damping) {
-            fresh->dn[c] = same ? old->dn[a] : 0;
-            fresh->ds[c] = same ? old->ds[a] : 0;
-        }
-    }
-}
+#include "contacts.h"
+#include "pairs.h"
+#include "walls.h"
 
 /* ------------------------------------------------------------------ */
 /* Disc–disc force–displacement law                                    */
 /* ------------------------------------------------------------------ */
 
-/* Candidates per chunk of the pair loop (below). */
-#define CLEAR_CHUNK 256
+/* Candidates per chunk of the pair loop (below; pairs.c sizes the per-chunk
+ * sums). */
+#define CLEAR_CHUNK BAL_PAIRS_CHUNK
 
 /* Zero the force sums of discs from..to (inclusive). */
 static inline __attribute__((always_inline)) void
@@ -217,20 +137,6 @@ void bal_par_plan(struct bal_sim *s)
     par->ranges = ranges;
 }
 
-enum bal_status bal_par_reserve_chunks(struct bal_sim *s)
-{
-    struct bal_par *par = &s->par;
-    const long need = chunks_of(s->pp.cap) + 1;
-    if (need <= par->chunk_cap)
-        return BAL_OK;
-    double *q = realloc(par->chunk_sums, (size_t)need * sizeof *q);
-    if (!q)
-        return BAL_ENOMEM;
-    par->chunk_sums = q;
-    par->chunk_cap = need;
-    return BAL_OK;
-}
-
 void bal_par_free(struct bal_par *par)
 {
     for (int t = 0; t < BAL_MAX_THREADS; t++)
@@ -248,7 +154,7 @@ struct range_state {
 };
 
 /* A range of the disc–disc list (all of it on one thread; see struct
- * bal_par in sim.h for several).  The loop starts the cycle's force sums.
+ * bal_par in state.h for several).  The loop starts the cycle's force sums.
  * It runs in chunks of CLEAR_CHUNK candidates; before a chunk, the sums of
  * every disc up to the chunk's highest j are zeroed (pairs are sorted by i
  * and j > i, so no disc above the highest j seen has been touched yet), the
@@ -280,7 +186,7 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
     float *restrict dsh = s->dash;
     /* The chain's parameters, read once: the kernels (laws.h) take them in
      * registers. */
-    const struct bal_law_params P = {s->normal_law, s->nu, s->delta0, s->gamma_n, s->psi, s->dt};
+    const struct bal_law_params P = bal_law_params_of(s);
     const int n_mat = s->n_mat;
     const struct bal_pair_law *restrict laws = s->law;
     const struct bal_pair_law *restrict one_law = s->disc_law;
@@ -546,7 +452,7 @@ bal_pair_loop_fn bal_contacts_select(int shear, int damping)
 void bal_contacts_walls(struct bal_sim *s)
 {
     struct bal_pairs *p = &s->pw;
-    const struct bal_law_params P = {s->normal_law, s->nu, s->delta0, s->gamma_n, s->psi, s->dt};
+    const struct bal_law_params P = bal_law_params_of(s);
     for (int k = 0; k < s->n_walls; k++) {
         struct bal_wall *W = &s->walls[k];
         W->f[0] = W->f[1] = W->moment = W->fn_sum = W->fn_s_sum = 0;
@@ -624,36 +530,4 @@ void bal_contacts_walls(struct bal_sim *s)
     }
     s->audit.wall_dash = wall_dash;
     s->audit.d_friction += lost_fric;
-}
-
-void bal_contact_dashpots(const struct bal_sim *s, const struct bal_pairs *p, long c,
-                          double *dn, double *ds)
-{
-    *dn = *ds = 0;
-    if (!(p->flags[c] & BAL_PAIR_TOUCHING))
-        return;
-    if (p != &s->pp) {
-        *dn = p->dn ? p->dn[c] : 0;
-        *ds = p->ds ? p->ds[c] : 0;
-        return;
-    }
-    if (!s->has_damping)
-        return;
-    const int i = p->i[c], j = p->j[c];
-    const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + s->mat[j]];
-    const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
-    const double dist = sqrt(dx * dx + dy * dy), ex = dx / dist, ey = dy / dist;
-    double vxi, vyi, wi, vxj, vyj, wj;
-    bal_integrate_previous(s, i, &vxi, &vyi, &wi);
-    bal_integrate_previous(s, j, &vxj, &vyj, &wj);
-    const double rvx = vxi - vxj, rvy = vyi - vyj;
-    const struct bal_law_params P = {s->normal_law, s->nu, s->delta0, s->gamma_n, s->psi, s->dt};
-    struct bal_kin k;
-    k.ndot = rvx * ex + rvy * ey;
-    k.delta = s->r[i] + s->r[j] - dist;
-    *dn = bal_law_normal_dashpot(&P, L, &k);
-    if (s->has_shear && L->shear && !(p->flags[c] & BAL_PAIR_SLIDING)) {
-        k.sdot = rvx * ey - rvy * ex - (wi * s->r[i] + wj * s->r[j]);
-        *ds = bal_law_shear_dashpot(L, &k);
-    }
 }

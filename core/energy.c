@@ -36,7 +36,11 @@
 #include <math.h>
 #include <stdio.h>
 
-#include "sim.h"
+#include "energy.h"
+#include "integrate.h"
+#include "measure.h"
+#include "pairs.h"
+#include "specimen.h"
 
 /* Σ m g·x over the free discs (held discs do not move). */
 static double gravity_potential(const struct bal_sim *s)
@@ -79,7 +83,7 @@ static double start_elastic(const struct bal_sim *s)
         for (long c = 0; c < p->n; c++) {
             double rmin;
             const struct bal_pair_law *law;
-            const double delta = bal_sim_overlap(s, walls, c, &rmin, &law);
+            const double delta = bal_pairs_overlap(s, walls, c, &rmin, &law);
             if (delta > 0)
                 e += bal_measure_normal_energy(s, law, 0, delta);
         }
@@ -247,7 +251,7 @@ static enum bal_status audit_not_finite(const struct bal_sim *s, const struct ba
         if (s->fixed[i] || isfinite(bal_mass(s, i) * (s->g[0] * s->x[i] + s->g[1] * s->y[i])))
             continue;
         char name[2 * BAL_NAME_MAX];
-        bal_output_disc_name(s, s->id[i], name, sizeof name);
+        bal_specimen_disc_name(s->scene, s->id[i], name, sizeof name);
         return bal_error(err, BAL_EUNSTABLE,
                          "%s: disc %s: its gravity potential m g.x is not finite at step %ld "
                          "(gravity or position near the limits of a double?)",
@@ -260,12 +264,12 @@ static enum bal_status audit_not_finite(const struct bal_sim *s, const struct ba
                 continue;
             double rmin;
             const struct bal_pair_law *L;
-            const double delta = bal_sim_overlap(s, walls, c, &rmin, &L);
+            const double delta = bal_pairs_overlap(s, walls, c, &rmin, &L);
             const double fs = pair_fs(p, c);
             if (isfinite(bal_measure_normal_energy(s, L, p->fn[c], delta) + fs * fs / L->ks))
                 continue;
             char a[2 * BAL_NAME_MAX], b[3 * BAL_NAME_MAX];
-            bal_sim_pair_names(s, walls, c, a, sizeof a, b, sizeof b);
+            bal_pairs_names(s, walls, c, a, sizeof a, b, sizeof b);
             return bal_error(err, BAL_EUNSTABLE,
                              "%s: the energy stored in the contact of disc %s and %s is not "
                              "finite at step %ld (force %g: stiffness or load near the limits "
@@ -323,7 +327,7 @@ enum bal_status bal_energy_overlap(const struct bal_sim *s, struct bal_error *er
         for (long c = 0; c < p->n; c++) {
             double rmin;
             const struct bal_pair_law *law;
-            const double delta = bal_sim_overlap(s, walls, c, &rmin, &law);
+            const double delta = bal_pairs_overlap(s, walls, c, &rmin, &law);
             if (delta / rmin > worst) {
                 worst = delta / rmin;
                 share = delta;
@@ -335,7 +339,7 @@ enum bal_status bal_energy_overlap(const struct bal_sim *s, struct bal_error *er
     if (wc < 0 || worst <= budget)
         return BAL_OK; /* only the sieve was passed: no pair is beyond its own budget */
     char a[2 * BAL_NAME_MAX], b[3 * BAL_NAME_MAX];
-    bal_sim_pair_names(s, wall, wc, a, sizeof a, b, sizeof b);
+    bal_pairs_names(s, wall, wc, a, sizeof a, b, sizeof b);
     return bal_error(err, BAL_EUNSTABLE,
                      "%s: overlap beyond the budget at step %ld: disc %s and %s overlap by %.6g, "
                      "%.3g of the smaller radius (limit %g, settings.overlap_budget) "

@@ -3,6 +3,9 @@
  * (Matuttis, Luding & Herrmann 2000, Sec. 4.2); the interface and the
  * problem are described in exact.h.
  *
+ * Kept whole (about 870 lines): one algorithm, the active-set and damped
+ * Newton solve of one banded system, whose parts serve only each other.
+ *
  * The network.  Every candidate pair of the simulation (s->pp, s->pw) whose
  * gap is at most BAL_EXACT_TOUCH r_max (overlaps included) and that has at
  * least one free body is a contact.  Pairs of two held bodies are left out:
@@ -78,7 +81,9 @@
 #include <gsl/gsl_vector.h>
 
 #include "exact.h"
-#include "scene.h"
+#include "scene_keys.h"
+#include "specimen.h"
+#include "walls.h"
 
 /* Most solves (factorisations of K) of the whole iteration.  Phase 1 takes
  * a handful; phase 2 about one per contact it has to change. */
@@ -173,7 +178,7 @@ static const char *scene_path(const struct bal_sim *s)
 
 static void disc_name(const struct bal_sim *s, int slot, char *buf, size_t size)
 {
-    bal_output_disc_name(s, s->id[slot], buf, size);
+    bal_specimen_disc_name(s->scene, s->id[slot], buf, size);
 }
 
 /* Room for a disc name ("NAME" or "FILL.k") or "wall 'NAME'". */

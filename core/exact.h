@@ -33,7 +33,7 @@
 
 #include <stdint.h>
 
-#include "sim.h"
+#include "state.h"
 
 /* Two bodies count as touching in the reference lattice when their gap is
  * at most this share of the largest radius: lattices built from decimal

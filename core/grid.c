@@ -6,9 +6,9 @@
  * once and never rebuilt, and the step pays nothing for a grid.  With many
  * discs a cell grid finds the pairs whose gap is below a Verlet skin, and
  * the lists are rebuilt only when some disc (or wall) has moved far enough
- * to close that skin (integrate.c tracks the displacements; when the two
- * largest could have closed it, bal_grid_lists_broken looks at the discs
- * that moved most).  The cross-over
+ * to close that skin (bal_grid_due, from the displacements the position
+ * pass of integrate.c returns; when the two largest could have closed it,
+ * it looks at the discs that moved most).  The cross-over
  * BAL_GRID_CROSSOVER was measured with `make bench-grid` (see README).
  *
  * Cells are square with side 2 r_max + skin, so every candidate of a disc
@@ -33,7 +33,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sim.h"
+#include "grid.h"
+#include "pairs.h"
+#include "specimen.h"
+#include "walls.h"
 
 /* Most candidates one disc can have in a rebuild; a disc of radius r_min
  * cannot have more non-overlapping neighbours within 2 r_max + skin.  The
@@ -216,7 +219,7 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
             while (bad < n - 1 && isfinite(s->x[bad] + s->y[bad]))
                 bad++;
             char name[2 * BAL_NAME_MAX];
-            bal_output_disc_name(s, s->id[bad], name, sizeof name);
+            bal_specimen_disc_name(s->scene, s->id[bad], name, sizeof name);
             return bal_error(err, BAL_EUNSTABLE,
                              "%s: disc %s: its position is not finite at step %ld (neighbour grid)",
                              s->scene->path, name, s->step);
@@ -304,7 +307,7 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
                     k += keep;
                     if (k == MAX_NEIGHBOURS + 1) {
                         char name[2 * BAL_NAME_MAX];
-                        bal_output_disc_name(s, s->id[i], name, sizeof name);
+                        bal_specimen_disc_name(s->scene, s->id[i], name, sizeof name);
                         return bal_error(err, BAL_EUNSTABLE,
                                          "%s: disc %s has more than %d neighbours within "
                                          "reach at step %ld (piled up?)",
@@ -329,7 +332,7 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
     }
     if (install(s, &s->pp, rs, count, 0, err))
         return err->code;
-    if (bal_par_reserve_chunks(s))
+    if (bal_pairs_reserve_chunks(s))
         return bal_error(err, BAL_ENOMEM, "neighbour list: out of memory for %ld pairs",
                          s->pp.cap);
 
@@ -415,7 +418,7 @@ static int mover_can_touch(const struct bal_sim *s, int m, double dm)
  * moved at least skin/2: those discs (the movers) lie in blocks whose
  * largest displacement is at least that, and each is checked against the
  * discs around it. */
-int bal_grid_lists_broken(const struct bal_sim *s, double d1)
+static int lists_broken(const struct bal_sim *s, double d1)
 {
     const double skin = s->skin, half_sq = 0.25 * skin * skin;
     if (d1 >= skin)
@@ -551,4 +554,23 @@ enum bal_status bal_grid_reorder(struct bal_sim *s, struct bal_error *err)
         s->reorders++;
     }
     return bal_grid_rebuild(s, err);
+}
+
+/* A pair left out of the list had a gap of at least the skin when it was
+ * built, and the gap of discs i and j closes by at most d_i + d_j <= d_1 +
+ * d_2 (the two largest displacements of distinct discs), so the list holds
+ * every contact until d_1 + d_2 reaches the skin.  (The usual 2 d_1 rebuilds
+ * twice as often when a single rattler moves.)  Then the movers are looked
+ * at one by one (lists_broken): two rattlers far apart cannot touch, and in
+ * a large packing there are always some.  A disc and a wall: d_1 + the
+ * wall's largest displacement. */
+int bal_grid_due(const struct bal_sim *s, struct bal_moves moved)
+{
+    if (!s->use_grid)
+        return 0;
+    const double d1 = sqrt(moved.d1_sq), d2 = sqrt(moved.d2_sq);
+    double wmax = 0;
+    for (int k = 0; k < s->n_walls; k++)
+        wmax = fmax(wmax, s->walls[k].disp);
+    return d1 + wmax >= s->skin || (d1 + d2 >= s->skin && lists_broken(s, d1));
 }

@@ -2,7 +2,7 @@
  * integrate.c — the law of motion, three ways, chosen per scene by
  * settings.integrator.  Each is a `struct bal_integrator_type` of two
  * halves: `positions` runs before the force evaluation of a cycle and
- * `velocities` after it (sim.c, bal_sim_cycle).  Forces include the body
+ * `velocities` after it (sim.c, the cycle).  Forces include the body
  * force m g scaled by the gravity ramp of the current stage (text after
  * C&S eq. 23a) and global damping C = α m, C* = α I (eq. 34), i.e. an
  * acceleration −α v, −α ω.  Held discs keep zero velocity and never move.
@@ -65,14 +65,16 @@
  * predicted positions; the stored positions and velocities after a cycle
  * are the corrected ones.  The derivative columns exist only for gear5.
  *
- * The position updates also track how far any disc has moved since the
- * neighbour list was built, which decides when it is rebuilt (grid.c).
+ * The position passes also track how far any disc has moved since the
+ * neighbour lists were built, and return the two largest displacements
+ * (each block's in par.block_sums): the cycle asks the neighbour search
+ * whether the lists still hold (grid.c, bal_grid_due).
  */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "sim.h"
+#include "integrate.h"
 
 /* The two largest squared displacements since the last rebuild, kept in
  * the position loops: m1 >= m2.  Written as comparisons (min/max
@@ -86,33 +88,9 @@ static inline void track_moves(double d2, double *m1, double *m2)
 
 static inline int blocks_of(const struct bal_sim *s) { return s->n > 0 ? bal_disc_blocks(s->n) : 0; }
 
-/* After the positions moved, with m1 >= m2 the two largest squared
- * displacements of any disc since the lists were built (and each block's
- * in par.block_sums): walls move; decide whether to rebuild.  A pair left
- * out of the list had a gap of at least the skin when it was built, and
- * the gap of discs i and j closes by at most d_i + d_j <= d_1 + d_2 (the
- * two largest displacements of distinct discs), so the list holds every
- * contact until d_1 + d_2 reaches the skin.  (The usual 2 d_1 rebuilds
- * twice as often when a single rattler moves.)  Then the movers are looked
- * at one by one (grid.c): two rattlers far apart cannot touch, and in a
- * large packing there are always some.  A disc and a wall: d_1 + the
- * wall's largest displacement. */
-static void moved(struct bal_sim *s, double m1, double m2)
-{
-    bal_walls_move(s);
-    if (!s->use_grid)
-        return;
-    const double d1 = sqrt(m1), d2 = sqrt(m2);
-    double wmax = 0;
-    for (int k = 0; k < s->n_walls; k++)
-        wmax = fmax(wmax, s->walls[k].disp);
-    if (d1 + wmax >= s->skin || (d1 + d2 >= s->skin && bal_grid_lists_broken(s, d1)))
-        s->need_rebuild = 1;
-}
-
 /* The two largest squared displacements, in a pass of their own (verlet and
  * gear5; centred keeps them in its position loop), and each block's. */
-static void moved_scan(struct bal_sim *s)
+static struct bal_moves moved_scan(struct bal_sim *s)
 {
     double m1 = 0, m2 = 0;
     if (s->use_grid)
@@ -126,7 +104,7 @@ static void moved_scan(struct bal_sim *s)
             track_moves(b1, &m1, &m2);
             track_moves(b2, &m1, &m2);
         }
-    moved(s, m1, m2);
+    return (struct bal_moves){m1, m2};
 }
 
 /* ------------------------------------------------------------------ */
@@ -135,7 +113,7 @@ static void moved_scan(struct bal_sim *s)
 
 /* The centred passes go through the discs in blocks of BAL_DISC_BLOCK; a
  * block's sums are its own, added up block after block, so that they are
- * the same on any number of threads (struct bal_par, sim.h). */
+ * the same on any number of threads (struct bal_par, state.h). */
 
 /* Run body(s, b) for every block b, on s->par.threads threads. */
 #define FOR_BLOCKS(s, b, body)                                                          \
@@ -182,7 +160,7 @@ static void centred_positions_block(struct bal_sim *s, int b)
     s->par.block_sums[2 * b + 1] = m2;
 }
 
-static void centred_positions(struct bal_sim *s)
+static struct bal_moves centred_positions(struct bal_sim *s)
 {
     FOR_BLOCKS(s, b, centred_positions_block(s, b));
     /* the two largest of all: the same whatever the blocks */
@@ -191,7 +169,7 @@ static void centred_positions(struct bal_sim *s)
         track_moves(s->par.block_sums[2 * b], &m1, &m2);
         track_moves(s->par.block_sums[2 * b + 1], &m1, &m2);
     }
-    moved(s, m1, m2);
+    return (struct bal_moves){m1, m2};
 }
 
 static void centred_previous(const struct bal_sim *s, int i, double *vx, double *vy, double *w)
@@ -290,7 +268,7 @@ static void centred_velocities(struct bal_sim *s)
 /* ------------------------------------------------------------------ */
 
 /* First half kick with the force sums of the last cycle, then the drift. */
-static void verlet_positions(struct bal_sim *s)
+static struct bal_moves verlet_positions(struct bal_sim *s)
 {
     const int n = s->n;
     const double dt = s->dt, hdt = dt / 2;
@@ -311,7 +289,7 @@ static void verlet_positions(struct bal_sim *s)
         y[i] += vy[i] * dt;
         th[i] += w[i] * dt;
     }
-    moved_scan(s);
+    return moved_scan(s);
 }
 
 /* Second half kick with the force sums of this cycle. */
@@ -408,7 +386,7 @@ static void gear_start(struct bal_sim *s)
     s->gear_started = 1;
 }
 
-static void gear_positions(struct bal_sim *s)
+static struct bal_moves gear_positions(struct bal_sim *s)
 {
     if (!s->gear_started)
         gear_start(s);
@@ -428,7 +406,7 @@ static void gear_positions(struct bal_sim *s)
             vp[i] = vk[i];
         }
     }
-    moved_scan(s);
+    return moved_scan(s);
 }
 
 static void gear_velocities(struct bal_sim *s)
@@ -472,7 +450,7 @@ static const struct bal_integrator_type integrators[] = {
     [BAL_INTEGRATOR_GEAR5] = {"gear5", gear_positions, gear_velocities, gear_previous, 0},
 };
 
-void bal_integrate_positions(struct bal_sim *s) { s->integ->positions(s); }
+struct bal_moves bal_integrate_positions(struct bal_sim *s) { return s->integ->positions(s); }
 
 void bal_integrate_velocities(struct bal_sim *s) { s->integ->velocities(s); }
 

@@ -24,7 +24,7 @@
  *
  * Adding a sub-model: one kernel here (with the stored energy of its spring,
  * if it has one, for the audit), one history column in struct bal_pairs
- * (sim.h) with its reserve/merge lines (contacts.c), and one switch: a flag
+ * (state.h) with its reserve/merge lines (pairs.c), and one switch: a flag
  * the disc–disc loop is specialised on (PAIR_VARIANT in contacts.c) and the
  * disc–wall loop tests.
  *

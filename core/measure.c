@@ -1,26 +1,26 @@
 /*
- * measure.c — what a run reports: probes of contacts, walls and discs, the
- * energies, and the unbalanced-force ratio of Cundall & Strack Tables 1–3.
+ * measure.c — what a run reports of its state: velocities at t_N, the
+ * energies, the dashpot forces, the unbalanced-force ratio of Cundall &
+ * Strack Tables 1–3 and the stress moments of each disc.  The scene's
+ * [probe] columns are read from here and from the energy audit (probes.c).
  *
  * Measurements are taken after a cycle N: forces, positions and contact
  * histories are those of t_N; velocities are centred at t_N as the mean of
  * v_{N−1/2} and v_{N+1/2} (C&S eq. 31), which the run keeps for the cycles
  * it reports.
  *
- * Wall resultants (Table 1): F1, F2 are the components of the force the
- * discs exert on the wall; the moment is about P, counter-clockwise; the
- * eccentricity e/(L/2) is the distance, along the wall, from the wall's
- * centre to the point where the resultant normal force acts, divided by
- * half the wall length (footnote 1 of Table 1).
- *
  * Stress (MLH Sec. 3, eq. 8): σ_αβ = (1/V) Σ_c f_α^c l_β^c.  Per disc the
  * sum runs over its contacts, f^c the force on the disc (elastic plus
  * dashpot), l^c from its centre to the contact point (the middle of the
  * overlap; for a wall, halfway between the disc surface and the wall), and
  * V = 2 sqrt(3) r², the hexagonal cell of a disc in a triangular packing of
- * its own size.  Held discs and walls bear the reactions.  Probes held_fx,
- * held_fy sum the contact forces on held discs; weight_x, weight_y the
- * gravity on the free ones (with the current ramp).
+ * its own size.  Held discs and walls bear the reactions.
+ *
+ * Dashpot forces of the last cycle: the disc–wall list stores them; the
+ * disc–disc loop does not (16 bytes a candidate), so reports recompute them
+ * from the geometry at t_N and the velocities the law read (integrate.c
+ * recovers them), with the law's own expressions (contacts.c), as the cycle
+ * computed them.
  *
  * Elastic energy: the energy stored in the contact springs.  For the
  * incremental law the springs are k_n and k_s: F_n²/(2 k_n) + F_s²/(2 k_s).
@@ -30,7 +30,11 @@
 #include <math.h>
 #include <string.h>
 
-#include "sim.h"
+#include "contacts.h"
+#include "integrate.h"
+#include "measure.h"
+#include "pairs.h"
+#include "walls.h"
 
 /* Velocities of disc i at t_N: the mean of v_{N-1/2} and v_{N+1/2} (eq. 31);
  * before the first cycle, the initial ones. */
@@ -63,7 +67,7 @@ double bal_measure_kinetic(const struct bal_sim *s)
 double bal_measure_normal_energy(const struct bal_sim *s, const struct bal_pair_law *L, double fn,
                                  double delta)
 {
-    const struct bal_law_params P = {s->normal_law, s->nu, s->delta0, s->gamma_n, s->psi, s->dt};
+    const struct bal_law_params P = bal_law_params_of(s);
     return bal_law_normal_energy(&P, L, fn, delta);
 }
 
@@ -77,7 +81,7 @@ double bal_measure_elastic(const struct bal_sim *s)
                 continue;
             double rmin;
             const struct bal_pair_law *L;
-            const double delta = bal_sim_overlap(s, walls, c, &rmin, &L);
+            const double delta = bal_pairs_overlap(s, walls, c, &rmin, &L);
             e += bal_measure_normal_energy(s, L, p->fn[c], delta);
             e += bal_law_shear_energy(L, pair_fs(p, c));
         }
@@ -85,10 +89,42 @@ double bal_measure_elastic(const struct bal_sim *s)
     return e;
 }
 
+void bal_measure_dashpots(const struct bal_sim *s, const struct bal_pairs *p, long c, double *dn,
+                          double *ds)
+{
+    *dn = *ds = 0;
+    if (!(p->flags[c] & BAL_PAIR_TOUCHING))
+        return;
+    if (p != &s->pp) {
+        *dn = p->dn ? p->dn[c] : 0;
+        *ds = p->ds ? p->ds[c] : 0;
+        return;
+    }
+    if (!s->has_damping)
+        return;
+    const int i = p->i[c], j = p->j[c];
+    const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + s->mat[j]];
+    const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
+    const double dist = sqrt(dx * dx + dy * dy), ex = dx / dist, ey = dy / dist;
+    double vxi, vyi, wi, vxj, vyj, wj;
+    bal_integrate_previous(s, i, &vxi, &vyi, &wi);
+    bal_integrate_previous(s, j, &vxj, &vyj, &wj);
+    const double rvx = vxi - vxj, rvy = vyi - vyj;
+    const struct bal_law_params P = bal_law_params_of(s);
+    struct bal_kin k;
+    k.ndot = rvx * ex + rvy * ey;
+    k.delta = s->r[i] + s->r[j] - dist;
+    *dn = bal_law_normal_dashpot(&P, L, &k); /* the cycle's own kernels (laws.h) */
+    if (s->has_shear && L->shear && !(p->flags[c] & BAL_PAIR_SLIDING)) {
+        k.sdot = rvx * ey - rvy * ex - (wi * s->r[i] + wj * s->r[j]);
+        *ds = bal_law_shear_dashpot(L, &k);
+    }
+}
+
 static double contact_force(const struct bal_sim *s, const struct bal_pairs *p, long c)
 {
     double dn, ds;
-    bal_contact_dashpots(s, p, c, &dn, &ds);
+    bal_measure_dashpots(s, p, c, &dn, &ds);
     return hypot(p->fn[c] + dn, pair_fs(p, c) + ds);
 }
 
@@ -112,17 +148,6 @@ double bal_measure_unbalanced(const struct bal_sim *s)
         smax = fmax(smax, hypot(sx, sy));
     }
     return smax / fbig;
-}
-
-/* Contacts whose flags include `flag` (touching, or sliding). */
-static long count_contacts(const struct bal_sim *s, uint8_t flag)
-{
-    long n = 0;
-    for (long c = 0; c < s->pp.n; c++)
-        n += (s->pp.flags[c] & flag) != 0;
-    for (long c = 0; c < s->pw.n; c++)
-        n += (s->pw.flags[c] & flag) != 0;
-    return n;
 }
 
 double bal_measure_disc_volume(double r)
@@ -150,7 +175,7 @@ void bal_measure_moments(const struct bal_sim *s, double *m)
         const double d = hypot(dx, dy), ex = dx / d, ey = dy / d;
         const double delta = s->r[i] + s->r[j] - d;
         double dn, ds;
-        bal_contact_dashpots(s, &s->pp, c, &dn, &ds);
+        bal_measure_dashpots(s, &s->pp, c, &dn, &ds);
         const double ftn = s->pp.fn[c] + dn;
         const double fts = pair_fs(&s->pp, c) + ds;
         /* Force on j is ftn e + fts t, t = (ey, -ex); on i the opposite.  The
@@ -173,95 +198,4 @@ void bal_measure_moments(const struct bal_sim *s, double *m)
         const double l = 0.5 * (s->r[i] + d);
         add_moment(m, i, -fx, -fy, l * ex, l * ey);
     }
-}
-
-double bal_measure_probe(const struct bal_sim *s, int probe)
-{
-    const struct bal_probe_ref *p = &s->probes[probe];
-    switch (p->kind) {
-    case BAL_PROBE_CONTACT_FN:
-    case BAL_PROBE_CONTACT_FS:
-    case BAL_PROBE_CONTACT_SLIDING: {
-        const struct bal_pairs *list = NULL;
-        const long c = bal_sim_find_contact(s, p->a_wall, p->a, p->b_wall, p->b, &list);
-        if (c < 0 || !(list->flags[c] & BAL_PAIR_TOUCHING))
-            return 0;
-        if (p->kind == BAL_PROBE_CONTACT_FN)
-            return list->fn[c];
-        if (p->kind == BAL_PROBE_CONTACT_FS)
-            return pair_fs(list, c);
-        return (list->flags[c] & BAL_PAIR_SLIDING) ? 1 : 0;
-    }
-    case BAL_PROBE_WALL_F1:
-        return s->walls[p->a].f[0];
-    case BAL_PROBE_WALL_F2:
-        return s->walls[p->a].f[1];
-    case BAL_PROBE_WALL_MOMENT:
-        return s->walls[p->a].moment;
-    case BAL_PROBE_WALL_ECC: {
-        const struct bal_wall *W = &s->walls[p->a];
-        if (W->fn_sum == 0)
-            return 0;
-        const double mid = 0.5 * (W->h1 + W->h2), half = 0.5 * (W->h2 - W->h1);
-        return (W->fn_s_sum / W->fn_sum - mid) / half;
-    }
-    case BAL_PROBE_DISC_X:
-        return s->x[p->a];
-    case BAL_PROBE_DISC_Y:
-        return s->y[p->a];
-    case BAL_PROBE_DISC_VX:
-    case BAL_PROBE_DISC_VY:
-    case BAL_PROBE_DISC_OMEGA: {
-        double vx, vy, w;
-        bal_measure_velocity(s, p->a, &vx, &vy, &w);
-        return p->kind == BAL_PROBE_DISC_VX ? vx : p->kind == BAL_PROBE_DISC_VY ? vy : w;
-    }
-    case BAL_PROBE_DISC_THETA:
-        return s->th[p->a] * (180 / BAL_PI);
-    case BAL_PROBE_ENERGY_KINETIC:
-        return bal_measure_kinetic(s);
-    case BAL_PROBE_ENERGY_ELASTIC:
-        return bal_measure_elastic(s);
-    case BAL_PROBE_WORK_WALLS:
-    case BAL_PROBE_WORK_GRAVITY:
-    case BAL_PROBE_DISSIPATED_DASHPOT:
-    case BAL_PROBE_DISSIPATED_FRICTION:
-    case BAL_PROBE_DISSIPATED_GLOBAL:
-    case BAL_PROBE_ENERGY_IMBALANCE: {
-        struct bal_energy e;
-        bal_energy_report(s, &e);
-        switch (p->kind) {
-        case BAL_PROBE_WORK_WALLS: return e.work_walls;
-        case BAL_PROBE_WORK_GRAVITY: return e.work_gravity;
-        case BAL_PROBE_DISSIPATED_DASHPOT: return e.dissipated_dashpot;
-        case BAL_PROBE_DISSIPATED_FRICTION: return e.dissipated_friction;
-        case BAL_PROBE_DISSIPATED_GLOBAL: return e.dissipated_global;
-        default: return e.imbalance;
-        }
-    }
-    case BAL_PROBE_UNBALANCED:
-        return bal_measure_unbalanced(s);
-    case BAL_PROBE_N_CONTACTS:
-        return (double)count_contacts(s, BAL_PAIR_TOUCHING);
-    case BAL_PROBE_N_SLIDING:
-        return (double)count_contacts(s, BAL_PAIR_SLIDING);
-    case BAL_PROBE_HELD_FX:
-    case BAL_PROBE_HELD_FY: {
-        double f = 0;
-        const int k = p->kind == BAL_PROBE_HELD_FX ? 0 : 1;
-        for (int i = 0; i < s->n; i++)
-            if (s->fixed[i])
-                f += s->f[3 * i + k];
-        return f;
-    }
-    case BAL_PROBE_WEIGHT_X:
-    case BAL_PROBE_WEIGHT_Y: {
-        double m = 0;
-        for (int i = 0; i < s->n; i++)
-            if (!s->fixed[i])
-                m += bal_mass(s, i);
-        return m * s->g[p->kind == BAL_PROBE_WEIGHT_X ? 0 : 1] * s->gfac;
-    }
-    }
-    return NAN;
 }

@@ -25,8 +25,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "scene.h"
-#include "sim.h"
+#include "measure.h"
+#include "scene_keys.h"
+#include "specimen.h"
+#include "walls.h"
 
 #ifndef BAL_BUILD_FLAGS
 #define BAL_BUILD_FLAGS "unknown"
@@ -34,28 +36,7 @@
 
 void bal_output_disc_name(const struct bal_sim *s, int id, char *buf, size_t size)
 {
-    const struct bal_scene *sc = s->scene;
-    if (id < sc->n_discs) {
-        snprintf(buf, size, "%s", sc->discs[id].name);
-        return;
-    }
-    long k = id - sc->n_discs;
-    for (int f = 0; f < sc->n_fills; f++) {
-        if (k < sc->fills[f].n) {
-            snprintf(buf, size, "%s.%ld", sc->fills[f].name, k);
-            return;
-        }
-        k -= sc->fills[f].n;
-    }
-    for (int p = 0; p < sc->n_piles; p++) {
-        const long n = bal_sim_pile_count(&sc->piles[p]);
-        if (k < n) {
-            snprintf(buf, size, "%s.%ld", sc->piles[p].name, k);
-            return;
-        }
-        k -= n;
-    }
-    snprintf(buf, size, "?%d", id);
+    bal_specimen_disc_name(s->scene, id, buf, size);
 }
 
 void bal_output_series_header(const struct bal_sim *s, FILE *f)
@@ -72,7 +53,7 @@ enum bal_status bal_output_series_row(const struct bal_sim *s, FILE *f, struct b
      * that is not finite stops the run before anything of the row is
      * written. */
     for (int p = 0; p < s->n_probes; p++) {
-        const double v = bal_measure_probe(s, p);
+        const double v = bal_probes_value(s, p);
         if (!isfinite(v)) {
             const struct bal_probe_def *pd = &s->scene->probes[p];
             const int ki = bal_scene_key_index(BAL_SEC_PROBE, "quantity");
@@ -148,7 +129,7 @@ static void write_contacts(const struct bal_sim *s, FILE *f)
         body_name(s, 0, i, a, sizeof a);
         body_name(s, 0, j, b, sizeof b);
         double dn, ds;
-        bal_contact_dashpots(s, &s->pp, c, &dn, &ds);
+        bal_measure_dashpots(s, &s->pp, c, &dn, &ds);
         fprintf(f, "%s\t%s\tdisc\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d\n", a,
                 b, s->x[i] + at * ex, s->y[i] + at * ey, ex, ey, s->pp.fn[c], pair_fs(&s->pp, c),
                 dn, ds, (s->pp.flags[c] & BAL_PAIR_SLIDING) != 0);
@@ -361,23 +342,22 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
     fputs(",\n  \"message\": ", f);
     json_string(f, message ? message : "");
     if (s) {
-        struct bal_run_info in;
-        bal_sim_info(s, &in);
-        fprintf(f, ",\n  \"steps\": %ld,\n  \"time\": ", in.steps);
-        json_number(f, in.time);
+        /* The counters of bal_sim_info, read from the state (output.c sits
+         * below the life cycle in sim.c, which writes series rows here). */
+        fprintf(f, ",\n  \"steps\": %ld,\n  \"time\": ", s->step);
+        json_number(f, s->time);
         fputs(",\n  \"dt\": ", f);
-        json_number(f, in.dt);
+        json_number(f, s->dt);
         fputs(",\n  \"dt_estimate\": ", f);
-        json_number(f, in.dt_estimate);
+        json_number(f, s->dt_estimate);
         fputs(",\n  \"dt_fraction\": ", f);
-        json_number(f, in.dt_fraction);
+        json_number(f, s->dt / s->dt_estimate);
         fputs(",\n  \"wall_seconds\": ", f);
-        json_number(f, in.wall_seconds);
+        json_number(f, s->wall_seconds);
         fprintf(f, ",\n  \"n_discs\": %d,\n  \"n_walls\": %d,\n  \"grid\": %s,\n"
                    "  \"rebuilds\": %ld,\n  \"candidates\": %ld,\n  \"particle_steps_per_s\": ",
-                in.n_discs, in.n_walls, in.grid_used ? "true" : "false", in.rebuilds,
-                in.n_candidates);
-        json_number(f, in.wall_seconds > 0 ? (double)in.steps * in.n_discs / in.wall_seconds : 0);
+                s->n, s->n_walls, s->use_grid ? "true" : "false", s->rebuilds, s->pp.n);
+        json_number(f, s->wall_seconds > 0 ? (double)s->step * s->n / s->wall_seconds : 0);
         fprintf(f, ",\n  \"gravity\": [%.17g, %.17g]", s->g[0], s->g[1]);
         fprintf(f, ",\n  \"threads\": %d", s->par.threads);
         fprintf(f, ",\n  \"timers\": {\"positions\": %.6g, \"neighbours\": %.6g, \"contacts\": %.6g, "
@@ -424,12 +404,12 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
         for (int p = 0; p < sc->n_piles; p++) {
             const struct bal_pile_def *pd = &sc->piles[p];
             const double s0 = pd->bottom == 1 ? pd->d * (1 + pd->c) : pd->d;
-            const long rows = bal_sim_pile_rows(pd);
+            const long rows = bal_specimen_pile_rows(pd);
             fprintf(f, "%s\n    {\"name\": ", p ? "," : "");
             json_string(f, pd->name);
             fprintf(f, ", \"L\": %ld, \"rows\": %ld, \"discs\": %ld, \"d\": %.17g, \"x0\": %.17g, "
                        "\"width\": %.17g}",
-                    pd->L, rows, bal_sim_pile_count(pd), pd->d, pd->origin[0],
+                    pd->L, rows, bal_specimen_pile_count(pd), pd->d, pd->origin[0],
                     (double)(pd->L - 1) * s0 + pd->d);
         }
         fputs("\n  ]", f);

@@ -1,5 +1,5 @@
 /*
- * scene.c — text scene → struct bal_scene, --set overrides, validation.
+ * scene.c — text scene → struct bal_scene, and --set overrides.
  *
  * Format (documented key by key in the README, generated from
  * scene_keys.c):
@@ -15,10 +15,10 @@
  *
  * Define, default, validate: bal_scene_default() gives an empty scene with
  * default settings; each new section starts from the defaults in the key
- * table; bal_scene_parse() checks syntax, types and ranges line by line;
- * bal_scene_validate() checks what needs the whole file (required keys,
- * references between sections, stages).  Every message names the file, the
- * line and the key and says what was expected.
+ * table (scene_keys.c); bal_scene_parse() checks syntax, types and ranges
+ * line by line; bal_scene_validate() then checks what needs the whole file
+ * (scene_validate.c).  Every message names the file, the line and the key
+ * and says what was expected.
  */
 #include <ctype.h>
 #include <errno.h>
@@ -75,7 +75,7 @@ static struct section_array section_array(struct bal_scene *s,
     return a;
 }
 
-static void *section_item(const struct bal_scene *s, enum bal_section_kind k, int i)
+void *bal_scene_section(const struct bal_scene *s, enum bal_section_kind k, int i)
 {
     struct section_array a = section_array((struct bal_scene *)s, k);
     if (k == BAL_SEC_SETTINGS)
@@ -83,35 +83,19 @@ static void *section_item(const struct bal_scene *s, enum bal_section_kind k, in
     return (char *)*a.items + (size_t)i * bal_scene_sections[k].size;
 }
 
-static int section_count(const struct bal_scene *s, enum bal_section_kind k)
+int bal_scene_count(const struct bal_scene *s, enum bal_section_kind k)
 {
     if (k == BAL_SEC_SETTINGS)
         return 1;
     return *section_array((struct bal_scene *)s, k).count;
 }
 
-static char *item_name(void *item)
-{
-    /* Every named section struct starts with char name[BAL_NAME_MAX]. */
-    return (char *)item;
-}
-
-static uint32_t *item_given(void *item, enum bal_section_kind k)
-{
-    return (uint32_t *)((char *)item + bal_scene_sections[k].given_offset);
-}
-
-static int *item_key_line(void *item, enum bal_section_kind k)
-{
-    return (int *)((char *)item + bal_scene_sections[k].key_line_offset);
-}
-
 int bal_scene_find(const struct bal_scene *s, enum bal_section_kind sec,
                    const char *name)
 {
-    int n = section_count(s, sec);
+    int n = bal_scene_count(s, sec);
     for (int i = 0; i < n; i++)
-        if (strcmp(item_name(section_item(s, sec, i)), name) == 0)
+        if (strcmp(bal_scene_item_name(bal_scene_section(s, sec, i)), name) == 0)
             return i;
     return -1;
 }
@@ -256,19 +240,31 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
         snprintf(msg, sizeof msg, "expected one of {%s}, got '%s'", key->choices, value);
         return where_error(err, w, key->name, "%s", msg);
     }
-    case BAL_KEY_MOVE: {
+    case BAL_KEY_CONTROL: {
+        /* A wall's name, then as many numbers as the key's form has words
+         * after "WALL" (key->choices: "WALL v1 v2 omega"). */
+        static const char *const counts[BAL_CONTROL_VALUES_MAX + 1] = {
+            "no", "one", "two", "three", "four", "five", "six", "seven", "eight"};
         struct bal_stage_def *st = item;
-        char wall[BAL_NAME_MAX + 1];
+        int n_values = 0;
+        for (const char *c = key->choices; (c = strchr(c, ' ')) != NULL; c++)
+            n_values++;
+        double values[BAL_CONTROL_VALUES_MAX];
+        char wall[BAL_NAME_MAX + 1], msg[BAL_MSG_MAX];
         int n_read = 0;
-        if (sscanf(value, "%48s%n", wall, &n_read) != 1 || !valid_name(wall))
-            return where_error(err, w, key->name,
-                               "expected 'WALL v1 v2 omega', got '%s'", value);
+        if (sscanf(value, "%48s%n", wall, &n_read) != 1 || !valid_name(wall)) {
+            snprintf(msg, sizeof msg, "expected '%s', got '%s'", key->choices, value);
+            return where_error(err, w, key->name, "%s", msg);
+        }
         p = value + n_read;
-        if (!parse_number(&p, &v[0]) || !parse_number(&p, &v[1]) ||
-            !parse_number(&p, &v[2]) || !at_end(p))
-            return where_error(err, w, key->name,
-                               "expected 'WALL v1 v2 omega' with three finite numbers, got '%s'",
-                               value);
+        int ok = 1;
+        for (int k = 0; k < n_values && ok; k++)
+            ok = parse_number(&p, &values[k]);
+        if (!ok || !at_end(p)) {
+            snprintf(msg, sizeof msg, "expected '%s' with %s finite numbers, got '%s'",
+                     key->choices, counts[n_values], value);
+            return where_error(err, w, key->name, "%s", msg);
+        }
         /* In a file a wall is moved once per stage; --set (line 0) replaces
          * the wall's motion, so a variant can change a loading speed. */
         struct bal_move_def *m = NULL;
@@ -286,9 +282,8 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
         }
         strcpy(m->wall, wall);
         m->line = w.line;
-        m->v[0] = v[0];
-        m->v[1] = v[1];
-        m->omega = v[2];
+        m->control = bal_scene_key_control(key->name);
+        memcpy((char *)m + key->offset, values, (size_t)n_values * sizeof(double));
         return BAL_OK;
     }
     }
@@ -310,7 +305,7 @@ static void apply_defaults(void *item, enum bal_section_kind k)
             (void)set_value(item, key, key->def, w, &ignored);
         }
     }
-    *item_given(item, k) = 0;
+    *bal_scene_item_given(item, k) = 0;
 }
 
 void bal_scene_default(struct bal_scene *s)
@@ -366,8 +361,8 @@ static enum bal_status new_section(struct bal_scene *s, enum bal_section_kind k,
     void *item = (char *)*a.items + (size_t)(*a.count) * size;
     memset(item, 0, size);
     (*a.count)++;
-    strcpy(item_name(item), name);
-    *(int *)((char *)item + BAL_NAME_MAX) = w.line; /* `line` follows `name` */
+    strcpy(bal_scene_item_name(item), name);
+    *bal_scene_item_line(item) = w.line;
     apply_defaults(item, k);
     *out = item;
     return BAL_OK;
@@ -391,17 +386,17 @@ static enum bal_status assign(void *item, enum bal_section_kind k,
         return where_error(err, w, key_name, "%s", msg);
     }
     const struct bal_key *key = bal_scene_key_at(k, ki);
-    uint32_t *given = item_given(item, k);
-    if ((*given & (1u << ki)) && key->type != BAL_KEY_MOVE && w.line > 0) {
+    uint32_t *given = bal_scene_item_given(item, k);
+    if ((*given & (1u << ki)) && key->type != BAL_KEY_CONTROL && w.line > 0) {
         char first[32];
-        snprintf(first, sizeof first, "%d", item_key_line(item, k)[ki]);
+        snprintf(first, sizeof first, "%d", bal_scene_item_key_line(item, k)[ki]);
         return where_error(err, w, key_name, "given twice in this section (first on line %s)",
                            first);
     }
     if (set_value(item, key, value, w, err))
         return err->code;
     *given |= 1u << ki;
-    item_key_line(item, k)[ki] = w.line;
+    bal_scene_item_key_line(item, k)[ki] = w.line;
     return BAL_OK;
 }
 
@@ -583,7 +578,7 @@ enum bal_status bal_scene_set(struct bal_scene *s, const char *assignment,
         if (i < 0)
             return bal_error(err, BAL_EINVAL, "%s: --set %s: no [%s %s] in the scene", s->path,
                              assignment, path, rest);
-        item = section_item(s, (enum bal_section_kind)k, i);
+        item = bal_scene_section(s, (enum bal_section_kind)k, i);
         key = dot2 + 1;
     } else {
         item = &s->settings;
@@ -592,283 +587,4 @@ enum bal_status bal_scene_set(struct bal_scene *s, const char *assignment,
     if (*value == '\0')
         return where_error(err, w, key, "%s", "expected a value after '='");
     return assign(item, (enum bal_section_kind)k, key, value, w, err);
-}
-
-/* ------------------------------------------------------------------ */
-/* Validation                                                          */
-/* ------------------------------------------------------------------ */
-
-static int line_of(void *item, enum bal_section_kind k, const char *key)
-{
-    int ki = bal_scene_key_index(k, key);
-    int l = ki >= 0 ? item_key_line(item, k)[ki] : 0;
-    return l > 0 ? l : *(int *)((char *)item + BAL_NAME_MAX);
-}
-
-/* FAIL_AT(item, kind, key, fmt, args...): at least one argument after fmt. */
-#define FAIL_AT(item, k, key, fmt, ...) \
-    bal_error(err, BAL_EINVAL, "%s:%d: %s: " fmt, s->path, line_of(item, k, key), key, __VA_ARGS__)
-
-static enum bal_status check_required(const struct bal_scene *s, enum bal_section_kind k,
-                                      struct bal_error *err)
-{
-    int n = section_count(s, k);
-    for (int i = 0; i < n; i++) {
-        void *item = section_item(s, k, i);
-        uint32_t given = *item_given(item, k);
-        for (int ki = 0;; ki++) {
-            const struct bal_key *key = bal_scene_key_at(k, ki);
-            if (!key)
-                break;
-            if (key->required && !(given & (1u << ki))) {
-                int line = k == BAL_SEC_SETTINGS ? s->settings.key_line[BAL_KEYS_MAX - 1]
-                                                 : *(int *)((char *)item + BAL_NAME_MAX);
-                return bal_error(err, BAL_EINVAL, "%s:%d: [%s %s]: %s: required key is missing (%s)",
-                                 s->path, line, bal_scene_sections[k].name,
-                                 k == BAL_SEC_SETTINGS ? "" : item_name(item), key->name,
-                                 key->doc);
-            }
-        }
-    }
-    return BAL_OK;
-}
-
-static enum bal_status check_material_ref(const struct bal_scene *s, void *item,
-                                          enum bal_section_kind k, const char *key,
-                                          const char *value, int need_density,
-                                          struct bal_error *err)
-{
-    int m = bal_scene_find(s, BAL_SEC_MATERIAL, value);
-    if (m < 0)
-        return FAIL_AT(item, k, key, "no [material %s] in the scene", value);
-    if (need_density && !(s->materials[m].density > 0))
-        return FAIL_AT(item, k, key,
-                       "material '%s' has no density > 0, which a disc needs for its mass",
-                       value);
-    return BAL_OK;
-}
-
-/* Is `name` a disc, a wall, or a wall made by a fill's box? */
-static int body_exists(const struct bal_scene *s, const char *name, int *is_wall)
-{
-    if (bal_scene_find(s, BAL_SEC_DISC, name) >= 0) {
-        *is_wall = 0;
-        return 1;
-    }
-    if (bal_scene_find(s, BAL_SEC_WALL, name) >= 0) {
-        *is_wall = 1;
-        return 1;
-    }
-    for (int p = 0; p < s->n_piles; p++) {
-        char nm[2 * BAL_NAME_MAX];
-        snprintf(nm, sizeof nm, "%s_floor", s->piles[p].name);
-        if (s->piles[p].bottom == 0 && strcmp(nm, name) == 0) {
-            *is_wall = 1;
-            return 1;
-        }
-    }
-    static const char *const sides[] = {"_bottom", "_right", "_top", "_left"};
-    for (int f = 0; f < s->n_fills; f++) {
-        if (!s->fills[f].box)
-            continue;
-        for (int k = 0; k < 4; k++) {
-            char nm[2 * BAL_NAME_MAX];
-            snprintf(nm, sizeof nm, "%s%s", s->fills[f].name, sides[k]);
-            if (strcmp(nm, name) == 0) {
-                *is_wall = 1;
-                return 1;
-            }
-        }
-    }
-    return 0;
-}
-
-/* Probes and moves find bodies by name, so a disc, a wall and the walls a
- * fill box or a smooth pile makes must not share one (else the first found
- * wins silently; seen by reading, while fuzzing). */
-static enum bal_status check_body_names(const struct bal_scene *s, struct bal_error *err)
-{
-    static const char *const sides[] = {"_bottom", "_right", "_top", "_left"};
-    for (int i = 0; i < s->n_walls; i++)
-        if (bal_scene_find(s, BAL_SEC_DISC, s->walls[i].name) >= 0)
-            return bal_error(err, BAL_EINVAL, "%s:%d: [wall %s]: a disc has this name too; "
-                             "probes and moves need one body per name",
-                             s->path, s->walls[i].line, s->walls[i].name);
-    for (int k = 0; k < s->n_fills + s->n_piles; k++) {
-        const int fill = k < s->n_fills;
-        const char *name = fill ? s->fills[k].name : s->piles[k - s->n_fills].name;
-        const int line = fill ? s->fills[k].line : s->piles[k - s->n_fills].line;
-        if (fill ? !s->fills[k].box : s->piles[k - s->n_fills].bottom != 0)
-            continue;
-        for (int side = 0; side < (fill ? 4 : 1); side++) {
-            char nm[2 * BAL_NAME_MAX];
-            snprintf(nm, sizeof nm, "%s%s", name, fill ? sides[side] : "_floor");
-            if (bal_scene_find(s, BAL_SEC_DISC, nm) >= 0 || bal_scene_find(s, BAL_SEC_WALL, nm) >= 0)
-                return bal_error(err, BAL_EINVAL, "%s:%d: [%s %s]: makes a wall '%s', but a disc "
-                                 "or wall has that name already",
-                                 s->path, line, fill ? "fill" : "pile", name, nm);
-        }
-    }
-    return BAL_OK;
-}
-
-enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *err)
-{
-    for (int k = 0; k < BAL_SEC_COUNT; k++)
-        if (check_required(s, (enum bal_section_kind)k, err))
-            return err->code;
-
-    const struct bal_settings *st = &s->settings;
-    const int delta0_given = (st->given & (1u << bal_scene_key_index(BAL_SEC_SETTINGS, "delta0"))) != 0;
-    if (st->normal_law == BAL_NORMAL_POWER && st->nu != 1.0 && !delta0_given)
-        return bal_error(err, BAL_EINVAL,
-                         "%s:%d: delta0: required with normal_law = power and nu != 1 "
-                         "(the force scale k_n delta0 depends on it)",
-                         s->path, st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "nu")]);
-    if (st->gamma_n > 0 && st->psi != 0 && !delta0_given)
-        return bal_error(err, BAL_EINVAL,
-                         "%s:%d: delta0: required with psi != 0 (the dashpot "
-                         "gamma_n (delta/delta0)^psi depends on it, MLH eq. 3)",
-                         s->path, st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "psi")]);
-
-    for (int i = 0; i < s->n_discs; i++) {
-        struct bal_disc_def *d = &s->discs[i];
-        if (check_material_ref(s, d, BAL_SEC_DISC, "material", d->material, 1, err))
-            return err->code;
-        if (d->fixed && (d->v[0] != 0 || d->v[1] != 0 || d->omega != 0))
-            return FAIL_AT(d, BAL_SEC_DISC, "fixed", "%s",
-                           "a held disc cannot have a velocity (v and omega must be 0)");
-    }
-    for (int i = 0; i < s->n_walls; i++) {
-        struct bal_wall_def *w = &s->walls[i];
-        if (!(w->h2 > w->h1))
-            return FAIL_AT(w, BAL_SEC_WALL, "h2", "expected h2 > h1 (a wall of positive length), "
-                                                  "got h1 = %g, h2 = %g", w->h1, w->h2);
-        if (check_material_ref(s, w, BAL_SEC_WALL, "material", w->material, 0, err))
-            return err->code;
-    }
-    for (int i = 0; i < s->n_fills; i++) {
-        struct bal_fill_def *f = &s->fills[i];
-        if (!(f->rmax >= f->rmin))
-            return FAIL_AT(f, BAL_SEC_FILL, "rmax", "expected rmax >= rmin, got %g < %g",
-                           f->rmax, f->rmin);
-        if (check_material_ref(s, f, BAL_SEC_FILL, "material", f->material, 1, err))
-            return err->code;
-        if (f->box) {
-            if (!*f->wall_material)
-                return FAIL_AT(f, BAL_SEC_FILL, "wall_material", "%s", "required with box = 1");
-            if (check_material_ref(s, f, BAL_SEC_FILL, "wall_material", f->wall_material, 0, err))
-                return err->code;
-        }
-    }
-    for (int i = 0; i < s->n_piles; i++) {
-        struct bal_pile_def *p = &s->piles[i];
-        if (check_material_ref(s, p, BAL_SEC_PILE, "material", p->material, 1, err))
-            return err->code;
-        if (p->bottom == 0) {
-            if (!*p->wall_material)
-                return FAIL_AT(p, BAL_SEC_PILE, "wall_material", "%s",
-                               "required with bottom = smooth (the floor's material)");
-            if (check_material_ref(s, p, BAL_SEC_PILE, "wall_material", p->wall_material, 0, err))
-                return err->code;
-            if (p->L < 3)
-                return FAIL_AT(p, BAL_SEC_PILE, "L", "%s",
-                               "a smooth bottom needs L >= 3 (two corner stones and a free disc)");
-        }
-    }
-    for (int i = 0; i < s->n_materials; i++) {
-        struct bal_material_def *m = &s->materials[i];
-        if (!(m->ks >= 1e-150 || m->ks == -1))
-            return FAIL_AT(m, BAL_SEC_MATERIAL, "ks", "expected ks >= 1e-150, like kn (or omit it "
-                                                      "for ks = kn), "
-                                                      "got %g", m->ks);
-    }
-    if (check_body_names(s, err))
-        return err->code;
-    if (s->n_stages == 0)
-        return bal_error(err, BAL_EINVAL, "%s: no [stage] section: the run would never start; "
-                                          "add e.g. [stage run] with cycles = N", s->path);
-    for (int i = 0; i < s->n_stages; i++) {
-        struct bal_stage_def *g = &s->stages[i];
-        for (int m = 0; m < g->n_moves; m++) {
-            int is_wall = 0;
-            if (!body_exists(s, g->moves[m].wall, &is_wall) || !is_wall)
-                return bal_error(err, BAL_EINVAL, "%s:%d: move: no wall named '%s'", s->path,
-                                 g->moves[m].line, g->moves[m].wall);
-        }
-    }
-    for (int i = 0; i < s->n_probes; i++) {
-        struct bal_probe_def *p = &s->probes[i];
-        int k = p->kind, wa = 0, wb = 0;
-        int contact = k == BAL_PROBE_CONTACT_FN || k == BAL_PROBE_CONTACT_FS ||
-                      k == BAL_PROBE_CONTACT_SLIDING;
-        int wall = k >= BAL_PROBE_WALL_F1 && k <= BAL_PROBE_WALL_ECC;
-        int disc = k >= BAL_PROBE_DISC_X && k <= BAL_PROBE_DISC_OMEGA;
-        if (contact || wall || disc) {
-            if (!*p->a)
-                return FAIL_AT(p, BAL_SEC_PROBE, "a", "%s", "this quantity needs a body in 'a'");
-            if (!body_exists(s, p->a, &wa))
-                return FAIL_AT(p, BAL_SEC_PROBE, "a", "no disc or wall named '%s'", p->a);
-            if (wall && !wa)
-                return FAIL_AT(p, BAL_SEC_PROBE, "a", "'%s' is a disc; this quantity needs a wall",
-                               p->a);
-            if (disc && wa)
-                return FAIL_AT(p, BAL_SEC_PROBE, "a", "'%s' is a wall; this quantity needs a disc",
-                               p->a);
-        }
-        if (contact) {
-            if (!*p->b)
-                return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "a contact probe needs a second body in 'b'");
-            if (!body_exists(s, p->b, &wb))
-                return FAIL_AT(p, BAL_SEC_PROBE, "b", "no disc or wall named '%s'", p->b);
-            if (wa && wb)
-                return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "two walls never make a contact");
-            if (strcmp(p->a, p->b) == 0)
-                return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "a body cannot touch itself");
-        } else if (*p->b) {
-            return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "only contact probes take a second body");
-        }
-    }
-    if (s->n_discs == 0 && s->n_fills == 0 && s->n_piles == 0)
-        return bal_error(err, BAL_EINVAL,
-                         "%s: no discs: add [disc NAME], [fill NAME] or [pile NAME] sections", s->path);
-    return BAL_OK;
-}
-
-/* ------------------------------------------------------------------ */
-/* Key list                                                            */
-/* ------------------------------------------------------------------ */
-
-void bal_scene_print_keys(FILE *out)
-{
-    static const char *const type_names[] = {"number", "integer", "two numbers", "name",
-                                             "word", "WALL v1 v2 omega"};
-    for (int k = 0; k < BAL_SEC_COUNT; k++) {
-        const struct bal_section_info *sec = &bal_scene_sections[k];
-        fprintf(out, "\n`[%s%s]` — %s\n\n", sec->name, sec->named ? " NAME" : "", sec->doc);
-        fprintf(out, "| key | type | default | range | meaning |\n|---|---|---|---|---|\n");
-        for (int i = 0;; i++) {
-            const struct bal_key *key = bal_scene_key_at((enum bal_section_kind)k, i);
-            if (!key)
-                break;
-            char range[96] = "";
-            /* A word's choices are printed whole (the probe quantities are
-             * longer than any fixed buffer kept for a numeric range). */
-            const char *shown = range;
-            if (key->type == BAL_KEY_ENUM)
-                shown = key->choices;
-            else if (key->type == BAL_KEY_DOUBLE || key->type == BAL_KEY_LONG) {
-                char lo[32] = "", hi[32] = "";
-                if (key->min > -1e300)
-                    snprintf(lo, sizeof lo, "%g", key->min);
-                if (key->max < 1e300)
-                    snprintf(hi, sizeof hi, "%g", key->max);
-                if (*lo || *hi)
-                    snprintf(range, sizeof range, "[%s, %s]", *lo ? lo : "-inf", *hi ? hi : "inf");
-            }
-            fprintf(out, "| `%s` | %s | %s | %s | %s |\n", key->name, type_names[key->type],
-                    key->def ? (*key->def ? key->def : "(none)") : (key->required ? "required" : "(none)"),
-                    shown, key->doc);
-        }
-    }
 }

@@ -1,67 +1,44 @@
 /*
- * scene.h — internal: the table of scene keys shared by the parser, the
- * range checks, `ballast info` and the README's key list.
- *
- * A scene file is a sequence of sections.  `[settings]` appears at most
- * once; the other kinds are named (`[disc x]`) and may repeat.  Each key of
- * a section kind is one row of bal_scene_keys: its type, where it lives in
- * the section's struct, its default (as text, parsed like a value from a
- * file, so the table is the only place a default is written), its range and
- * a one-line doc.
+ * scene.h — internal: a parsed scene's sections, found by kind and name
+ * (scene.c), for the validation (scene_validate.c) and for the modules that
+ * build a simulation from the scene.
  */
 #ifndef BAL_SCENE_H
 #define BAL_SCENE_H
 
-#include <stddef.h>
+#include <stdint.h>
 
-#include "ballast.h"
-
-enum bal_key_type {
-    BAL_KEY_DOUBLE,   /* one finite number */
-    BAL_KEY_LONG,     /* one integer */
-    BAL_KEY_VEC2,     /* two finite numbers */
-    BAL_KEY_NAME,     /* a name of another section (resolved in validate) */
-    BAL_KEY_ENUM,     /* one word of `choices` (space separated), stored as int */
-    BAL_KEY_MOVE      /* repeatable: "WALL vx vy omega" appended to a stage */
-};
-
-enum bal_section_kind {
-    BAL_SEC_SETTINGS, BAL_SEC_MATERIAL, BAL_SEC_DISC, BAL_SEC_WALL,
-    BAL_SEC_FILL, BAL_SEC_PILE, BAL_SEC_STAGE, BAL_SEC_PROBE, BAL_SEC_COUNT
-};
-
-struct bal_key {
-    enum bal_section_kind section;
-    const char *name;
-    enum bal_key_type type;
-    size_t offset;          /* offset of the value in the section struct */
-    const char *def;        /* default as text; NULL = required (or empty) */
-    int required;           /* 1: validate refuses a section without it */
-    double min, max;        /* inclusive range for numbers */
-    const char *choices;    /* for BAL_KEY_ENUM */
-    const char *doc;        /* one line for `ballast keys` and the README */
-};
-
-struct bal_section_info {
-    const char *name;       /* as written between the brackets */
-    int named;              /* 1: "[kind NAME]" */
-    size_t size;            /* sizeof the section struct */
-    size_t given_offset;    /* offsetof(struct, given) */
-    size_t key_line_offset; /* offsetof(struct, key_line) */
-    const char *doc;
-};
-
-extern const struct bal_key bal_scene_keys[];
-extern const size_t bal_scene_n_keys;
-extern const struct bal_section_info bal_scene_sections[BAL_SEC_COUNT];
-
-/* Index of key `name` within its section kind, or -1. */
-int bal_scene_key_index(enum bal_section_kind sec, const char *name);
-/* The k-th key of a section kind (k = index within that kind). */
-const struct bal_key *bal_scene_key_at(enum bal_section_kind sec, int k);
+#include "scene_keys.h"
 
 /* Index of the named material / disc / wall / stage in s, or -1. */
 int bal_scene_find(const struct bal_scene *s, enum bal_section_kind sec,
                    const char *name);
+/* Section i of kind k (the settings for BAL_SEC_SETTINGS), and how many
+ * sections of kind k the scene has (1 for the settings). */
+void *bal_scene_section(const struct bal_scene *s, enum bal_section_kind k, int i);
+int bal_scene_count(const struct bal_scene *s, enum bal_section_kind k);
+
+/* What every section struct shares: a named one starts with its name and
+ * the line of its header; every one ends with BAL_SECTION_TAIL, which keys
+ * were given and on which lines (at the offsets of the section table). */
+static inline char *bal_scene_item_name(void *item)
+{
+    return (char *)item;
+}
+
+static inline int *bal_scene_item_line(void *item)
+{
+    return (int *)((char *)item + BAL_NAME_MAX);
+}
+
+static inline uint32_t *bal_scene_item_given(void *item, enum bal_section_kind k)
+{
+    return (uint32_t *)((char *)item + bal_scene_sections[k].given_offset);
+}
+
+static inline int *bal_scene_item_key_line(void *item, enum bal_section_kind k)
+{
+    return (int *)((char *)item + bal_scene_sections[k].key_line_offset);
+}
 
 #endif /* BAL_SCENE_H */

@@ -11,14 +11,15 @@
  */
 #include <float.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <string.h>
 
-#include "scene.h"
+#include "scene_keys.h"
 
 #define BIG DBL_MAX
 #define LBIG 2147483647.0
 /* Largest stiffness: two materials combine as 2 k_a k_b / (k_a + k_b)
- * (sim.c), whose product overflows to inf/inf = NaN above about 9e153
+ * (build.c), whose product overflows to inf/inf = NaN above about 9e153
  * (found by fuzzing: kn = 1e155 gave a NaN time step). */
 #define KBIG 1e150
 /* Smallest stiffness, for the same product: 2 k_a k_b underflows to 0 below
@@ -35,6 +36,11 @@
 #define G(field) offsetof(struct bal_stage_def, field)
 #define Q(field) offsetof(struct bal_pile_def, field)
 #define P(field) offsetof(struct bal_probe_def, field)
+#define MV(field) offsetof(struct bal_move_def, field)
+
+/* `move` stores its three numbers from v on: v[0], v[1], omega. */
+_Static_assert(offsetof(struct bal_move_def, omega) == MV(v) + 2 * sizeof(double),
+               "the numbers of `move` are consecutive doubles of struct bal_move_def");
 
 const struct bal_key bal_scene_keys[] = {
     /* [settings] */
@@ -173,7 +179,10 @@ const struct bal_key bal_scene_keys[] = {
      "... and the disc stresses change by <= this share of the largest between checks"},
     {BAL_SEC_STAGE, "check_every", BAL_KEY_LONG, G(check_every), "100", 0, 1, 1e15, NULL,
      "cycles between checks of the stop rule"},
-    {BAL_SEC_STAGE, "move", BAL_KEY_MOVE, G(moves), NULL, 0, -BIG, BIG, NULL,
+    /* A wall controller's key (walls.c; bal_scene_controls says which): its
+     * numbers go, in order, to consecutive doubles of struct bal_move_def
+     * from `offset` on. */
+    {BAL_SEC_STAGE, "move", BAL_KEY_CONTROL, MV(v), NULL, 0, -BIG, BIG, "WALL v1 v2 omega",
      "repeatable: WALL v1 v2 omega; velocity of P and angular velocity about P (C&S p. 53); "
      "walls not named are at rest; --set replaces the named wall's motion"},
 
@@ -192,6 +201,13 @@ const struct bal_key bal_scene_keys[] = {
 };
 
 const size_t bal_scene_n_keys = sizeof bal_scene_keys / sizeof bal_scene_keys[0];
+
+/* Each wall controller's stage key (a BAL_KEY_CONTROL row above). */
+const struct bal_control_key bal_scene_controls[] = {
+    {"move", BAL_CONTROL_PRESCRIBED},
+};
+
+const size_t bal_scene_n_controls = sizeof bal_scene_controls / sizeof bal_scene_controls[0];
 
 #define SEC(type) sizeof(struct type), offsetof(struct type, given), \
     offsetof(struct type, key_line)
@@ -220,6 +236,22 @@ int bal_scene_key_index(enum bal_section_kind sec, const char *name)
     return -1;
 }
 
+int bal_scene_key_control(const char *key)
+{
+    for (size_t i = 0; i < bal_scene_n_controls; i++)
+        if (strcmp(bal_scene_controls[i].key, key) == 0)
+            return bal_scene_controls[i].control;
+    return -1;
+}
+
+const char *bal_scene_key_for_control(int control)
+{
+    for (size_t i = 0; i < bal_scene_n_controls; i++)
+        if (bal_scene_controls[i].control == control)
+            return bal_scene_controls[i].key;
+    return NULL;
+}
+
 const struct bal_key *bal_scene_key_at(enum bal_section_kind sec, int k)
 {
     for (size_t i = 0; i < bal_scene_n_keys; i++) {
@@ -229,4 +261,42 @@ const struct bal_key *bal_scene_key_at(enum bal_section_kind sec, int k)
             return &bal_scene_keys[i];
     }
     return NULL;
+}
+
+/* The key list of `ballast keys` and the README: one Markdown table per
+ * section kind. */
+void bal_scene_print_keys(FILE *out)
+{
+    static const char *const type_names[] = {"number", "integer", "two numbers", "name",
+                                             "word", NULL};
+    for (int k = 0; k < BAL_SEC_COUNT; k++) {
+        const struct bal_section_info *sec = &bal_scene_sections[k];
+        fprintf(out, "\n`[%s%s]` — %s\n\n", sec->name, sec->named ? " NAME" : "", sec->doc);
+        fprintf(out, "| key | type | default | range | meaning |\n|---|---|---|---|---|\n");
+        for (int i = 0;; i++) {
+            const struct bal_key *key = bal_scene_key_at((enum bal_section_kind)k, i);
+            if (!key)
+                break;
+            char range[96] = "";
+            /* A word's choices are printed whole (the probe quantities are
+             * longer than any fixed buffer kept for a numeric range). */
+            const char *shown = range;
+            if (key->type == BAL_KEY_ENUM)
+                shown = key->choices;
+            else if (key->type == BAL_KEY_DOUBLE || key->type == BAL_KEY_LONG) {
+                char lo[32] = "", hi[32] = "";
+                if (key->min > -1e300)
+                    snprintf(lo, sizeof lo, "%g", key->min);
+                if (key->max < 1e300)
+                    snprintf(hi, sizeof hi, "%g", key->max);
+                if (*lo || *hi)
+                    snprintf(range, sizeof range, "[%s, %s]", *lo ? lo : "-inf", *hi ? hi : "inf");
+            }
+            /* A controller's key shows its form ("WALL v1 v2 omega") as its type. */
+            const char *type = key->type == BAL_KEY_CONTROL ? key->choices : type_names[key->type];
+            fprintf(out, "| `%s` | %s | %s | %s | %s |\n", key->name, type,
+                    key->def ? (*key->def ? key->def : "(none)") : (key->required ? "required" : "(none)"),
+                    shown, key->doc);
+        }
+    }
 }

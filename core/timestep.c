@@ -1,6 +1,10 @@
 /*
  * timestep.c — the critical time-step estimate.
  *
+ * Kept whole (about 670 lines, 90 of them the derivation below): one
+ * estimate — the contacts at the start, the two bounds on the network and
+ * the coordination bound — whose parts serve only each other.
+ *
  * 1. The paper's estimate (C&S p. 53), kept for comparison.  BALL estimates
  *    the critical step from a single degree of freedom, a mass m on a spring
  *    k: Δt = 2 √(m/k).  bal_timestep_single_spring() takes, for every disc,
@@ -89,7 +93,8 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "sim.h"
+#include "timestep.h"
+#include "walls.h"
 
 /* The estimate is this share of the bound 2/(ω (√(1+ζ²) + ζ)).  At the
  * bound itself the centred scheme is only marginally stable: its conserved

@@ -1,6 +1,9 @@
 /*
  * bench.c — the dense-packing benchmark behind `make bench`.
  *
+ * Kept whole (about 1000 lines): one benchmark program, whose modes share
+ * the packing, the settling, the timing and the reporting.
+ *
  * For each N it loads the benchmark scene through the ordinary scene
  * machinery (setting fill.pack.n and fill.pack.columns), runs every stage
  * but the last untimed (the packing falls and settles under gravity), then
@@ -45,7 +48,7 @@
 #include <unistd.h>
 
 #include "ballast.h"
-#include "sim.h"
+#include "state.h"
 
 #define REPEATS 5
 #define TARGET_SECONDS 2.0
@@ -88,7 +91,7 @@ static double timed_steps(struct bal_sim *sim, long steps, struct bal_error *err
 {
     const double t0 = now();
     for (long k = 0; k < steps; k++)
-        if (bal_sim_cycle(sim, err))
+        if (bal_sim_step(sim, err))
             return -1;
     return now() - t0;
 }
@@ -164,7 +167,7 @@ static int prepare(const char *path, long n, const struct options *o, struct pre
     struct bal_sim *sim = p->sim;
     const struct bal_scene *sc = &p->sc;
     /* Settle on every core: the packing is bitwise the one a single thread
-     * settles (struct bal_par, sim.h), in less time.  Timed on one thread
+     * settles (struct bal_par, state.h), in less time.  Timed on one thread
      * (or as the caller then sets). */
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     cores = cores < 1 ? 1 : cores > BAL_MAX_THREADS ? BAL_MAX_THREADS : cores;
@@ -173,7 +176,7 @@ static int prepare(const char *path, long n, const struct options *o, struct pre
     for (int g = 0; g + 1 < sc->n_stages; g++) {
         bal_sim_set_stage(sim, g);
         for (long c = 0; c < sc->stages[g].cycles; c++, p->settled++)
-            if (bal_sim_cycle(sim, &err)) {
+            if (bal_sim_step(sim, &err)) {
                 fprintf(stderr, "bench: settling: %s\n", err.msg);
                 prepared_free(p);
                 return 1;
@@ -187,7 +190,7 @@ static int prepare(const char *path, long n, const struct options *o, struct pre
     while (!o->flowing && bal_measure_kinetic(sim) > SETTLED_EK_OVER_EE * bal_measure_elastic(sim) &&
            extra < settle_blocks_cap(n) * sc->stages[0].cycles) {
         for (long c = 0; c < sc->stages[0].cycles; c++, extra++, p->settled++)
-            if (bal_sim_cycle(sim, &err)) {
+            if (bal_sim_step(sim, &err)) {
                 fprintf(stderr, "bench: settling: %s\n", err.msg);
                 prepared_free(p);
                 return 1;
@@ -518,12 +521,12 @@ static int settle_packing(const char *path, long n, double **xyt, int *n_out)
     for (int g = 0; rc == 0 && g + 1 < sc.n_stages; g++) {
         bal_sim_set_stage(ref, g);
         for (long c = 0; rc == 0 && c < sc.stages[g].cycles; c++, settle++)
-            rc = bal_sim_cycle(ref, &err) != BAL_OK;
+            rc = bal_sim_step(ref, &err) != BAL_OK;
     }
     while (rc == 0 && bal_measure_kinetic(ref) > SETTLED_EK_OVER_EE * bal_measure_elastic(ref) &&
            settle < (MAX_SETTLE_BLOCKS + 1) * sc.stages[0].cycles)
         for (long c = 0; rc == 0 && c < sc.stages[0].cycles; c++, settle++)
-            rc = bal_sim_cycle(ref, &err) != BAL_OK;
+            rc = bal_sim_step(ref, &err) != BAL_OK;
     *xyt = rc ? NULL : malloc(3 * sizeof **xyt * (size_t)ref->n);
     if (rc == 0 && *xyt == NULL) {
         snprintf(err.msg, sizeof err.msg, "out of memory");

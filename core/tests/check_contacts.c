@@ -27,14 +27,14 @@
 static double t_dn(const struct tfx *f, const struct bal_pairs *L, long c)
 {
     double dn, ds;
-    bal_contact_dashpots(f->sim, L, c, &dn, &ds);
+    bal_measure_dashpots(f->sim, L, c, &dn, &ds);
     return dn;
 }
 
 static double t_ds(const struct tfx *f, const struct bal_pairs *L, long c)
 {
     double dn, ds;
-    bal_contact_dashpots(f->sim, L, c, &dn, &ds);
+    bal_measure_dashpots(f->sim, L, c, &dn, &ds);
     return ds;
 }
 
@@ -374,7 +374,7 @@ START_TEST(contacts_sliding_probe)
 }
 END_TEST
 
-/* Two materials: k = 2 k_a k_b / (k_a + k_b) (sim.c build_laws: springs in
+/* Two materials: k = 2 k_a k_b / (k_a + k_b) (build.c build_laws: springs in
  * series scaled so equal materials keep their value), and k_s = k_n when ks
  * is omitted.  k_a = 2.9e4, k_b = 6.1e4 → k = 3.9311...e4. */
 START_TEST(contacts_pair_stiffness)

@@ -318,7 +318,7 @@ END_TEST
  * gravity).  The disc sinks by v, both springs shorten by v:
  *   F_a = k_a v,  F_b = k_b v,  F_a + F_b = m g
  *   →  F_a = m g k_a/(k_a + k_b),  F_b = m g k_b/(k_a + k_b).
- * k_c is the pair law's kn (sim.h); the scene makes k_a ≠ k_b. */
+ * k_c is the pair law's kn (build.c); the scene makes k_a ≠ k_b. */
 START_TEST(exact_load_shared_by_stiffness)
 {
     const double r = 0.52, xc = 0.1, m = mass(r);

@@ -160,7 +160,7 @@ START_TEST(grid_candidates_sparse_scene)
             if (dx * dx + dy * dy < reach * reach) {
                 const struct bal_pairs *L;
                 n_exp++;
-                all_found &= bal_sim_find_contact(s, 0, i, 0, j, &L) >= 0;
+                all_found &= bal_pairs_find_contact(s, 0, i, 0, j, &L) >= 0;
             }
         }
     }

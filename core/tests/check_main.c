@@ -119,7 +119,7 @@ int t_probe(const struct tfx *f, const char *name)
 
 double t_probe_value(const struct tfx *f, const char *name)
 {
-    return bal_measure_probe(f->sim, t_probe(f, name));
+    return bal_probes_value(f->sim, t_probe(f, name));
 }
 
 static void resolve(const struct tfx *f, const char *name, int *is_wall, int *index)
@@ -145,7 +145,7 @@ long t_contact(const struct tfx *f, const char *a, const char *b, const struct b
     int aw = 0, ai = 0, bw = 0, bi = 0;
     resolve(f, a, &aw, &ai);
     resolve(f, b, &bw, &bi);
-    long c = bal_sim_find_contact(f->sim, aw, ai, bw, bi, list);
+    long c = bal_pairs_find_contact(f->sim, aw, ai, bw, bi, list);
     ck_assert_msg(c >= 0, "no candidate for the contact %s–%s", a, b);
     return c;
 }

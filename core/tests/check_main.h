@@ -20,8 +20,18 @@
 #include <check.h>
 
 #include "ballast.h"
+#include "build.h"
+#include "contacts.h"
+#include "energy.h"
+#include "grid.h"
+#include "integrate.h"
+#include "measure.h"
+#include "pairs.h"
 #include "scene.h"
-#include "sim.h"
+#include "specimen.h"
+#include "state.h"
+#include "timestep.h"
+#include "walls.h"
 
 Suite *suite_scene(void);
 Suite *suite_contacts(void);

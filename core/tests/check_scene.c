@@ -139,9 +139,39 @@ START_TEST(scene_parse_values)
     ck_assert_int_eq(sc->stages[0].moves[0].line, 32);
     ck_assert_double_eq_tol(sc->stages[0].moves[0].v[1], -0.0625, 0.0625 * PARSE_REL);
     ck_assert_double_eq_tol(sc->stages[0].moves[0].omega, 0.015, 0.015 * PARSE_REL);
+    ck_assert_int_eq(sc->stages[0].moves[0].control, BAL_CONTROL_PRESCRIBED);
     ck_assert_int_eq(sc->n_probes, 1);
     ck_assert_int_eq(sc->probes[0].kind, BAL_PROBE_WALL_F2);
     ck_assert_str_eq(sc->probes[0].a, "floor");
+}
+END_TEST
+
+/* Every wall controller's key names a controller, takes at most
+ * BAL_CONTROL_VALUES_MAX numbers after the wall's name (the parser's
+ * buffer), and stores them within struct bal_move_def; every controller
+ * has a key. */
+START_TEST(scene_control_keys)
+{
+    int keys = 0;
+    for (int i = 0;; i++) {
+        const struct bal_key *key = bal_scene_key_at(BAL_SEC_STAGE, i);
+        if (!key)
+            break;
+        if (key->type != BAL_KEY_CONTROL)
+            continue;
+        keys++;
+        const int control = bal_scene_key_control(key->name);
+        ck_assert_msg(control >= 0, "stage key %s names no controller", key->name);
+        ck_assert_str_eq(bal_scene_key_for_control(control), key->name);
+        ck_assert_msg(strncmp(key->choices, "WALL ", 5) == 0, "%s: form '%s'", key->name,
+                      key->choices);
+        size_t n = 0;
+        for (const char *c = key->choices; (c = strchr(c, ' ')) != NULL; c++)
+            n++;
+        ck_assert_msg(n >= 1 && n <= BAL_CONTROL_VALUES_MAX, "%s: %zu numbers", key->name, n);
+        ck_assert(key->offset + n * sizeof(double) <= sizeof(struct bal_move_def));
+    }
+    ck_assert_int_eq(keys, (int)bal_scene_n_controls);
 }
 END_TEST
 
@@ -593,11 +623,11 @@ START_TEST(scene_pile_counts)
         p.L = L;
         p.d = 0.83;
         p.slope = 0;
-        ck_assert_msg(bal_sim_pile_count(&p) == pile_n30(L), "slope 30, L = %ld: %ld discs", L,
-                      bal_sim_pile_count(&p));
+        ck_assert_msg(bal_specimen_pile_count(&p) == pile_n30(L), "slope 30, L = %ld: %ld discs", L,
+                      bal_specimen_pile_count(&p));
         p.slope = 1;
-        ck_assert_msg(bal_sim_pile_count(&p) == L * (L + 1) / 2, "slope 60, L = %ld: %ld discs", L,
-                      bal_sim_pile_count(&p));
+        ck_assert_msg(bal_specimen_pile_count(&p) == L * (L + 1) / 2, "slope 60, L = %ld: %ld discs", L,
+                      bal_specimen_pile_count(&p));
     }
 }
 END_TEST
@@ -953,6 +983,7 @@ Suite *suite_scene(void)
     tcase_add_test(tc, scene_every_default_parses);
     tcase_add_test(tc, scene_parse_values);
     tcase_add_test(tc, scene_angles_are_degrees);
+    tcase_add_test(tc, scene_control_keys);
     tcase_add_test(tc, scene_set_overrides);
     tcase_add_test(tc, scene_load_file);
     tcase_add_test(tc, scene_print_keys_lists_every_key);

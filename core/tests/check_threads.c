@@ -1,6 +1,6 @@
 /*
  * check_threads.c — suite "threads": a cycle on several threads (OpenMP;
- * struct bal_par in sim.h) gives bitwise the results of one thread.
+ * struct bal_par in state.h) gives bitwise the results of one thread.
  *
  * The disc–disc list is cut into ranges, one per thread; a range logs what
  * it adds to the discs an earlier range also reaches, and the logs are

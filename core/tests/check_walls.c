@@ -2,8 +2,8 @@
  * check_walls.c — suite "walls": straight rigid walls (C&S Fig. 4, p. 53):
  * the closest point of the segment A = P + h1 e … B = P + h2 e, disc–wall
  * contacts on the interior and at the end points, the contact normal, the
- * wall resultant (probes wall_f1, wall_f2, wall_moment, wall_ecc) and walls
- * moved by a stage.
+ * wall resultant (probes wall_f1, wall_f2, wall_moment, wall_ecc), walls
+ * moved by a stage, and the controllers a stage gives its walls.
  *
  * A disc–wall contact is a disc–disc contact whose body y is the wall's
  * closest point c, of radius 0: e_c = (c − x)/|c − x| points from the disc
@@ -274,6 +274,55 @@ START_TEST(walls_stage_motion)
 }
 END_TEST
 
+/* Each stage gives the walls it names their controller and its parameters
+ * (`move` names the prescribed one: V and ω as given); a wall the stage
+ * does not name is at rest, with no controller, whatever the stage before
+ * did.  Stage a moves w1 only, stage b w2 only, stage c neither. */
+START_TEST(walls_stage_controllers)
+{
+    char text[T_TEXT_MAX];
+    snprintf(text, sizeof text,
+             "[settings]\ndt = %.17g\n"
+             "[material g]\nkn = 5.3e4\ndensity = 2.385\n"
+             "[wall w1]\np = 0 0\nangle = 0\nh1 = -1\nh2 = 1\nmaterial = g\n"
+             "[wall w2]\np = 0 3\nangle = 90\nh1 = -1\nh2 = 1\nmaterial = g\n"
+             "[disc d]\nx = 5 5\nr = 0.5\nmaterial = g\n"
+             "[stage a]\ncycles = 3\nmove = w1 0.13 -0.07 0.21\n"
+             "[stage b]\ncycles = 2\nmove = w2 -0.4 0.25 0\n"
+             "[stage c]\ncycles = 1\n",
+             DT);
+    struct tfx *f = tfx_new(text, "controllers");
+    struct bal_sim *s = f->sim;
+    const struct bal_wall *w1 = &s->walls[0], *w2 = &s->walls[1];
+
+    bal_sim_set_stage(s, 0);
+    ck_assert_ptr_nonnull(w1->controller);
+    ck_assert_str_eq(w1->controller->name, "prescribed");
+    ck_assert_ptr_eq(w1->move, &f->sc.stages[0].moves[0]);
+    ck_assert(w1->v[0] == 0.13 && w1->v[1] == -0.07 && w1->omega == 0.21);
+    ck_assert_ptr_null(w2->controller);
+    ck_assert(w2->v[0] == 0 && w2->v[1] == 0 && w2->omega == 0);
+    ck_assert_int_eq(s->walls_controlled, 0); /* prescribed: nothing per cycle */
+
+    bal_sim_set_stage(s, 1);
+    ck_assert_ptr_null(w1->controller);
+    ck_assert_ptr_null(w1->move);
+    ck_assert(w1->v[0] == 0 && w1->v[1] == 0 && w1->omega == 0);
+    ck_assert_str_eq(w2->controller->name, "prescribed");
+    ck_assert(w2->v[0] == -0.4 && w2->v[1] == 0.25 && w2->omega == 0);
+
+    /* The prescribed controller acts only when its stage begins: a cycle
+     * (which runs the controllers after the wall forces) keeps V and ω. */
+    t_steps(f, 2);
+    ck_assert(w2->v[0] == -0.4 && w2->v[1] == 0.25 && w2->omega == 0);
+
+    bal_sim_set_stage(s, 2);
+    ck_assert_ptr_null(w1->controller);
+    ck_assert_ptr_null(w2->controller);
+    ck_assert(w2->v[0] == 0 && w2->v[1] == 0);
+}
+END_TEST
+
 /* A disc at rest against a wall that moves with V = (0.13, −0.07) and turns
  * at ω = 0.21 about P.  After cycle 1 (wall moved first, as in eq. 1):
  *   P1 = P0 + V Δt, α1 = α0 + ω Δt, c = P1 + h e1 with h = (x − P1)·e1,
@@ -342,6 +391,7 @@ Suite *suite_walls(void)
     tcase_add_checked_fixture(tc, NULL, tfx_teardown);
     tcase_add_test(tc, walls_closest_point);
     tcase_add_test(tc, walls_stage_motion);
+    tcase_add_test(tc, walls_stage_controllers);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("contact");

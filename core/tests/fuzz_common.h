@@ -20,7 +20,7 @@
  *     spread over more than the largest number (the neighbour grid), and
  *     out of memory; so are --set errors (they name the --set);
  *   - finite: when bal_sim_run returns BAL_OK, every quantity the run reports
- *     is finite: each probe (bal_measure_probe), bal_measure_kinetic,
+ *     is finite: each probe (bal_probes_value), bal_measure_kinetic,
  *     bal_measure_elastic, bal_measure_unbalanced, every field of
  *     bal_energy_report (relative may be +inf only when throughput is 0, as
  *     energy.c documents), and the time, dt, dt_estimate and dt_fraction of
@@ -48,7 +48,8 @@
 
 #include "ballast.h"
 #include "scene.h"
-#include "sim.h"
+#include "specimen.h"
+#include "state.h"
 
 #define FUZZ_MAX_DISCS 2000
 #define FUZZ_MAX_DISCS_ALL_PAIRS 200
@@ -236,7 +237,7 @@ static void fuzz_check_finite(const struct bal_sim *sim, const struct bal_scene 
     if (fuzz_skip("finite"))
         return;
     for (int p = 0; p < sc->n_probes; p++) {
-        const double v = bal_measure_probe(sim, p);
+        const double v = bal_probes_value(sim, p);
         if (!isfinite(v)) {
             char q[32];
             fuzz_quantity_name(sc->probes[p].kind, q, sizeof q);
@@ -299,8 +300,8 @@ static long fuzz_count_discs(const struct bal_scene *s)
             return n;
     }
     for (int p = 0; p < s->n_piles; p++) {
-        /* bal_sim_pile_count loops over the rows: at most L of them. */
-        n += bal_sim_pile_count(&s->piles[p]);
+        /* bal_specimen_pile_count loops over the rows: at most L of them. */
+        n += bal_specimen_pile_count(&s->piles[p]);
         if (n > FUZZ_MAX_DISCS)
             return n;
     }
@@ -379,7 +380,7 @@ static void fuzz_simulate(struct bal_scene *sc, const char *text, struct fuzz_ou
     for (int k = 0; st == BAL_OK && k < 3; k++)
         st = bal_sim_step(sim, &err);
     for (int p = 0; p < sc->n_probes; p++)
-        (void)bal_measure_probe(sim, p);
+        (void)bal_probes_value(sim, p);
     (void)bal_measure_unbalanced(sim);
     bal_energy_report(sim, &out->e);
     struct bal_run_info info;

@@ -26,7 +26,7 @@
  * The simulation is skipped when it would be too big for a fuzzing
  * iteration (memory or time), which is a limit of this harness, not of
  * ballast: more than FUZZ_MAX_DISCS discs (counted as bal_sim_create counts
- * them: [disc] sections, fill n, bal_sim_pile_count), more than
+ * them: [disc] sections, fill n, bal_specimen_pile_count), more than
  * FUZZ_MAX_DISCS_ALL_PAIRS with grid = off (every pair is a candidate).
  */
 #include <stddef.h>

@@ -1,6 +1,10 @@
 /*
- * sim.h — internal: the simulation state and the module interfaces of the
- * step pipeline.  Not part of the public API; the Check tests include it.
+ * state.h — internal: the state of a simulation, struct bal_sim and its
+ * parts, with the few inline helpers that read it.  Every module of the
+ * step includes it; it has no functions of its own to call, so it sits
+ * below them all.  The behaviour lives in the modules, each with its own
+ * header (pairs.h, grid.h, contacts.h, walls.h, integrate.h, ...).  Not
+ * part of the public API; the Check tests and the benchmark include it.
  *
  * Layout.  Discs are struct-of-arrays in cell order: sorted along a
  * row-major cell grid at creation and again every BAL_REORDER_EVERY
@@ -8,9 +12,10 @@
  * sums the pair loop adds to (force and moment; the dashpots' share) keep a
  * disc's three together, so that in a packing larger than the cache the
  * loop has fewer streams to wait on.  `id[i]` is the disc's index in scene
- * order (discs of [disc] sections first, then those of each [fill]);
- * outputs are written in that order.  A re-sort renumbers the discs and
- * the keys of the candidate lists with them (new2old).
+ * order (discs of [disc] sections first, then those of each [fill] and
+ * [pile]: specimen.c); outputs are written in that order.  A re-sort
+ * renumbers the discs and the keys of the candidate lists with them
+ * (new2old).
  *
  * Contacts.  Two flat candidate lists, disc–disc and disc–wall, each sorted
  * by key = (lo << 32) | hi (pair_key(); not stored: it is i and j).  A
@@ -18,15 +23,18 @@
  * F_s) in parallel arrays; a candidate whose bodies do not overlap has zero
  * history.  When the neighbour list is rebuilt, the new candidate list is
  * merged with the old one in one linear pass, so history survives rebuilds
- * (contacts.c).
+ * (pairs.c, grid.c).
  */
-#ifndef BAL_SIM_H
-#define BAL_SIM_H
+#ifndef BAL_STATE_H
+#define BAL_STATE_H
 
 #include <stdint.h>
 
 #include "ballast.h"
 #include "laws.h"
+
+struct bal_integrator_type;      /* a law of motion: integrate.h */
+struct bal_wall_controller_type; /* how a stage drives a wall: walls.h */
 
 #define BAL_PI 3.14159265358979323846
 
@@ -35,7 +43,7 @@
  * exists only when `shear` is set and the normal dashpot (dn) only when
  * `damping` is: a frictionless, undamped scene carries neither, and its
  * rebuilds do not copy them.  The disc–disc list never stores its dashpot
- * forces (they are recomputed for reports: bal_contact_dashpots); the wall
+ * forces (they are recomputed for reports: bal_measure_dashpots); the wall
  * list does.  Read F_s through pair_fs(). */
 struct bal_pairs {
     long n, cap;
@@ -63,7 +71,12 @@ struct bal_wall {
     double e[2];           /* (cos α, sin α) */
     double h1, h2;         /* end multipliers */
     int material;
-    double v[2], omega;    /* current motion (from the stage) */
+    double v[2], omega;    /* velocity of P and angular velocity about P for the next
+                            * move, set by its controller */
+    const struct bal_wall_controller_type *controller; /* the current stage's, or NULL:
+                            * the stage leaves the wall at rest (walls.c) */
+    const struct bal_move_def *move; /* the stage's line for the wall: the controller's
+                            * parameters (scene data), or NULL */
     /* Resultant of the contact forces exerted by the discs on the wall,
      * accumulated in the last cycle. */
     double f[2];           /* F1, F2 */
@@ -142,20 +155,6 @@ struct bal_probe_ref {
     int b_wall, b;
 };
 
-/* A law of motion (integrate.c), chosen once by settings.integrator.  A
- * cycle calls `positions` before the force evaluation and `velocities`
- * after it; `previous` gives the velocities the contact law read in the last
- * cycle (for recomputing dashpot forces).  `staggered`: after a cycle the
- * stored velocities are v_{N+1/2}, so measurements at t_N average them with
- * `previous` (C&S eq. 31); otherwise the stored velocities are v_N. */
-struct bal_integrator_type {
-    const char *name;
-    void (*positions)(struct bal_sim *s);
-    void (*velocities)(struct bal_sim *s);
-    void (*previous)(const struct bal_sim *s, int i, double *vx, double *vy, double *w);
-    int staggered;
-};
-
 /* Several threads in one cycle (OpenMP), with results bitwise those of one
  * thread (contacts.c, integrate.c):
  * - the disc–disc list is cut into ranges of whole chunks, one per thread.
@@ -186,6 +185,14 @@ struct bal_par {
     double *block_sums;          /* per block of discs, 2 each: a pass's sums (integrate.c) */
 };
 #define BAL_DISC_BLOCK 4096          /* discs per block */
+
+/* The two largest squared displacements of any disc since the lists were
+ * built, d1_sq >= d2_sq (zero without the grid): what the position pass of
+ * a cycle returns (integrate.c) and the neighbour search judges (grid.c,
+ * bal_grid_due).  Each block's are in par.block_sums. */
+struct bal_moves {
+    double d1_sq, d2_sq;
+};
 
 /* Blocks of n discs; at least one, so that block_sums always exists. */
 static inline int bal_disc_blocks(int n)
@@ -224,6 +231,8 @@ struct bal_sim {
     /* walls */
     int n_walls;
     struct bal_wall *walls;
+    int walls_controlled;        /* walls of this stage whose controller acts in every
+                                  * cycle: 0 lets a cycle skip them all (walls.c) */
 
     /* materials */
     double *density;             /* per material: mass per area */
@@ -309,31 +318,17 @@ static inline double bal_mass(const struct bal_sim *s, int i)
     return s->density[s->mat[i]] * BAL_PI * s->r[i] * s->r[i];
 }
 
+/* The parameters of the contact-law chain (laws.h) that do not depend on
+ * the pair, as the loops read them. */
+static inline struct bal_law_params bal_law_params_of(const struct bal_sim *s)
+{
+    return (struct bal_law_params){s->normal_law, s->nu, s->delta0, s->gamma_n, s->psi, s->dt};
+}
+
 static inline double bal_inertia(const struct bal_sim *s, int i)
 {
     return 0.5 * bal_mass(s, i) * s->r[i] * s->r[i];
 }
-
-/* contacts.c */
-enum bal_status bal_pairs_reserve(struct bal_pairs *p, long cap);
-void bal_pairs_free(struct bal_pairs *p);
-void bal_pairs_merge_history(struct bal_pairs *fresh, const struct bal_pairs *old);
-/* Position of `key` in the sorted list p, or -1 (binary search). */
-long bal_pairs_find(const struct bal_pairs *p, uint64_t key);
-bal_pair_loop_fn bal_contacts_select(int shear, int damping);
-/* Cut the disc–disc list into ranges for s->par.threads threads (the pair
- * loop calls it after each rebuild); reserve the per-chunk sums for the
- * list's capacity (after every reserve of s->pp); free it all. */
-void bal_par_plan(struct bal_sim *s);
-enum bal_status bal_par_reserve_chunks(struct bal_sim *s);
-void bal_par_free(struct bal_par *par);
-void bal_contacts_walls(struct bal_sim *s);
-/* The dashpot forces D_n, D_s of contact c of list p in the last cycle:
- * stored for walls, recomputed for disc pairs from the geometry at t_N and
- * the velocities v_{N-1/2} (recovered), exactly as the cycle computed them.
- * Zero for a contact that is not touching. */
-void bal_contact_dashpots(const struct bal_sim *s, const struct bal_pairs *p, long c,
-                          double *dn, double *ds);
 
 /* The cell, 0 to n - 1, of a point c cell sizes from a grid's origin: the
  * conversion to int is range-checked (a point beyond the grid, or not a
@@ -344,141 +339,11 @@ static inline int bal_cell_index(double c, int n)
     return c >= 0 ? (c < n ? (int)c : n - 1) : 0;
 }
 
-/* grid.c */
 /* Squared displacement of disc i since the lists were built. */
 static inline double bal_moved_sq(const struct bal_sim *s, int i)
 {
     const double dx = s->x[i] - s->x_ref[i], dy = s->y[i] - s->y_ref[i];
     return dx * dx + dy * dy;
 }
-enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err);
-/* Called when the two largest displacements since the last rebuild, d_1
- * >= d_2, reach the skin together: is there a pair outside the list that
- * can touch now?  1 if so (or if it cannot tell cheaply), 0 if the lists
- * still hold every contact.  Reads the displacement maxima of each block of
- * discs from par.block_sums (the position pass's). */
-int bal_grid_lists_broken(const struct bal_sim *s, double d1);
-/* Re-sort the discs into cell order of their current positions, carrying
- * every per-disc array and the probes along, then rebuild the lists (their
- * history found through the permutation). */
-enum bal_status bal_grid_reorder(struct bal_sim *s, struct bal_error *err);
-void bal_grid_scratch_free(struct bal_rebuild_scratch *rs);
-/* The permutation that puts discs in row-major order of cells of side h
- * (order[new] = old); ties keep their order, so it is deterministic.
- * `keys` is scratch of n entries. */
-void bal_grid_cell_order(const double *x, const double *y, int n, double h,
-                         struct bal_cell_key *keys, int32_t *order);
-/* Rebuilds between two re-sorts: the order decays only as discs flow, and a
- * re-sort costs about as much as a few rebuilds. */
-#define BAL_REORDER_EVERY 20
-void bal_grid_free(struct bal_grid *g);
-/* With fewer discs than this, `grid = auto` uses all pairs.  Measured with
- * `build/bench --grid cases/bench/dense.scene` (README, "Neighbour search"):
- * the Verlet-listed grid was faster at every N >= 4, settled or falling
- * (1.2-1.5x at N = 4-16, 14x at N = 256), so all pairs serve only scenes of
- * two or three discs, whose single list is built once. */
-#define BAL_GRID_CROSSOVER 4
 
-/* walls.c */
-void bal_walls_move(struct bal_sim *s);
-/* Closest point of wall w to (x, y); returns squared distance. */
-double bal_walls_closest(const struct bal_wall *w, double x, double y,
-                         double *cx, double *cy);
-/* Unit normal from (x, y) to the closest point of wall w (the wall's own
- * normal when the point lies on it); returns the distance. */
-double bal_walls_normal(const struct bal_wall *w, double x, double y, double *ex, double *ey);
-
-/* integrate.c */
-/* Set s->integ from the scene and reserve what it needs (gear5: its
- * derivative columns); after the discs exist. */
-enum bal_status bal_integrate_setup(struct bal_sim *s, struct bal_error *err);
-void bal_integrate_free(struct bal_sim *s);
-/* After bal_grid_reorder: carry the integrator's per-disc columns along the
- * permutation s->new2old. */
-void bal_integrate_reordered(struct bal_sim *s);
-/* Per-disc columns of gear5: scaled derivatives r2..r5 of x, y, θ (12), the
- * predicted velocities the contact law read (3), one scratch column. */
-#define BAL_GEAR_COLUMNS 16
-/* The two halves of the law of motion of s->integ (one dispatch each). */
-void bal_integrate_positions(struct bal_sim *s);
-void bal_integrate_velocities(struct bal_sim *s);
-/* The velocities of disc i that the contact law read in the last cycle:
- * centred and verlet v_{N-1/2} (recovered from the stored velocities and
- * the force sums by inverting the last update), gear5 the predicted v_N. */
-void bal_integrate_previous(const struct bal_sim *s, int i, double *vx, double *vy, double *w);
-
-/* energy.c */
-/* Take the baseline of the audit (after the first cycle). */
-void bal_energy_begin(struct bal_sim *s);
-/* Add the walls' work of this cycle (after the wall loop). */
-void bal_energy_walls(struct bal_sim *s);
-/* Add the losses of global damping and of the contact dashpots in this
- * cycle (after the velocity update). */
-void bal_energy_global(struct bal_sim *s);
-void bal_energy_dashpots(struct bal_sim *s);
-/* Around a cycle in which g_fac changes (before it moves the discs, after
- * the velocity update): the gravity's work in intervals of constant g_fac. */
-void bal_energy_gravity_before(struct bal_sim *s);
-void bal_energy_gravity(struct bal_sim *s);
-/* BAL_EUNSTABLE naming the worst contact if an overlap exceeds the budget. */
-enum bal_status bal_energy_overlap(const struct bal_sim *s, struct bal_error *err);
-/* BAL_EUNSTABLE if the run created more energy than settings.energy_guard
- * times the energy that went through it. */
-enum bal_status bal_energy_guard(const struct bal_sim *s, struct bal_error *err);
-
-/* timestep.c */
-double bal_timestep_estimate(const struct bal_sim *s);
-double bal_timestep_single_spring(const struct bal_sim *s);
-void bal_timestep_detail(const struct bal_sim *s, struct bal_dt_detail *d);
-
-/* measure.c */
-/* Velocities of disc i at t_N (eq. 31), recovered after a cycle. */
-void bal_measure_velocity(const struct bal_sim *s, int i, double *vx, double *vy, double *w);
-/* Per disc, Σ_c f^c ⊗ l^c over its contacts (MLH eq. 8 without 1/V), into
- * m[4 i .. 4 i + 3] = xx, xz, zx, zz (z vertical). */
-void bal_measure_moments(const struct bal_sim *s, double *m);
-/* The volume V_i of MLH eq. (8) for one disc: the hexagonal cell of a disc of
- * its size in a triangular packing, 2 sqrt(3) r^2. */
-double bal_measure_disc_volume(double r);
-/* The energy stored by the normal spring of a contact with pair law L:
- * F_n²/(2 k_n) for the incremental law, ∫ F_n dδ at overlap δ for the power law. */
-double bal_measure_normal_energy(const struct bal_sim *s, const struct bal_pair_law *L, double fn,
-                                 double delta);
-
-/* sim.c */
-/* Scene-order index of the disc in slot i; name of wall k; the C&S contact
- * point of disc i with disc or wall j (as in contacts.tsv). */
-int bal_sim_disc_id(const struct bal_sim *s, int i);
-const char *bal_sim_wall_name(const struct bal_sim *s, int k);
-/* Candidate c of the disc–disc list (walls = 0) or of the disc–wall list
- * (walls = 1): its overlap δ (negative: a gap), the smaller radius of its
- * bodies and their pair law; and the names of its bodies for messages,
- * "A" and "disc B" or "wall W". */
-double bal_sim_overlap(const struct bal_sim *s, int walls, long c, double *rmin,
-                       const struct bal_pair_law **law);
-void bal_sim_pair_names(const struct bal_sim *s, int walls, long c, char *a, size_t na, char *b,
-                        size_t nb);
-void bal_sim_contact_point(const struct bal_sim *s, int i, int is_wall, int j, double *px,
-                           double *py);
-/* Most discs a scene may make (array indices are int32_t). */
-#define BAL_MAX_DISCS 100000000L
-/* A property of a disc, for naming where the scene set it. */
-enum bal_disc_prop { BAL_DISC_PLACE, BAL_DISC_SIZE, BAL_DISC_SPEED, BAL_DISC_SPIN };
-/* "FILE:LINE: KEY: disc NAME" of the key that set property `prop` of the
- * disc with scene-order index id: its [disc] key, or the key of the [fill]
- * or [pile] that generated it (the section's header line when the key was
- * left at its default). */
-void bal_sim_disc_origin(const struct bal_scene *sc, int id, enum bal_disc_prop prop, char *buf,
-                         size_t size);
-/* Bytes the simulation holds while it steps (every array at its allocated
- * capacity), split into what scales with discs and with candidate pairs. */
-void bal_sim_memory(const struct bal_sim *s, double *disc_bytes, double *pair_bytes);
-/* Number of rows and of discs a [pile] generates. */
-long bal_sim_pile_rows(const struct bal_pile_def *p);
-long bal_sim_pile_count(const struct bal_pile_def *p);
-enum bal_status bal_sim_cycle(struct bal_sim *s, struct bal_error *err);
-/* Candidate index of the contact between two bodies, or -1. */
-long bal_sim_find_contact(const struct bal_sim *s, int a_wall, int a, int b_wall, int b,
-                          const struct bal_pairs **list);
-
-#endif /* BAL_SIM_H */
+#endif /* BAL_STATE_H */

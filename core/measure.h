@@ -1,0 +1,28 @@
+/*
+ * measure.h — internal: what a run reports of its state (measure.c).
+ */
+#ifndef BAL_MEASURE_H
+#define BAL_MEASURE_H
+
+#include "state.h"
+
+/* The dashpot forces D_n, D_s of contact c of list p in the last cycle:
+ * stored for walls, recomputed for disc pairs from the geometry at t_N and
+ * the velocities v_{N-1/2} (recovered), exactly as the cycle computed them.
+ * Zero for a contact that is not touching. */
+void bal_measure_dashpots(const struct bal_sim *s, const struct bal_pairs *p, long c, double *dn,
+                          double *ds);
+/* Velocities of disc i at t_N (eq. 31), recovered after a cycle. */
+void bal_measure_velocity(const struct bal_sim *s, int i, double *vx, double *vy, double *w);
+/* Per disc, Σ_c f^c ⊗ l^c over its contacts (MLH eq. 8 without 1/V), into
+ * m[4 i .. 4 i + 3] = xx, xz, zx, zz (z vertical). */
+void bal_measure_moments(const struct bal_sim *s, double *m);
+/* The volume V_i of MLH eq. (8) for one disc: the hexagonal cell of a disc of
+ * its size in a triangular packing, 2 sqrt(3) r^2. */
+double bal_measure_disc_volume(double r);
+/* The energy stored by the normal spring of a contact with pair law L:
+ * F_n²/(2 k_n) for the incremental law, ∫ F_n dδ at overlap δ for the power law. */
+double bal_measure_normal_energy(const struct bal_sim *s, const struct bal_pair_law *L, double fn,
+                                 double delta);
+
+#endif /* BAL_MEASURE_H */

@@ -1,0 +1,254 @@
+/*
+ * scene_validate.c — what a scene must satisfy as a whole, checked once
+ * before a simulation is built from it (bal_scene_validate).
+ *
+ * The parser (scene.c) has checked each value against its key's type and
+ * range; here come the checks that need more than one line: required keys,
+ * references to other sections (materials, walls, bodies of probes and
+ * moves), names that two bodies would share, settings that need another
+ * (delta0 with the power law or psi), and a scene that would do nothing (no
+ * stage, no disc).  Every message names the file, the line and the key, and
+ * says what was expected.
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "scene.h"
+
+static int line_of(void *item, enum bal_section_kind k, const char *key)
+{
+    int ki = bal_scene_key_index(k, key);
+    int l = ki >= 0 ? bal_scene_item_key_line(item, k)[ki] : 0;
+    return l > 0 ? l : *bal_scene_item_line(item);
+}
+
+/* FAIL_AT(item, kind, key, fmt, args...): at least one argument after fmt. */
+#define FAIL_AT(item, k, key, fmt, ...) \
+    bal_error(err, BAL_EINVAL, "%s:%d: %s: " fmt, s->path, line_of(item, k, key), key, __VA_ARGS__)
+
+static enum bal_status check_required(const struct bal_scene *s, enum bal_section_kind k,
+                                      struct bal_error *err)
+{
+    int n = bal_scene_count(s, k);
+    for (int i = 0; i < n; i++) {
+        void *item = bal_scene_section(s, k, i);
+        uint32_t given = *bal_scene_item_given(item, k);
+        for (int ki = 0;; ki++) {
+            const struct bal_key *key = bal_scene_key_at(k, ki);
+            if (!key)
+                break;
+            if (key->required && !(given & (1u << ki))) {
+                int line = k == BAL_SEC_SETTINGS ? s->settings.key_line[BAL_KEYS_MAX - 1]
+                                                 : *bal_scene_item_line(item);
+                return bal_error(err, BAL_EINVAL, "%s:%d: [%s %s]: %s: required key is missing (%s)",
+                                 s->path, line, bal_scene_sections[k].name,
+                                 k == BAL_SEC_SETTINGS ? "" : bal_scene_item_name(item), key->name,
+                                 key->doc);
+            }
+        }
+    }
+    return BAL_OK;
+}
+
+static enum bal_status check_material_ref(const struct bal_scene *s, void *item,
+                                          enum bal_section_kind k, const char *key,
+                                          const char *value, int need_density,
+                                          struct bal_error *err)
+{
+    int m = bal_scene_find(s, BAL_SEC_MATERIAL, value);
+    if (m < 0)
+        return FAIL_AT(item, k, key, "no [material %s] in the scene", value);
+    if (need_density && !(s->materials[m].density > 0))
+        return FAIL_AT(item, k, key,
+                       "material '%s' has no density > 0, which a disc needs for its mass",
+                       value);
+    return BAL_OK;
+}
+
+/* Is `name` a disc, a wall, or a wall made by a fill's box? */
+static int body_exists(const struct bal_scene *s, const char *name, int *is_wall)
+{
+    if (bal_scene_find(s, BAL_SEC_DISC, name) >= 0) {
+        *is_wall = 0;
+        return 1;
+    }
+    if (bal_scene_find(s, BAL_SEC_WALL, name) >= 0) {
+        *is_wall = 1;
+        return 1;
+    }
+    for (int p = 0; p < s->n_piles; p++) {
+        char nm[2 * BAL_NAME_MAX];
+        snprintf(nm, sizeof nm, "%s_floor", s->piles[p].name);
+        if (s->piles[p].bottom == 0 && strcmp(nm, name) == 0) {
+            *is_wall = 1;
+            return 1;
+        }
+    }
+    static const char *const sides[] = {"_bottom", "_right", "_top", "_left"};
+    for (int f = 0; f < s->n_fills; f++) {
+        if (!s->fills[f].box)
+            continue;
+        for (int k = 0; k < 4; k++) {
+            char nm[2 * BAL_NAME_MAX];
+            snprintf(nm, sizeof nm, "%s%s", s->fills[f].name, sides[k]);
+            if (strcmp(nm, name) == 0) {
+                *is_wall = 1;
+                return 1;
+            }
+        }
+    }
+    return 0;
+}
+
+/* Probes and moves find bodies by name, so a disc, a wall and the walls a
+ * fill box or a smooth pile makes must not share one (else the first found
+ * wins silently; seen by reading, while fuzzing). */
+static enum bal_status check_body_names(const struct bal_scene *s, struct bal_error *err)
+{
+    static const char *const sides[] = {"_bottom", "_right", "_top", "_left"};
+    for (int i = 0; i < s->n_walls; i++)
+        if (bal_scene_find(s, BAL_SEC_DISC, s->walls[i].name) >= 0)
+            return bal_error(err, BAL_EINVAL, "%s:%d: [wall %s]: a disc has this name too; "
+                             "probes and moves need one body per name",
+                             s->path, s->walls[i].line, s->walls[i].name);
+    for (int k = 0; k < s->n_fills + s->n_piles; k++) {
+        const int fill = k < s->n_fills;
+        const char *name = fill ? s->fills[k].name : s->piles[k - s->n_fills].name;
+        const int line = fill ? s->fills[k].line : s->piles[k - s->n_fills].line;
+        if (fill ? !s->fills[k].box : s->piles[k - s->n_fills].bottom != 0)
+            continue;
+        for (int side = 0; side < (fill ? 4 : 1); side++) {
+            char nm[2 * BAL_NAME_MAX];
+            snprintf(nm, sizeof nm, "%s%s", name, fill ? sides[side] : "_floor");
+            if (bal_scene_find(s, BAL_SEC_DISC, nm) >= 0 || bal_scene_find(s, BAL_SEC_WALL, nm) >= 0)
+                return bal_error(err, BAL_EINVAL, "%s:%d: [%s %s]: makes a wall '%s', but a disc "
+                                 "or wall has that name already",
+                                 s->path, line, fill ? "fill" : "pile", name, nm);
+        }
+    }
+    return BAL_OK;
+}
+
+enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *err)
+{
+    for (int k = 0; k < BAL_SEC_COUNT; k++)
+        if (check_required(s, (enum bal_section_kind)k, err))
+            return err->code;
+
+    const struct bal_settings *st = &s->settings;
+    const int delta0_given = (st->given & (1u << bal_scene_key_index(BAL_SEC_SETTINGS, "delta0"))) != 0;
+    if (st->normal_law == BAL_NORMAL_POWER && st->nu != 1.0 && !delta0_given)
+        return bal_error(err, BAL_EINVAL,
+                         "%s:%d: delta0: required with normal_law = power and nu != 1 "
+                         "(the force scale k_n delta0 depends on it)",
+                         s->path, st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "nu")]);
+    if (st->gamma_n > 0 && st->psi != 0 && !delta0_given)
+        return bal_error(err, BAL_EINVAL,
+                         "%s:%d: delta0: required with psi != 0 (the dashpot "
+                         "gamma_n (delta/delta0)^psi depends on it, MLH eq. 3)",
+                         s->path, st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "psi")]);
+
+    for (int i = 0; i < s->n_discs; i++) {
+        struct bal_disc_def *d = &s->discs[i];
+        if (check_material_ref(s, d, BAL_SEC_DISC, "material", d->material, 1, err))
+            return err->code;
+        if (d->fixed && (d->v[0] != 0 || d->v[1] != 0 || d->omega != 0))
+            return FAIL_AT(d, BAL_SEC_DISC, "fixed", "%s",
+                           "a held disc cannot have a velocity (v and omega must be 0)");
+    }
+    for (int i = 0; i < s->n_walls; i++) {
+        struct bal_wall_def *w = &s->walls[i];
+        if (!(w->h2 > w->h1))
+            return FAIL_AT(w, BAL_SEC_WALL, "h2", "expected h2 > h1 (a wall of positive length), "
+                                                  "got h1 = %g, h2 = %g", w->h1, w->h2);
+        if (check_material_ref(s, w, BAL_SEC_WALL, "material", w->material, 0, err))
+            return err->code;
+    }
+    for (int i = 0; i < s->n_fills; i++) {
+        struct bal_fill_def *f = &s->fills[i];
+        if (!(f->rmax >= f->rmin))
+            return FAIL_AT(f, BAL_SEC_FILL, "rmax", "expected rmax >= rmin, got %g < %g",
+                           f->rmax, f->rmin);
+        if (check_material_ref(s, f, BAL_SEC_FILL, "material", f->material, 1, err))
+            return err->code;
+        if (f->box) {
+            if (!*f->wall_material)
+                return FAIL_AT(f, BAL_SEC_FILL, "wall_material", "%s", "required with box = 1");
+            if (check_material_ref(s, f, BAL_SEC_FILL, "wall_material", f->wall_material, 0, err))
+                return err->code;
+        }
+    }
+    for (int i = 0; i < s->n_piles; i++) {
+        struct bal_pile_def *p = &s->piles[i];
+        if (check_material_ref(s, p, BAL_SEC_PILE, "material", p->material, 1, err))
+            return err->code;
+        if (p->bottom == 0) {
+            if (!*p->wall_material)
+                return FAIL_AT(p, BAL_SEC_PILE, "wall_material", "%s",
+                               "required with bottom = smooth (the floor's material)");
+            if (check_material_ref(s, p, BAL_SEC_PILE, "wall_material", p->wall_material, 0, err))
+                return err->code;
+            if (p->L < 3)
+                return FAIL_AT(p, BAL_SEC_PILE, "L", "%s",
+                               "a smooth bottom needs L >= 3 (two corner stones and a free disc)");
+        }
+    }
+    for (int i = 0; i < s->n_materials; i++) {
+        struct bal_material_def *m = &s->materials[i];
+        if (!(m->ks >= 1e-150 || m->ks == -1))
+            return FAIL_AT(m, BAL_SEC_MATERIAL, "ks", "expected ks >= 1e-150, like kn (or omit it "
+                                                      "for ks = kn), got %g", m->ks);
+    }
+    if (check_body_names(s, err))
+        return err->code;
+    if (s->n_stages == 0)
+        return bal_error(err, BAL_EINVAL, "%s: no [stage] section: the run would never start; "
+                                          "add e.g. [stage run] with cycles = N", s->path);
+    for (int i = 0; i < s->n_stages; i++) {
+        struct bal_stage_def *g = &s->stages[i];
+        for (int m = 0; m < g->n_moves; m++) {
+            const struct bal_move_def *mv = &g->moves[m];
+            int is_wall = 0;
+            if (!body_exists(s, mv->wall, &is_wall) || !is_wall)
+                return bal_error(err, BAL_EINVAL, "%s:%d: %s: no wall named '%s'", s->path,
+                                 mv->line, bal_scene_key_for_control(mv->control), mv->wall);
+        }
+    }
+    for (int i = 0; i < s->n_probes; i++) {
+        struct bal_probe_def *p = &s->probes[i];
+        int k = p->kind, wa = 0, wb = 0;
+        int contact = k == BAL_PROBE_CONTACT_FN || k == BAL_PROBE_CONTACT_FS ||
+                      k == BAL_PROBE_CONTACT_SLIDING;
+        int wall = k >= BAL_PROBE_WALL_F1 && k <= BAL_PROBE_WALL_ECC;
+        int disc = k >= BAL_PROBE_DISC_X && k <= BAL_PROBE_DISC_OMEGA;
+        if (contact || wall || disc) {
+            if (!*p->a)
+                return FAIL_AT(p, BAL_SEC_PROBE, "a", "%s", "this quantity needs a body in 'a'");
+            if (!body_exists(s, p->a, &wa))
+                return FAIL_AT(p, BAL_SEC_PROBE, "a", "no disc or wall named '%s'", p->a);
+            if (wall && !wa)
+                return FAIL_AT(p, BAL_SEC_PROBE, "a", "'%s' is a disc; this quantity needs a wall",
+                               p->a);
+            if (disc && wa)
+                return FAIL_AT(p, BAL_SEC_PROBE, "a", "'%s' is a wall; this quantity needs a disc",
+                               p->a);
+        }
+        if (contact) {
+            if (!*p->b)
+                return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "a contact probe needs a second body in 'b'");
+            if (!body_exists(s, p->b, &wb))
+                return FAIL_AT(p, BAL_SEC_PROBE, "b", "no disc or wall named '%s'", p->b);
+            if (wa && wb)
+                return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "two walls never make a contact");
+            if (strcmp(p->a, p->b) == 0)
+                return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "a body cannot touch itself");
+        } else if (*p->b) {
+            return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "only contact probes take a second body");
+        }
+    }
+    if (s->n_discs == 0 && s->n_fills == 0 && s->n_piles == 0)
+        return bal_error(err, BAL_EINVAL,
+                         "%s: no discs: add [disc NAME], [fill NAME] or [pile NAME] sections", s->path);
+    return BAL_OK;
+}
+

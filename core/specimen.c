@@ -1,0 +1,298 @@
+/*
+ * specimen.c — the discs a scene generates, in scene order.
+ *
+ * A scene places discs one by one ([disc] sections) or by generators, laid
+ * out here before the builder (build.c) sorts them into cell order:
+ *
+ *   [fill]  n discs on a square lattice of spacing 2 rmax, `columns` to a
+ *           row, filled row by row from the region's lower-left corner;
+ *           radii uniform in [rmin, rmax] and, with vmax > 0, speeds uniform
+ *           in [0, vmax) in uniform directions, drawn from a SplitMix64
+ *           generator seeded by the section (same seed, same discs on every
+ *           platform; no global state);
+ *   [pile]  equal discs on a triangular lattice (MLH Sec. 4, Fig. 2): row M
+ *           holds L − 3M (30°) or L − M (60°) discs, each row at the lowest
+ *           height where it touches the row below (struct bal_pile_def).
+ *
+ * Scene order — [disc] sections first, then each [fill], then each [pile],
+ * each in file order — is the disc's stable id: outputs are written in it,
+ * and messages name a disc by it.  The functions at the end turn an id back
+ * into a name (FILL.k) and into the scene line that placed the disc.
+ *
+ * A new generator (the polydisperse specimen, say) is a section in the key
+ * table, a count in bal_specimen_count, a lay_* function called from
+ * bal_specimen_generate, and its branch in the name and origin functions.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "scene.h"
+#include "specimen.h"
+#include "state.h" /* BAL_PI */
+
+/* ------------------------------------------------------------------ */
+/* Counting                                                            */
+/* ------------------------------------------------------------------ */
+
+/* Discs in row M of a pile (0 when the pile has no row M). */
+static long pile_row_count(const struct bal_pile_def *p, long M)
+{
+    const long n = p->L - (p->slope == 0 ? 3 : 1) * M;
+    return n > 0 ? n : 0;
+}
+
+long bal_specimen_pile_rows(const struct bal_pile_def *p)
+{
+    long rows = 0;
+    while (pile_row_count(p, rows) > 0)
+        rows++;
+    return rows;
+}
+
+long bal_specimen_pile_count(const struct bal_pile_def *p)
+{
+    long n = 0;
+    for (long M = 0; pile_row_count(p, M) > 0; M++)
+        n += pile_row_count(p, M);
+    return n;
+}
+
+long bal_specimen_count(const struct bal_scene *sc)
+{
+    long n = sc->n_discs;
+    for (int f = 0; f < sc->n_fills; f++)
+        n += sc->fills[f].n;
+    for (int p = 0; p < sc->n_piles; p++)
+        n += bal_specimen_pile_count(&sc->piles[p]);
+    return n;
+}
+
+/* ------------------------------------------------------------------ */
+/* Generators                                                          */
+/* ------------------------------------------------------------------ */
+
+/* A small, seedable generator (SplitMix64) kept in a local variable: no
+ * global state, the same seed gives the same discs on every platform. */
+static uint64_t splitmix64(uint64_t *state)
+{
+    uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+static double uniform01(uint64_t *state)
+{
+    return (double)(splitmix64(state) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* The discs of the [disc] sections, from index k on; returns the index
+ * after the last. */
+static int lay_discs(const struct bal_scene *sc, struct bal_specimen *d, int k)
+{
+    for (int i = 0; i < sc->n_discs; i++, k++) {
+        const struct bal_disc_def *dd = &sc->discs[i];
+        d->x[k] = dd->x[0];
+        d->y[k] = dd->x[1];
+        d->r[k] = dd->r;
+        d->vx[k] = dd->v[0];
+        d->vy[k] = dd->v[1];
+        d->th[k] = dd->theta * (BAL_PI / 180);
+        d->w[k] = dd->omega;
+        d->mat[k] = bal_scene_find(sc, BAL_SEC_MATERIAL, dd->material);
+        d->fixed[k] = (uint8_t)(dd->fixed != 0);
+    }
+    return k;
+}
+
+/* A [fill] lattice from index k on; returns the index after the last disc. */
+static int lay_fill(const struct bal_fill_def *fd, int mat, struct bal_specimen *d, int k)
+{
+    uint64_t rng = (uint64_t)fd->seed;
+    const double pitch = 2 * fd->rmax;
+    for (long q = 0; q < fd->n; q++, k++) {
+        const long row = q / fd->columns, col = q % fd->columns;
+        d->x[k] = fd->origin[0] + fd->rmax + (double)col * pitch;
+        d->y[k] = fd->origin[1] + fd->rmax + (double)row * pitch;
+        d->r[k] = fd->rmin + (fd->rmax - fd->rmin) * uniform01(&rng);
+        if (fd->vmax > 0) {
+            const double speed = fd->vmax * uniform01(&rng);
+            const double dir = 2 * BAL_PI * uniform01(&rng);
+            d->vx[k] = speed * cos(dir);
+            d->vy[k] = speed * sin(dir);
+        }
+        d->mat[k] = mat;
+    }
+    return k;
+}
+
+/* Lay out a pile (struct bal_pile_def documents the rules) into the arrays
+ * from index k on; returns the index after the last disc. */
+static int lay_pile(const struct bal_pile_def *p, int mat, struct bal_specimen *d, int k)
+{
+    const double dd = p->d, r = 0.5 * dd;
+    const double s0 = p->bottom == 1 ? dd * (1 + p->c) : dd;
+    const double s = p->bottom == 1 ? dd * fmax(1.0, 1 + p->c) : dd;
+    const double xc = p->origin[0] + r + 0.5 * (double)(p->L - 1) * s0;
+    int below = k;                   /* first disc of the previous row */
+    long n_below = 0;
+    for (long M = 0; pile_row_count(p, M) > 0; M++) {
+        const long n = pile_row_count(p, M);
+        const double spacing = M == 0 ? s0 : s;
+        double y = p->origin[1] + r;
+        if (M > 0) {
+            /* The lowest height at which no disc of this row overlaps one of
+             * the row below: touching in the hollows, exactly. */
+            y = -INFINITY;
+            for (long a = 0; a < n; a++) {
+                const double x = xc + ((double)a - 0.5 * (double)(n - 1)) * spacing;
+                for (long b = 0; b < n_below; b++) {
+                    const double dx = fabs(x - d->x[below + b]);
+                    if (dx < dd)
+                        y = fmax(y, d->y[below + b] + sqrt(dd * dd - dx * dx));
+                }
+            }
+            if (!isfinite(y))
+                y = d->y[below] + dd;
+        }
+        const int first = k;
+        for (long a = 0; a < n; a++, k++) {
+            d->x[k] = xc + ((double)a - 0.5 * (double)(n - 1)) * spacing;
+            d->y[k] = y;
+            d->r[k] = r;
+            d->mat[k] = mat;
+            d->row[k] = (int32_t)M;
+            d->fixed[k] = M == 0 && (p->bottom == 1 || a == 0 || a == n - 1);
+        }
+        below = first;
+        n_below = n;
+    }
+    return k;
+}
+
+static double *alloc_doubles(size_t n, int *ok)
+{
+    double *p = calloc(n ? n : 1, sizeof *p);
+    if (!p)
+        *ok = 0;
+    return p;
+}
+
+enum bal_status bal_specimen_generate(const struct bal_scene *sc, int n, struct bal_specimen *d,
+                                      struct bal_error *err)
+{
+    int ok = 1;
+    d->x = alloc_doubles((size_t)n, &ok);
+    d->y = alloc_doubles((size_t)n, &ok);
+    d->r = alloc_doubles((size_t)n, &ok);
+    d->vx = alloc_doubles((size_t)n, &ok);
+    d->vy = alloc_doubles((size_t)n, &ok);
+    d->th = alloc_doubles((size_t)n, &ok);
+    d->w = alloc_doubles((size_t)n, &ok);
+    d->mat = calloc((size_t)(n ? n : 1), sizeof *d->mat);
+    d->fixed = calloc((size_t)(n ? n : 1), sizeof *d->fixed);
+    d->row = malloc((size_t)(n ? n : 1) * sizeof *d->row);
+    if (!ok || !d->mat || !d->fixed || !d->row)
+        return bal_error(err, BAL_ENOMEM, "%s: out of memory for %d discs", sc->path, n);
+    for (int i = 0; i < n; i++)
+        d->row[i] = -1;
+    int k = lay_discs(sc, d, 0);
+    for (int f = 0; f < sc->n_fills; f++)
+        k = lay_fill(&sc->fills[f], bal_scene_find(sc, BAL_SEC_MATERIAL, sc->fills[f].material),
+                     d, k);
+    for (int p = 0; p < sc->n_piles; p++)
+        k = lay_pile(&sc->piles[p], bal_scene_find(sc, BAL_SEC_MATERIAL, sc->piles[p].material),
+                     d, k);
+    return BAL_OK;
+}
+
+void bal_specimen_free(struct bal_specimen *d)
+{
+    free(d->x);
+    free(d->y);
+    free(d->r);
+    free(d->vx);
+    free(d->vy);
+    free(d->th);
+    free(d->w);
+    free(d->mat);
+    free(d->fixed);
+    free(d->row);
+}
+
+/* ------------------------------------------------------------------ */
+/* Scene order back to the scene: names and origins                    */
+/* ------------------------------------------------------------------ */
+
+void bal_specimen_disc_name(const struct bal_scene *sc, int id, char *buf, size_t size)
+{
+    if (id < sc->n_discs) {
+        snprintf(buf, size, "%s", sc->discs[id].name);
+        return;
+    }
+    long k = id - sc->n_discs;
+    for (int f = 0; f < sc->n_fills; f++) {
+        if (k < sc->fills[f].n) {
+            snprintf(buf, size, "%s.%ld", sc->fills[f].name, k);
+            return;
+        }
+        k -= sc->fills[f].n;
+    }
+    for (int p = 0; p < sc->n_piles; p++) {
+        const long n = bal_specimen_pile_count(&sc->piles[p]);
+        if (k < n) {
+            snprintf(buf, size, "%s.%ld", sc->piles[p].name, k);
+            return;
+        }
+        k -= n;
+    }
+    snprintf(buf, size, "?%d", id);
+}
+
+void bal_specimen_disc_origin(const struct bal_scene *sc, int id, enum bal_disc_prop prop,
+                              char *buf, size_t size)
+{
+    /* The key of each property in a [disc], a [fill] and a [pile] section. */
+    static const char *const keys[][3] = {
+        [BAL_DISC_PLACE] = {"x", "origin", "origin"},
+        [BAL_DISC_SIZE] = {"r", "rmin", "d"},
+        [BAL_DISC_SPEED] = {"v", "vmax", "d"},
+        [BAL_DISC_SPIN] = {"omega", "vmax", "d"},
+    };
+    if (id < sc->n_discs) {
+        const struct bal_disc_def *d = &sc->discs[id];
+        const char *key = keys[prop][0];
+        const int ki = bal_scene_key_index(BAL_SEC_DISC, key);
+        const int line = ki >= 0 && d->key_line[ki] > 0 ? d->key_line[ki] : d->line;
+        snprintf(buf, size, "%s:%d: %s: disc %s", sc->path, line, key, d->name);
+        return;
+    }
+    long k = id - sc->n_discs;
+    for (int f = 0; f < sc->n_fills; f++, k -= sc->fills[f - 1].n) {
+        const struct bal_fill_def *fd = &sc->fills[f];
+        if (k >= fd->n)
+            continue;
+        const char *key = keys[prop][1];
+        const int ki = bal_scene_key_index(BAL_SEC_FILL, key);
+        const int line = ki >= 0 && fd->key_line[ki] > 0 ? fd->key_line[ki] : fd->line;
+        snprintf(buf, size, "%s:%d: %s: disc %s.%ld of [fill %s]", sc->path, line, key, fd->name,
+                 k, fd->name);
+        return;
+    }
+    for (int p = 0; p < sc->n_piles; p++) {
+        const struct bal_pile_def *pd = &sc->piles[p];
+        const long n = bal_specimen_pile_count(pd);
+        if (k >= n) {
+            k -= n;
+            continue;
+        }
+        const char *key = keys[prop][2];
+        const int ki = bal_scene_key_index(BAL_SEC_PILE, key);
+        const int line = ki >= 0 && pd->key_line[ki] > 0 ? pd->key_line[ki] : pd->line;
+        snprintf(buf, size, "%s:%d: %s: disc %s.%ld of [pile %s]", sc->path, line, key, pd->name,
+                 k, pd->name);
+        return;
+    }
+    snprintf(buf, size, "%s: disc %d", sc->path, id);
+}

@@ -1,0 +1,50 @@
+/*
+ * specimen.h — internal: the discs a scene generates, in scene order
+ * (specimen.c).
+ */
+#ifndef BAL_SPECIMEN_H
+#define BAL_SPECIMEN_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "ballast.h"
+
+/* Most discs a scene may make (array indices are int32_t). */
+#define BAL_MAX_DISCS 100000000L
+
+/* The discs of a scene in scene order ([disc] sections, then each [fill],
+ * then each [pile]), before the builder sorts them into cell order: one
+ * column per property, n entries each. */
+struct bal_specimen {
+    double *x, *y, *r, *vx, *vy, *th, *w;
+    int32_t *mat;                /* material index in the scene */
+    uint8_t *fixed;              /* 1: held */
+    int32_t *row;                /* row M of a pile disc, -1 otherwise */
+};
+
+/* Discs the scene makes: its [disc] sections and what its generators lay
+ * (may exceed BAL_MAX_DISCS: the builder refuses that). */
+long bal_specimen_count(const struct bal_scene *sc);
+/* Number of rows and of discs a [pile] generates. */
+long bal_specimen_pile_rows(const struct bal_pile_def *p);
+long bal_specimen_pile_count(const struct bal_pile_def *p);
+/* Lay out the n discs of the scene into d (which it allocates; free with
+ * bal_specimen_free, also after a failure). */
+enum bal_status bal_specimen_generate(const struct bal_scene *sc, int n, struct bal_specimen *d,
+                                      struct bal_error *err);
+void bal_specimen_free(struct bal_specimen *d);
+
+/* The name of the disc with scene-order index id: its [disc] name, or
+ * FILL.k / PILE.k for the k-th disc a generator made. */
+void bal_specimen_disc_name(const struct bal_scene *sc, int id, char *buf, size_t size);
+/* A property of a disc, for naming where the scene set it. */
+enum bal_disc_prop { BAL_DISC_PLACE, BAL_DISC_SIZE, BAL_DISC_SPEED, BAL_DISC_SPIN };
+/* "FILE:LINE: KEY: disc NAME" of the key that set property `prop` of the
+ * disc with scene-order index id: its [disc] key, or the key of the [fill]
+ * or [pile] that generated it (the section's header line when the key was
+ * left at its default). */
+void bal_specimen_disc_origin(const struct bal_scene *sc, int id, enum bal_disc_prop prop,
+                              char *buf, size_t size);
+
+#endif /* BAL_SPECIMEN_H */

@@ -1,0 +1,39 @@
+/*
+ * walls.h — internal: straight rigid walls, their geometry, their motion
+ * and the controllers that drive them (walls.c).
+ */
+#ifndef BAL_WALLS_H
+#define BAL_WALLS_H
+
+#include "state.h"
+
+/* Closest point of wall w to (x, y); returns squared distance. */
+double bal_walls_closest(const struct bal_wall *w, double x, double y, double *cx, double *cy);
+/* Unit normal from (x, y) to the closest point of wall w (the wall's own
+ * normal when the point lies on it); returns the distance. */
+double bal_walls_normal(const struct bal_wall *w, double x, double y, double *ex, double *ey);
+/* Index of the wall named `name`, or -1. */
+int bal_walls_find(const struct bal_sim *s, const char *name);
+/* Move every wall by its velocity over one time step (eq. 22a for P and α). */
+void bal_walls_move(struct bal_sim *s);
+
+/* A wall's controller: how a stage drives the wall, chosen by the stage key
+ * that names it (the table in walls.c, indexed by enum bal_wall_control).
+ * `start` takes the parameters of the stage's line when the stage begins;
+ * `control`, unless NULL, runs in every cycle once the cycle's wall forces
+ * are known, and sets the velocity of the wall's next move. */
+struct bal_wall_controller_type {
+    const char *name;
+    void (*start)(struct bal_wall *w, const struct bal_move_def *mv);
+    void (*control)(struct bal_sim *s, struct bal_wall *w);
+};
+
+/* Stage g begins: each wall it names gets its controller and parameters;
+ * the others are at rest, with none. */
+void bal_walls_stage(struct bal_sim *s, const struct bal_stage_def *g);
+/* After the wall forces of the cycle (bal_contacts_walls) and the audit of
+ * the walls' work (bal_energy_walls): every controller that acts per cycle
+ * sets its wall's velocity for the next cycle. */
+void bal_walls_control(struct bal_sim *s);
+
+#endif /* BAL_WALLS_H */

@@ -268,7 +268,7 @@ enum bal_status bal_scene_validate(const struct bal_scene *s,
                                    struct bal_error *err);
 /* Release what the scene owns. */
 void bal_scene_free(struct bal_scene *s);
-/* Print every key of every section with default, range and doc (README). */
+/* Print every key of every section with default, range and doc (docs/scene-format.md). */
 void bal_scene_print_keys(FILE *out);
 
 /* ------------------------------------------------------------------ */

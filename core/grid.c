@@ -9,7 +9,7 @@
  * to close that skin (bal_grid_due, from the displacements the position
  * pass of integrate.c returns; when the two largest could have closed it,
  * it looks at the discs that moved most).  The cross-over
- * BAL_GRID_CROSSOVER was measured with `make bench-grid` (see README).
+ * BAL_GRID_CROSSOVER was measured with `build/bench --grid` (docs/benchmarks.md).
  *
  * Cells are square with side 2 r_max + skin, so every candidate of a disc
  * lies in its own cell or the eight around it.  Discs are binned by a

@@ -32,7 +32,7 @@ void bal_grid_cell_order(const double *x, const double *y, int n, double h,
 void bal_grid_free(struct bal_grid *g);
 void bal_grid_scratch_free(struct bal_rebuild_scratch *rs);
 /* With fewer discs than this, `grid = auto` uses all pairs.  Measured with
- * `build/bench --grid cases/bench/dense.scene` (README, "Neighbour search"):
+ * `build/bench --grid cases/bench/dense.scene` (docs/benchmarks.md, "Neighbour search"):
  * the Verlet-listed grid was faster at every N >= 4, settled or falling
  * (1.2-1.5x at N = 4-16, 14x at N = 256), so all pairs serve only scenes of
  * two or three discs, whose single list is built once. */

@@ -1,7 +1,7 @@
 /*
  * scene.c — text scene → struct bal_scene, and --set overrides.
  *
- * Format (documented key by key in the README, generated from
+ * Format (documented key by key in docs/scene-format.md, generated from
  * scene_keys.c):
  *
  *     # a comment runs to the end of the line

@@ -2,7 +2,7 @@
  * scene_keys.c — every key a scene file may contain, in one table.
  *
  * The parser, the range checks, `ballast keys` and the key list in the
- * README all read this table, so they cannot drift apart.  A default is
+ * key tables of docs/scene-format.md all read this table, so they cannot drift apart.  A default is
  * written as text and parsed like a value from a file; a key without a
  * default and with `required` set must be given.
  *
@@ -263,7 +263,7 @@ const struct bal_key *bal_scene_key_at(enum bal_section_kind sec, int k)
     return NULL;
 }
 
-/* The key list of `ballast keys` and the README: one Markdown table per
+/* The key list of `ballast keys` and docs/scene-format.md: one Markdown table per
  * section kind. */
 void bal_scene_print_keys(FILE *out)
 {

@@ -1,6 +1,6 @@
 /*
  * scene_keys.h — internal: the table of scene keys shared by the parser,
- * the range checks, `ballast keys` and the README's key list
+ * the range checks, `ballast keys` and the key tables of docs/scene-format.md
  * (scene_keys.c).
  *
  * A scene file is a sequence of sections.  `[settings]` appears at most
@@ -43,7 +43,7 @@ struct bal_key {
     const char *choices;    /* BAL_KEY_ENUM: the words; BAL_KEY_CONTROL: the form,
                              * "WALL" and one word per number, which go to consecutive
                              * doubles of struct bal_move_def from `offset` on */
-    const char *doc;        /* one line for `ballast keys` and the README */
+    const char *doc;        /* one line for `ballast keys` and docs/scene-format.md */
 };
 
 /* The wall controller that each BAL_KEY_CONTROL key of a stage names. */

@@ -13,7 +13,7 @@ A point whose run failed (status unstable: the overlap budget or energy runaway 
 it, or no run.json) has no error; its row says so (status, note = the run's message) and the
 report draws it as "unstable" at the top of the diagram, at the cost it spent before stopping.
 
-The error of a run (one number, documented in README.md) is the largest of its error terms:
+The error of a run (one number, documented in docs/error-against-cost.md) is the largest of its error terms:
 
   * a check of the case (reference/*.ref) of kind analytic, exact or paper with a point
     reference (tolerance abs, rel or ratio): |q - ref| / |ref|, where q is the check's

@@ -1003,7 +1003,7 @@ static void head_on_rms(const char *integ, double h, double *T_rms, double *e_rm
 }
 
 /* Observed orders between h = 0.025 and 0.003125 (a factor 8).  Measured
- * (README, "Integrators"): contact duration 2.00 (centred, verlet), 3.0
+ * (docs/physics.md, "Integrators"): contact duration 2.00 (centred, verlet), 3.0
  * (gear5); restitution 2.0 for all three: the force has a kink at contact
  * onset and end, and every scheme that samples it at whole steps makes an
  * O(Δt²) error in the impulse of the step that holds the kink.  The
@@ -1030,7 +1030,7 @@ END_TEST
  * y = y_e + (V/ω) sin ωt.  Each integrator is started exactly (centred:
  * v_{1/2} = V cos(ωΔt/2); verlet: the force sum at t_0 = m g; gear5: the
  * derivatives y^(k)(0) of the closed form), so the error after 10 periods
- * is the scheme's own.  Measured (README): centred and verlet order 2.00;
+ * is the scheme's own.  Measured (docs/physics.md): centred and verlet order 2.00;
  * gear5 5.9-6.1 down to the round-off floor (~1e-11 of the amplitude).
  * Energy: centred and verlet keep it within h²/4 without drift; Gear-5
  * loses it steadily, ∝ h^5.  Windows: [1.9, 2.1]; gear5 > 5 between h = 0.2

@@ -893,10 +893,10 @@ START_TEST(scene_pile_smallest)
 END_TEST
 
 /* ------------------------------------------------------------------ */
-/* Fuzzing findings (make test-fuzz; README "Fuzzing")                 */
+/* Fuzzing findings (make test-fuzz; docs/fuzzing.md)                   */
 /* ------------------------------------------------------------------ */
 
-/* Each finding of the fuzzing work (README "Fuzzing" says which the fuzzer
+/* Each finding of the fuzzing work (docs/fuzzing.md says which the fuzzer
  * found and which were found by reading next to them), as a small scene
  * under fuzz/regress/ (the fuzz run replays the same files): the stage that
  * must refuse it ('p' parse, 'c' create; 'o' = accepted and runs), the status

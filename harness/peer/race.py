@@ -94,11 +94,11 @@ G = 9.81
 REPEATS = 5
 # Steps of every timed run, sweep and race alike (the sweep times what the
 # race runs): about 2 s of ballast and 5-7 s of LAMMPS at N = 20000 on the
-# 2-core VM of the README.
+# 2-core VM of docs/benchmarks.md.
 RACE_STEPS = 3000
 RACE_N = 20000
 
-# The cross-check (see README "Benchmarks", bench-peer, for the measured
+# The cross-check (see docs/benchmarks.md, bench-peer, for the measured
 # values).  Three runs of the same 300 discs for CHECK_STEPS steps:
 #
 # - frictionless: both codes do the same arithmetic in a different order, so

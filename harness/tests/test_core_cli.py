@@ -3,7 +3,7 @@
 
 - `--out` naming a file is refused as such (exit 2), not with internal temporary paths;
 - a scene saved with a UTF-8 byte-order mark runs like the same scene without it;
-- `ballast keys` lists every probe quantity (and so does the README, test_readme.py);
+- `ballast keys` lists every probe quantity (and so does docs/scene-format.md, test_readme.py);
 - a rerun into a folder that held a finished run removes the old run.json before anything
   else, so a kill at any moment never leaves it saying ok beside missing outputs;
 - on a full disk `run` and `exact` end with exit 3 and leave no temporary file (a small

@@ -464,7 +464,7 @@ enum bal_status bal_build_lists(struct bal_sim *s, struct bal_error *err)
     s->pp.damping = 0; /* disc-pair dashpots are recomputed for reports */
     s->pw.shear = 1;
     s->pw.damping = 1;
-    s->pair_loop = bal_contacts_select(s->has_shear, s->has_damping);
+    s->pair_loop = bal_contacts_select(s->normal_law, s->has_shear, s->has_damping);
     if (bal_grid_rebuild(s, err))
         return err->code;
     return check_overlaps(s, err);

@@ -7,9 +7,10 @@
 
 #include "state.h"
 
-/* The disc–disc loop compiled with or without the tangential and the
- * damping kernels (laws.h); chosen once per simulation. */
-bal_pair_loop_fn bal_contacts_select(int shear, int damping);
+/* The disc–disc loop compiled for this normal law (enum bal_normal_law),
+ * with or without the tangential and the damping kernels (laws.h); chosen
+ * once per simulation. */
+bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping);
 /* The disc–wall contacts of the cycle: their forces on the discs' sums and
  * the resultants on the walls (after the disc–disc loop started the sums). */
 void bal_contacts_walls(struct bal_sim *s);

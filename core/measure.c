@@ -73,6 +73,7 @@ double bal_measure_normal_energy(const struct bal_sim *s, const struct bal_pair_
 
 double bal_measure_elastic(const struct bal_sim *s)
 {
+    const struct bal_law_params P = bal_law_params_of(s);
     double e = 0;
     for (int walls = 0; walls < 2; walls++) {
         const struct bal_pairs *p = walls ? &s->pw : &s->pp;
@@ -82,7 +83,7 @@ double bal_measure_elastic(const struct bal_sim *s)
             double rmin;
             const struct bal_pair_law *L;
             const double delta = bal_pairs_overlap(s, walls, c, &rmin, &L);
-            e += bal_measure_normal_energy(s, L, p->fn[c], delta);
+            e += bal_law_normal_energy(&P, L, p->fn[c], delta);
             e += bal_law_shear_energy(L, pair_fs(p, c));
         }
     }

@@ -89,6 +89,11 @@ enum bal_integrator {
     BAL_INTEGRATOR_GEAR5 = 2    /* Gear's 6-value predictor-corrector (MLH Sec. 5.3) */
 };
 
+enum bal_rolling_model {
+    BAL_ROLLING_MODEL1 = 0,     /* JYH eq. (35): elasto-perfectly plastic, |M| <= M_0 */
+    BAL_ROLLING_MODEL2 = 1      /* JYH eq. (36): elasto-brittle, M = 0 once |θ_r| > θ_r⁰ */
+};
+
 struct bal_settings {
     double dt;            /* time step; 0 = dt_fraction × estimate (default 0) */
     double dt_fraction;   /* fraction of the critical-step estimate (0.1) */
@@ -111,6 +116,7 @@ struct bal_settings {
     long allow_overlap;   /* 1: discs may overlap each other or walls at the start (0) */
     long force_dt;        /* 1: accept a time step at or above the stability estimate (0) */
     int integrator;       /* enum bal_integrator (centred) */
+    int rolling_model;    /* enum bal_rolling_model, for pairs with rolling > 0 (model1) */
     BAL_SECTION_TAIL;
 };
 
@@ -122,6 +128,8 @@ struct bal_material_def {
     double friction;      /* tan φ_μ (0) */
     double cohesion;      /* c of eq. (19), force (0) */
     double density;       /* mass per area (per unit thickness) (required for discs) */
+    double rolling;       /* shape parameter δ of JYH eq. (24), B = δ r; 0: no rolling
+                           * resistance (a pair uses the smaller of its two) (0) */
     BAL_SECTION_TAIL;
 };
 
@@ -226,8 +234,17 @@ enum bal_probe_kind {
     BAL_PROBE_DISSIPATED_FRICTION, BAL_PROBE_DISSIPATED_GLOBAL, BAL_PROBE_ENERGY_IMBALANCE,
     BAL_PROBE_UNBALANCED, BAL_PROBE_N_CONTACTS, BAL_PROBE_N_SLIDING,
     BAL_PROBE_HELD_FX, BAL_PROBE_HELD_FY, BAL_PROBE_WEIGHT_X, BAL_PROBE_WEIGHT_Y,
+    BAL_PROBE_CONTACT_MR, BAL_PROBE_CONTACT_THETA_R, BAL_PROBE_CONTACT_ROLLING,
+    BAL_PROBE_DISSIPATED_ROLLING,
     BAL_PROBE_COUNT
 };
+
+/* Does a probe of this kind read one contact (bodies a and b)? */
+static inline int bal_probe_is_contact(int kind)
+{
+    return kind <= BAL_PROBE_CONTACT_SLIDING ||
+           (kind >= BAL_PROBE_CONTACT_MR && kind <= BAL_PROBE_CONTACT_ROLLING);
+}
 
 struct bal_probe_def {
     char name[BAL_NAME_MAX];  /* column name in series.tsv */
@@ -310,6 +327,7 @@ struct bal_energy {
     double kinetic, elastic;      /* now */
     double work_walls, work_gravity;
     double dissipated_dashpot, dissipated_friction, dissipated_global;
+    double dissipated_rolling;    /* plastic rolling (Model 1), lost rolling springs (Model 2) */
     double imbalance;             /* > 0: energy lost unaccounted; < 0: created */
     double throughput;            /* kinetic0 + elastic0 + |work_walls| + |work_gravity| */
     double relative;              /* |imbalance| / throughput */

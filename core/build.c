@@ -110,6 +110,9 @@ static void build_laws(struct bal_sim *s, const struct bal_scene *sc)
             L->shear = L->tan_phi > 0 || L->cohesion > 0;
             if (L->shear)
                 s->has_shear = 1;
+            L->rolling = fmin(A->rolling, B->rolling);
+            if (L->rolling > 0)
+                s->has_rolling = 1;
         }
     }
 }
@@ -460,11 +463,18 @@ static enum bal_status check_overlaps(const struct bal_sim *s, struct bal_error 
 
 enum bal_status bal_build_lists(struct bal_sim *s, struct bal_error *err)
 {
-    s->pp.shear = (uint8_t)s->has_shear;
+    /* The rolling law runs in the variants with the tangential kernel (it
+     * reads the spins those read), so a scene with rolling resistance gets
+     * them even without friction; a frictionless pair skips the tangential
+     * kernel inside them (L->shear). */
+    s->pp.shear = (uint8_t)(s->has_shear || s->has_rolling);
     s->pp.damping = 0; /* disc-pair dashpots are recomputed for reports */
+    s->pp.rolling = (uint8_t)s->has_rolling;
     s->pw.shear = 1;
     s->pw.damping = 1;
-    s->pair_loop = bal_contacts_select(s->normal_law, s->has_shear, s->has_damping);
+    s->pw.rolling = (uint8_t)s->has_rolling;
+    s->pair_loop = bal_contacts_select(s->normal_law, s->has_shear || s->has_rolling,
+                                       s->has_damping, s->has_rolling);
     if (bal_grid_rebuild(s, err))
         return err->code;
     return check_overlaps(s, err);

@@ -59,8 +59,10 @@
 
 /* What a variant of the disc–disc loop is compiled with (PAIR_VARIANT),
  * one bit each: the power law (else the incremental one), the tangential
- * kernel, the damping kernels.  A new sub-model is one more bit. */
-enum { MOD_POWER = 1, MOD_SHEAR = 2, MOD_DAMP = 4 };
+ * kernel, the damping kernels, the rolling kernel (only with the tangential
+ * one: it reads the spins that kernel reads).  A new sub-model is one more
+ * bit. */
+enum { MOD_POWER = 1, MOD_SHEAR = 2, MOD_DAMP = 4, MOD_ROLL = 8 };
 
 /* Zero the force sums of discs from..to (inclusive). */
 static inline __attribute__((always_inline)) void
@@ -146,6 +148,7 @@ void bal_par_free(struct bal_par *par)
     for (int t = 0; t < BAL_MAX_THREADS; t++)
         free(par->log[t]);
     free(par->chunk_sums);
+    free(par->chunk_roll);
     free(par->block_sums);
     memset(par, 0, sizeof *par);
 }
@@ -191,6 +194,7 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
     /* The chain's parameters, read once: the kernels (laws.h) take them in
      * registers. */
     const int shear = (mods & MOD_SHEAR) != 0, damp = (mods & MOD_DAMP) != 0;
+    const int roll = (mods & MOD_ROLL) != 0;
     struct bal_law_params P = bal_law_params_of(s);
     /* A constant here: each variant runs one normal law, and a power-law
      * variant without damping or friction never reads a velocity. */
@@ -204,6 +208,7 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
      * by one (energy.c). */
     const double budget = s->overlap_sieve;
     double *restrict chunk_sums = s->par.chunk_sums;
+    double *restrict chunk_roll = s->par.chunk_roll;
     const long end = s->par.start[t + 1];
     const int zone = logged ? s->par.zone[t] : -1;
     struct bal_sum_log *restrict log = logged ? s->par.log[t] : NULL;
@@ -219,7 +224,7 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
             clear_sums(f, dsh, cleared + 1, top, damp);
             cleared = top;
         }
-        double lost_fric = 0; /* energy audit (energy.c) */
+        double lost_fric = 0, lost_roll = 0; /* energy audit (energy.c) */
         for (long c = c0; c < c1; c++) {
             const int i = p->i[c], j = p->j[c];
             const double dx = x[j] - x[i], dy = y[j] - y[i];
@@ -231,6 +236,8 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
                 p->flags[c] = 0;
                 if (shear)
                     p->fs[c] = 0;
+                if (roll)
+                    p->mr[c] = p->tr[c] = 0;
                 continue;
             }
             const struct bal_pair_law *L = one_law ? one_law : &laws[mat[i] * n_mat + mat[j]];
@@ -242,11 +249,13 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
             k.delta = rs - dist;
             over |= k.delta > budget; /* a first sieve; bal_energy_overlap judges each pair */
 
-            /* The chain of laws.h: normal -> damping -> tangential. */
+            /* The chain of laws.h: normal -> damping -> tangential -> rolling. */
             const double fn = bal_law_normal(&P, L, &k, p->fn[c]);
             p->fn[c] = fn;
             double ftn = fn, fts = 0, dn = 0, ds = 0;
-            uint8_t flags = BAL_PAIR_TOUCHING;
+            /* A contact's lost rolling resistance (Model 2) lasts while it does. */
+            uint8_t flags = roll ? (uint8_t)(BAL_PAIR_TOUCHING | (p->flags[c] & BAL_PAIR_BROKEN))
+                                 : BAL_PAIR_TOUCHING;
             if (damp) {
                 dn = bal_law_normal_dashpot(&P, L, &k);
                 ftn += dn;
@@ -262,7 +271,26 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
                     fts += ds;
                 }
             }
+            /* The couple on y, +(M + M_d); on x the opposite (JYH eq. 52). */
+            double mr = 0, md = 0;
+            if (roll && L->rolling > 0) {
+                const struct bal_roll R = bal_law_roll_of(L, bal_law_common_radius(r[i], r[j]));
+                const double wrel = w[i] - w[j];
+                const double dtheta = wrel * P.dt;
+                p->tr[c] += dtheta;
+                mr = bal_law_rolling(&P, R, fn, dtheta, p->mr[c], &lost_roll, &flags);
+                p->mr[c] = mr;
+                if (damp) {
+                    md = bal_law_rolling_dashpot(&P, L, R, k.delta, wrel);
+                    mr += md;
+                }
+            }
             p->flags[c] = flags;
+            /* The moments on x and y: the shear force's, and the couple. */
+            const double tqi = roll ? fts * r[i] - mr : fts * r[i];
+            const double tqj = roll ? fts * r[j] + mr : fts * r[j];
+            const float dtqi = (float)(roll ? ds * r[i] - md : ds * r[i]);
+            const float dtqj = (float)(roll ? ds * r[j] + md : ds * r[j]);
 
             /* Force on y is +(ftn e + fts t); on x the opposite (Fig. 3). */
             const double fcx = ftn * ex + fts * ey;
@@ -276,33 +304,31 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
                 /* a - b is a + (-b) exactly, so the replay adds the same
                  * (but for the sign of a NaN: a run with one stops anyway) */
                 if (i <= zone)
-                    log[n_log++] = (struct bal_sum_log){-fcx, -fcy, fts * r[i], -dcx, -dcy,
-                                                        (float)(ds * r[i]), i};
+                    log[n_log++] = (struct bal_sum_log){-fcx, -fcy, tqi, -dcx, -dcy, dtqi, i};
                 else {
                     f[3 * i] -= fcx;
                     f[3 * i + 1] -= fcy;
                     if (shear)
-                        f[3 * i + 2] += fts * r[i];
+                        f[3 * i + 2] += tqi;
                     if (damp) {
                         dsh[3 * i] -= dcx;
                         dsh[3 * i + 1] -= dcy;
                         if (shear)
-                            dsh[3 * i + 2] += (float)(ds * r[i]);
+                            dsh[3 * i + 2] += dtqi;
                     }
                 }
                 if (j <= zone)
-                    log[n_log++] = (struct bal_sum_log){fcx, fcy, fts * r[j], dcx, dcy,
-                                                        (float)(ds * r[j]), j};
+                    log[n_log++] = (struct bal_sum_log){fcx, fcy, tqj, dcx, dcy, dtqj, j};
                 else {
                     f[3 * j] += fcx;
                     f[3 * j + 1] += fcy;
                     if (shear)
-                        f[3 * j + 2] += fts * r[j];
+                        f[3 * j + 2] += tqj;
                     if (damp) {
                         dsh[3 * j] += dcx;
                         dsh[3 * j + 1] += dcy;
                         if (shear)
-                            dsh[3 * j + 2] += (float)(ds * r[j]);
+                            dsh[3 * j + 2] += dtqj;
                     }
                 }
                 continue;
@@ -312,8 +338,8 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
             f[3 * j] += fcx;
             f[3 * j + 1] += fcy;
             if (shear) {
-                f[3 * i + 2] += fts * r[i];
-                f[3 * j + 2] += fts * r[j];
+                f[3 * i + 2] += tqi;
+                f[3 * j + 2] += tqj;
             }
             if (damp) {
                 /* the dashpots' share, for their work at t_N (energy.c) */
@@ -323,13 +349,15 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
                 dsh[3 * j] += dcx;
                 dsh[3 * j + 1] += dcy;
                 if (shear) {
-                    dsh[3 * i + 2] += (float)(ds * r[i]);
-                    dsh[3 * j + 2] += (float)(ds * r[j]);
+                    dsh[3 * i + 2] += dtqi;
+                    dsh[3 * j + 2] += dtqj;
                 }
             }
         }
         if (shear)
             chunk_sums[c0 / CLEAR_CHUNK] = lost_fric;
+        if (roll)
+            chunk_roll[c0 / CLEAR_CHUNK] = lost_roll;
     }
     if (logged)
         s->par.log_n[t] = n_log;
@@ -401,6 +429,13 @@ pair_loop(struct bal_sim *restrict s, void (*on_threads)(struct bal_sim *), cons
             lost_fric += par->chunk_sums[k];
         s->audit.d_friction += lost_fric;
     }
+    if (mods & MOD_ROLL) {
+        double lost_roll = 0;
+        const long chunks = chunks_of(s->pp.n);
+        for (long k = 0; k < chunks; k++)
+            lost_roll += par->chunk_roll[k];
+        s->audit.d_rolling += lost_roll;
+    }
     s->over_budget |= over;
 }
 /* Each variant with its parallel region in a function of its own: in the
@@ -430,9 +465,9 @@ pair_loop(struct bal_sim *restrict s, void (*on_threads)(struct bal_sim *), cons
 #ifdef BAL_BARE
 PAIR_VARIANT(loop_pow, MOD_POWER)
 
-bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping)
+bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping, int rolling)
 {
-    (void)normal_law, (void)shear, (void)damping;
+    (void)normal_law, (void)shear, (void)damping, (void)rolling;
     return loop_pow;
 }
 #else
@@ -444,13 +479,21 @@ PAIR_VARIANT(loop_inc_d, MOD_DAMP)
 PAIR_VARIANT(loop_pow_d, MOD_POWER | MOD_DAMP)
 PAIR_VARIANT(loop_inc_sd, MOD_SHEAR | MOD_DAMP)
 PAIR_VARIANT(loop_pow_sd, MOD_POWER | MOD_SHEAR | MOD_DAMP)
+PAIR_VARIANT(loop_inc_sr, MOD_SHEAR | MOD_ROLL)
+PAIR_VARIANT(loop_pow_sr, MOD_POWER | MOD_SHEAR | MOD_ROLL)
+PAIR_VARIANT(loop_inc_sdr, MOD_SHEAR | MOD_DAMP | MOD_ROLL)
+PAIR_VARIANT(loop_pow_sdr, MOD_POWER | MOD_SHEAR | MOD_DAMP | MOD_ROLL)
 
-bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping)
+/* Rolling only with the tangential kernel: the caller asks for shear when
+ * it asks for rolling (build.c), so the table has no variant without. */
+bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping, int rolling)
 {
-    static const bal_pair_loop_fn table[] = {loop_inc,   loop_pow,   loop_inc_s,  loop_pow_s,
-                                             loop_inc_d, loop_pow_d, loop_inc_sd, loop_pow_sd};
+    static const bal_pair_loop_fn table[16] = {
+        loop_inc,   loop_pow,   loop_inc_s,  loop_pow_s,  loop_inc_d, loop_pow_d,
+        loop_inc_sd, loop_pow_sd, NULL,      NULL,        loop_inc_sr, loop_pow_sr,
+        NULL,        NULL,        loop_inc_sdr, loop_pow_sdr};
     const int mods = (normal_law == BAL_NORMAL_POWER ? MOD_POWER : 0) | (shear ? MOD_SHEAR : 0) |
-                     (damping ? MOD_DAMP : 0);
+                     (damping ? MOD_DAMP : 0) | (rolling ? MOD_ROLL | MOD_SHEAR : 0);
     return table[mods];
 }
 #endif
@@ -470,7 +513,8 @@ void bal_contacts_walls(struct bal_sim *s)
         struct bal_wall *W = &s->walls[k];
         W->f[0] = W->f[1] = W->moment = W->fn_sum = W->fn_s_sum = 0;
     }
-    double lost_fric = 0, wall_dash = 0;
+    double lost_fric = 0, lost_roll = 0, wall_dash = 0;
+    const int roll = p->rolling;
     for (long c = 0; c < p->n; c++) {
         const int i = p->i[c];
         struct bal_wall *W = &s->walls[p->j[c]];
@@ -480,6 +524,11 @@ void bal_contacts_walls(struct bal_sim *s)
         if (d2 >= ri * ri) {
             p->fn[c] = p->fs[c] = p->dn[c] = p->ds[c] = 0;
             p->flags[c] = 0;
+            if (roll) {
+                p->mr[c] = p->tr[c] = 0;
+                if (p->dm)
+                    p->dm[c] = 0;
+            }
             continue;
         }
         const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + W->material];
@@ -509,18 +558,36 @@ void bal_contacts_walls(struct bal_sim *s)
          * no shear force and no shear dashpot, as in the disc–disc loop. */
         const double fn = bal_law_normal(&P, L, &k, p->fn[c]);
         const double dn = bal_law_normal_dashpot(&P, L, &k);
-        uint8_t flags = BAL_PAIR_TOUCHING;
+        uint8_t flags = roll ? (uint8_t)(BAL_PAIR_TOUCHING | (p->flags[c] & BAL_PAIR_BROKEN))
+                             : BAL_PAIR_TOUCHING;
         const double fs = L->shear ? bal_law_tangential(&P, L, &k, fn, p->fs[c], &lost_fric, &flags)
                                    : 0.0;
         const double ds = (!L->shear || (flags & BAL_PAIR_SLIDING)) ? 0.0
                                                                      : bal_law_shear_dashpot(L, &k);
+        /* Rolling against a wall: the common radius is 2 r (JYH eq. 11b),
+         * the relative rotation the disc's against the wall's. */
+        double mr = 0, md = 0;
+        if (roll && L->rolling > 0) {
+            const struct bal_roll R = bal_law_roll_of(L, 2 * ri);
+            const double wrel = s->w[i] - W->omega;
+            const double dtheta = wrel * P.dt;
+            p->tr[c] += dtheta;
+            mr = bal_law_rolling(&P, R, fn, dtheta, p->mr[c], &lost_roll, &flags);
+            p->mr[c] = mr;
+            if (p->dm) {
+                md = bal_law_rolling_dashpot(&P, L, R, k.delta, wrel);
+                p->dm[c] = md;
+            }
+        }
         if (s->dash) {
             /* the dashpots' share on the disc, and their power on the wall
              * side (its velocity is prescribed): energy.c */
             s->dash[3 * i] -= (float)(dn * ex + ds * tx);
             s->dash[3 * i + 1] -= (float)(dn * ey + ds * ty);
-            s->dash[3 * i + 2] += (float)(ds * ri);
+            s->dash[3 * i + 2] += (float)(roll ? ds * ri - md : ds * ri);
             wall_dash += dn * (wvx * ex + wvy * ey) + ds * (wvx * tx + wvy * ty);
+            if (roll)
+                wall_dash += md * W->omega;
         }
         p->fn[c] = fn;
         p->fs[c] = fs;
@@ -533,14 +600,17 @@ void bal_contacts_walls(struct bal_sim *s)
         const double fcy = ftn * ey + fts * ty;
         s->f[3 * i] -= fcx;
         s->f[3 * i + 1] -= fcy;
-        s->f[3 * i + 2] += fts * ri;
+        s->f[3 * i + 2] += roll ? fts * ri - (mr + md) : fts * ri;
         W->f[0] += fcx;
         W->f[1] += fcy;
         W->moment += (cx - W->p[0]) * fcy - (cy - W->p[1]) * fcx;
+        if (roll)
+            W->moment += mr + md; /* the couple on the wall */
         const double along = (cx - W->p[0]) * W->e[0] + (cy - W->p[1]) * W->e[1];
         W->fn_sum += ftn;
         W->fn_s_sum += ftn * along;
     }
     s->audit.wall_dash = wall_dash;
     s->audit.d_friction += lost_fric;
+    s->audit.d_rolling += lost_roll;
 }

@@ -8,9 +8,9 @@
 #include "state.h"
 
 /* The disc–disc loop compiled for this normal law (enum bal_normal_law),
- * with or without the tangential and the damping kernels (laws.h); chosen
- * once per simulation. */
-bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping);
+ * with or without the tangential, the damping and the rolling kernels
+ * (laws.h); chosen once per simulation. */
+bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping, int rolling);
 /* The disc–wall contacts of the cycle: their forces on the discs' sums and
  * the resultants on the walls (after the disc–disc loop started the sums). */
 void bal_contacts_walls(struct bal_sim *s);

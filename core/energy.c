@@ -5,11 +5,13 @@
  * Balance, from the start (t_0, before the first cycle) to now:
  *
  *   W_walls + W_gravity = ΔE_k + ΔE_el + D_dashpot + D_friction + D_global
+ *                         + D_rolling
  *                         + imbalance
  *
  *   E_k        Σ ½ m v_N² + ½ I ω_N², v_N the centred velocity (C&S eq. 31)
  *   E_el       stored in the contact springs: ½ F_n²/k_n (incremental law) or
- *              ∫ F_n dδ = k_n δ0² (δ/δ0)^(ν+1)/(ν+1) (power law), + ½ F_s²/k_s
+ *              ∫ F_n dδ = k_n δ0² (δ/δ0)^(ν+1)/(ν+1) (power law), + ½ F_s²/k_s,
+ *              + ½ M²/K_m of the rolling springs (JYH eq. 28)
  *   W_walls    Σ_cycles −(F̄·V + M̄ ω) Δt over the walls, F and M the resultant
  *              and moment about P of the discs' forces on the wall, F̄ the
  *              mean of their values at the two ends of the cycle
@@ -21,6 +23,10 @@
  *              their per-disc sums; the latest cycle counts half
  *   D_friction Σ_cycles F_max |slip|, slip = (|F_s trial| − F_max)/k_s, where
  *              the Coulomb limit (eq. 19) cuts the shear force
+ *   D_rolling  Σ_cycles M_0 |plastic rolling| where Model 1 caps the rolling
+ *              moment (JYH eq. 35), and M²/(2 K_m) of each rolling spring
+ *              Model 2 breaks (eq. 36); the rolling dashpot (eq. 49c) is a
+ *              contact dashpot, in D_dashpot
  *   D_global   Σ_cycles α (m v_N² + I ω_N²) Δt: eqs (35)–(36) are
  *              m (v_{N+1/2} − v_{N−1/2})/Δt = F − α m v_N; the latest
  *              cycle counts half (it is centred on the end)
@@ -230,10 +236,11 @@ void bal_energy_report(const struct bal_sim *s, struct bal_energy *e)
         e->work_gravity += a->gfac_last * (gravity_potential(s) - a->g_last);
     e->dissipated_dashpot = a->d_dashpot - 0.5 * a->d_dashpot_last;
     e->dissipated_friction = a->d_friction;
+    e->dissipated_rolling = a->d_rolling;
     e->dissipated_global = a->d_global - 0.5 * a->d_global_last;
     e->imbalance = e->work_walls + e->work_gravity -
                    (e->kinetic - e->kinetic0 + e->elastic - e->elastic0 + e->dissipated_dashpot +
-                    e->dissipated_friction + e->dissipated_global);
+                    e->dissipated_friction + e->dissipated_global + e->dissipated_rolling);
     /* The energy that went through the run: what it started with and every
      * work and loss, each counted once. */
     e->throughput = e->kinetic0 + e->elastic0 + fabs(e->work_walls) + fabs(e->work_gravity);
@@ -294,7 +301,7 @@ enum bal_status bal_energy_guard(const struct bal_sim *s, struct bal_error *err)
      * number, whether or not the runaway guard is on. */
     const double terms[] = {e.kinetic0, e.elastic0, e.kinetic, e.elastic, e.work_walls,
                             e.work_gravity, e.dissipated_dashpot, e.dissipated_friction,
-                            e.dissipated_global, e.imbalance, e.throughput};
+                            e.dissipated_global, e.dissipated_rolling, e.imbalance, e.throughput};
     for (size_t k = 0; k < sizeof terms / sizeof terms[0]; k++)
         if (!isfinite(terms[k]))
             return audit_not_finite(s, &e, err);

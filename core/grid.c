@@ -170,6 +170,24 @@ static enum bal_status install(const struct bal_sim *s, struct bal_pairs *p,
         gather(p->dn, rs, n);
         gather(p->ds, rs, n);
     }
+    if (p->rolling) {
+        gather(p->mr, rs, n);
+        gather(p->tr, rs, n);
+        if (p->damping)
+            gather(p->dm, rs, n);
+        /* A re-sort can turn a pair round (its lower slot becomes the
+         * higher).  F_s keeps its meaning (ṡ is the same seen from either
+         * disc), but the rolling history is oriented, θ_r = ∫(ω_x − ω_y):
+         * it changes sign with the order. */
+        if (s->reordered && !walls)
+            for (long c = 0; c < n; c++) {
+                const int ni = (int)(rs->key[c] >> 32), nj = (int)(rs->key[c] & 0xffffffffu);
+                if (rs->map[c] >= 0 && s->new2old[ni] > s->new2old[nj]) {
+                    p->mr[c] = -p->mr[c];
+                    p->tr[c] = -p->tr[c];
+                }
+            }
+    }
     for (long c = 0; c < n; c++)
         rs->bytes[c] = rs->map[c] >= 0 ? p->flags[rs->map[c]] : 0;
     memcpy(p->flags, rs->bytes, (size_t)n * sizeof *p->flags);
@@ -538,10 +556,10 @@ enum bal_status bal_grid_reorder(struct bal_sim *s, struct bal_error *err)
             s->slot[s->id[i]] = i;
         for (int k = 0; k < s->n_probes; k++) {
             struct bal_probe_ref *p = &s->probes[k];
-            const int disc_a = !p->a_wall && (p->kind <= BAL_PROBE_CONTACT_SLIDING ||
+            const int disc_a = !p->a_wall && (bal_probe_is_contact(p->kind) ||
                                               (p->kind >= BAL_PROBE_DISC_X &&
                                                p->kind <= BAL_PROBE_DISC_OMEGA));
-            const int disc_b = !p->b_wall && p->kind <= BAL_PROBE_CONTACT_SLIDING;
+            const int disc_b = !p->b_wall && bal_probe_is_contact(p->kind);
             const int old_a = p->a, old_b = p->b;
             for (int i = 0; i < n && (disc_a || disc_b); i++) {
                 if (disc_a && s->new2old[i] == old_a)

@@ -13,6 +13,26 @@
  *   tangential  F_s += k_s ṡ Δt, |F_s| ≤ F_n tan φ_μ + c (eqs 15, 17–19);
  *               the slip's loss F_max |slip| for the energy audit
  *               history: F_s
+ *   rolling     Jiang, Yu & Harris (2005), Secs 2–3: the contact width
+ *               B = δ r (eq. 24) with the common radius r = 2 r1 r2/(r1 + r2)
+ *               (eq. 9b; r = 2 r1 against a wall, eq. 11b); the rolling
+ *               stiffness K_m = K_n B²/12 (eq. 29), the peak moment
+ *               M_0 = F_n B/6 (eq. 33), the rolling dashpot μ_m = μ_n B²/12
+ *               (eq. 49c).  The relative rotation θ_r accumulates
+ *               dθ_r = dθ_1 − dθ_2 (eqs 12–13) and the elastic moment M
+ *               follows it incrementally, M += K_m dθ_r, like the shear
+ *               spring; Model 1 (eq. 35) caps |M| at M_0 (plastic rolling,
+ *               unloading elastic from the cap), Model 2 (eq. 36) loses M
+ *               for good once |M| would pass M_0 (|θ_r| > θ_r⁰ = M_0/K_m =
+ *               2 F_n/(K_n B)): the contact width is gone until the contact
+ *               opens and forms again.  The couples act on the rotations only
+ *               (eq. 52): −(M + M_d) on x, +(M + M_d) on y, M_d = μ_m θ̇_r.
+ *               history: M, θ_r; flags ROLLING (at the cap), BROKEN (Model 2)
+ *
+ * In ballast's notation JYH's K_n is the pair's k_n (for the power law with
+ * ν ≠ 1 its coefficient k_n, not the tangent stiffness) and μ_n the pair's
+ * normal dashpot c_n + γ_n (δ/δ0)^ψ.  JYH's Table 1 writes K_s in eq. (29);
+ * the derivation (eqs 25–28) and eq. (49d) have K_n: a misprint.
  *
  * A kernel takes the contact's kinematics (struct bal_kin), its pair law
  * (struct bal_pair_law) and its own slice of history, and returns a force;
@@ -46,6 +66,7 @@ struct bal_pair_law {
     double cohesion;       /* smaller c of the two */
     double cn, cs;         /* dashpots β k_n, β k_s */
     int shear;             /* 1 if tan φ_μ > 0 or c > 0: the pair has a shear force */
+    double rolling;        /* the smaller δ of the two (JYH eq. 24); 0: no rolling law */
 };
 
 /* The parameters of the chain that do not depend on the pair. */
@@ -54,6 +75,7 @@ struct bal_law_params {
     double nu, delta0;     /* power law (MLH eq. 2) */
     double gamma_n, psi;   /* viscous normal damping (MLH eq. 3) */
     double dt;             /* the time step: the incremental springs' Δt */
+    int rolling_model;     /* enum bal_rolling_model */
 };
 
 /* The kinematics of one touching contact at t_N. */
@@ -65,6 +87,8 @@ struct bal_kin {
 
 #define BAL_PAIR_TOUCHING 1u
 #define BAL_PAIR_SLIDING 2u
+#define BAL_PAIR_ROLLING 4u  /* Model 1: the rolling moment is at its cap M_0 */
+#define BAL_PAIR_BROKEN 8u   /* Model 2: the contact has lost its rolling resistance */
 
 /* ---------------------------------------------------------------- normal */
 
@@ -154,6 +178,71 @@ static inline double bal_law_tangential(const struct bal_law_params *P,
 static inline double bal_law_shear_energy(const struct bal_pair_law *L, double fs)
 {
     return L->ks > 0 ? fs * fs / (2 * L->ks) : 0;
+}
+
+/* --------------------------------------------------------------- rolling */
+
+/* The rolling parameters of a contact of common radius r (JYH eqs 24, 29,
+ * 33, 49c): B = δ r, K_m = K_n B²/12, M_0 = F_n B/6, μ_m = μ_n B²/12.
+ * Written as K_n B²/12 with B = δ r, in that order, so that the law tester's
+ * hand values (check_contacts.c) are the same products. */
+struct bal_roll {
+    double b;              /* contact width B */
+    double km;             /* rolling stiffness K_m */
+};
+
+static inline struct bal_roll bal_law_roll_of(const struct bal_pair_law *L, double r)
+{
+    const double b = L->rolling * r;
+    return (struct bal_roll){b, L->kn * b * b / 12};
+}
+
+/* The common radius 2 r1 r2/(r1 + r2) of two discs (eq. 9b). */
+static inline double bal_law_common_radius(double r1, double r2)
+{
+    return 2 * r1 * r2 / (r1 + r2);
+}
+
+/* The elastic rolling moment M at t_N from its history m_prev and the
+ * increment of relative rotation dtheta = (ω_x − ω_y) Δt, with the elastic
+ * F_n of this cycle (the cap follows the current normal force).  Model 1
+ * caps |M| at M_0: the capped spring gives up (|M| − M_0)/K_m of plastic
+ * rolling against M_0, added to *lost, and the contact is flagged ROLLING.
+ * Model 2: a contact flagged BROKEN carries no moment; one whose |M| would
+ * pass M_0 is flagged BROKEN and its spring's energy M²/(2 K_m) is lost. */
+static inline double bal_law_rolling(const struct bal_law_params *P, struct bal_roll R, double fn,
+                                     double dtheta, double m_prev, double *lost, uint8_t *flags)
+{
+    if (*flags & BAL_PAIR_BROKEN)
+        return 0;
+    double m = m_prev + R.km * dtheta;
+    const double m0 = fn * R.b / 6;
+    if (fabs(m) > m0) {
+        if (P->rolling_model == BAL_ROLLING_MODEL2) {
+            *lost += m * m / (2 * R.km);
+            *flags |= BAL_PAIR_BROKEN;
+            return 0;
+        }
+        *lost += m0 * (fabs(m) - m0) / R.km;
+        m = copysign(m0, m);
+        *flags |= BAL_PAIR_ROLLING;
+    }
+    return m;
+}
+
+/* The rolling dashpot's moment M_d = μ_m θ̇_r, μ_m = μ_n B²/12 (eq. 49c),
+ * with μ_n the pair's normal dashpot coefficient at overlap δ. */
+static inline double bal_law_rolling_dashpot(const struct bal_law_params *P,
+                                             const struct bal_pair_law *L, struct bal_roll R,
+                                             double delta, double theta_dot)
+{
+    return (L->cn + bal_law_viscous(P, delta)) * R.b * R.b / 12 * theta_dot;
+}
+
+/* The energy the rolling spring stores, M²/(2 K_m). */
+static inline double bal_law_rolling_energy(struct bal_roll R, double m)
+{
+    return R.km > 0 ? m * m / (2 * R.km) : 0;
 }
 
 #endif /* BAL_LAWS_H */

@@ -71,6 +71,13 @@ double bal_measure_normal_energy(const struct bal_sim *s, const struct bal_pair_
     return bal_law_normal_energy(&P, L, fn, delta);
 }
 
+double bal_measure_common_radius(const struct bal_sim *s, int walls, const struct bal_pairs *p,
+                                 long c)
+{
+    const int i = p->i[c];
+    return walls ? 2 * s->r[i] : bal_law_common_radius(s->r[i], s->r[p->j[c]]);
+}
+
 double bal_measure_elastic(const struct bal_sim *s)
 {
     const struct bal_law_params P = bal_law_params_of(s);
@@ -85,6 +92,9 @@ double bal_measure_elastic(const struct bal_sim *s)
             const double delta = bal_pairs_overlap(s, walls, c, &rmin, &L);
             e += bal_law_normal_energy(&P, L, p->fn[c], delta);
             e += bal_law_shear_energy(L, pair_fs(p, c));
+            if (p->rolling && L->rolling > 0)
+                e += bal_law_rolling_energy(bal_law_roll_of(L, bal_measure_common_radius(s, walls, p, c)),
+                                            p->mr[c]);
         }
     }
     return e;
@@ -120,6 +130,26 @@ void bal_measure_dashpots(const struct bal_sim *s, const struct bal_pairs *p, lo
         k.sdot = rvx * ey - rvy * ex - (wi * s->r[i] + wj * s->r[j]);
         *ds = bal_law_shear_dashpot(L, &k);
     }
+}
+
+double bal_measure_rolling_dashpot(const struct bal_sim *s, const struct bal_pairs *p, long c)
+{
+    if (!p->rolling || !s->has_damping || !(p->flags[c] & BAL_PAIR_TOUCHING))
+        return 0;
+    if (p != &s->pp)
+        return p->dm ? p->dm[c] : 0;
+    const int i = p->i[c], j = p->j[c];
+    const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + s->mat[j]];
+    if (!(L->rolling > 0))
+        return 0;
+    double vxi, vyi, wi, vxj, vyj, wj;
+    bal_integrate_previous(s, i, &vxi, &vyi, &wi);
+    bal_integrate_previous(s, j, &vxj, &vyj, &wj);
+    const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
+    const double dist = sqrt(dx * dx + dy * dy); /* as the cycle computes it */
+    const struct bal_law_params P = bal_law_params_of(s);
+    const struct bal_roll R = bal_law_roll_of(L, bal_law_common_radius(s->r[i], s->r[j]));
+    return bal_law_rolling_dashpot(&P, L, R, s->r[i] + s->r[j] - dist, wi - wj);
 }
 
 static double contact_force(const struct bal_sim *s, const struct bal_pairs *p, long c)

@@ -12,6 +12,13 @@
  * Zero for a contact that is not touching. */
 void bal_measure_dashpots(const struct bal_sim *s, const struct bal_pairs *p, long c, double *dn,
                           double *ds);
+/* The rolling dashpot's moment M_d of contact c of list p in the last cycle
+ * (JYH eq. 49c): stored for walls, recomputed for disc pairs as the cycle
+ * computed it; 0 without rolling resistance or damping. */
+double bal_measure_rolling_dashpot(const struct bal_sim *s, const struct bal_pairs *p, long c);
+/* The common radius of contact c (JYH eq. 9b; 2 r against a wall, eq. 11b). */
+double bal_measure_common_radius(const struct bal_sim *s, int walls, const struct bal_pairs *p,
+                                 long c);
 /* Velocities of disc i at t_N (eq. 31), recovered after a cycle. */
 void bal_measure_velocity(const struct bal_sim *s, int i, double *vx, double *vy, double *w);
 /* Per disc, Σ_c f^c ⊗ l^c over its contacts (MLH eq. 8 without 1/V), into

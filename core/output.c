@@ -115,9 +115,23 @@ static void body_name(const struct bal_sim *s, int is_wall, int index, char *buf
         bal_output_disc_name(s, s->id[index], buf, size);
 }
 
+/* With rolling resistance, a contact's row ends with its rolling moment M,
+ * its rolling dashpot's M_d, its relative rotation θ_r (all oriented from
+ * body a to body b, the couple on a being −(M + M_d)) and its rolling state
+ * (1 at the cap, 2 lost: Model 2); a scene without rolling writes none of
+ * these columns. */
+static void rolling_columns(const struct bal_sim *s, const struct bal_pairs *p, long c, FILE *f)
+{
+    if (!p->rolling)
+        return;
+    fprintf(f, "\t%.17g\t%.17g\t%.17g\t%d", p->mr[c], bal_measure_rolling_dashpot(s, p, c),
+            p->tr[c], (p->flags[c] & BAL_PAIR_BROKEN) ? 2 : (p->flags[c] & BAL_PAIR_ROLLING) ? 1 : 0);
+}
+
 static void write_contacts(const struct bal_sim *s, FILE *f)
 {
-    fputs("a\tb\tkind\tx\ty\tnx\tny\tfn\tfs\tdn\tds\tsliding\n", f);
+    fputs("a\tb\tkind\tx\ty\tnx\tny\tfn\tfs\tdn\tds\tsliding", f);
+    fputs(s->has_rolling ? "\tmr\tmd\ttheta_r\trolling\n" : "\n", f);
     char a[2 * BAL_NAME_MAX], b[2 * BAL_NAME_MAX];
     for (long c = 0; c < s->pp.n; c++) {
         if (!(s->pp.flags[c] & BAL_PAIR_TOUCHING))
@@ -130,9 +144,11 @@ static void write_contacts(const struct bal_sim *s, FILE *f)
         body_name(s, 0, j, b, sizeof b);
         double dn, ds;
         bal_measure_dashpots(s, &s->pp, c, &dn, &ds);
-        fprintf(f, "%s\t%s\tdisc\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d\n", a,
+        fprintf(f, "%s\t%s\tdisc\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d", a,
                 b, s->x[i] + at * ex, s->y[i] + at * ey, ex, ey, s->pp.fn[c], pair_fs(&s->pp, c),
                 dn, ds, (s->pp.flags[c] & BAL_PAIR_SLIDING) != 0);
+        rolling_columns(s, &s->pp, c, f);
+        fputc('\n', f);
     }
     for (long c = 0; c < s->pw.n; c++) {
         if (!(s->pw.flags[c] & BAL_PAIR_TOUCHING))
@@ -145,9 +161,11 @@ static void write_contacts(const struct bal_sim *s, FILE *f)
          * (C&S p. 49, contact A of Fig. 1). */
         const double at = 0.5 * (s->r[i] + d);
         body_name(s, 0, i, a, sizeof a);
-        fprintf(f, "%s\t%s\twall\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d\n", a,
+        fprintf(f, "%s\t%s\twall\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d", a,
                 W->name, s->x[i] + at * ex, s->y[i] + at * ey, ex, ey, s->pw.fn[c], s->pw.fs[c],
                 s->pw.dn[c], s->pw.ds[c], (s->pw.flags[c] & BAL_PAIR_SLIDING) != 0);
+        rolling_columns(s, &s->pw, c, f);
+        fputc('\n', f);
     }
 }
 
@@ -381,6 +399,10 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
         for (size_t k = 0; k < sizeof terms / sizeof terms[0]; k++) {
             fprintf(f, ", \"%s\": ", terms[k].name);
             json_number(f, terms[k].v);
+        }
+        if (s->has_rolling) { /* a scene without rolling keeps the run.json it had */
+            fputs(", \"dissipated_rolling\": ", f);
+            json_number(f, en.dissipated_rolling);
         }
         fputs("}", f);
         fputs(",\n  \"unbalanced\": ", f);

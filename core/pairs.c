@@ -45,6 +45,10 @@ enum bal_status bal_pairs_reserve(struct bal_pairs *p, long cap)
     if (ok && p->damping)
         ok = grow_array((void **)&p->dn, c, sizeof *p->dn) &&
              grow_array((void **)&p->ds, c, sizeof *p->ds);
+    if (ok && p->rolling)
+        ok = grow_array((void **)&p->mr, c, sizeof *p->mr) &&
+             grow_array((void **)&p->tr, c, sizeof *p->tr) &&
+             (!p->damping || grow_array((void **)&p->dm, c, sizeof *p->dm));
     if (!ok)
         return BAL_ENOMEM;
     p->cap = cap;
@@ -53,17 +57,21 @@ enum bal_status bal_pairs_reserve(struct bal_pairs *p, long cap)
 
 void bal_pairs_free(struct bal_pairs *p)
 {
-    const uint8_t shear = p->shear, damping = p->damping;
+    const uint8_t shear = p->shear, damping = p->damping, rolling = p->rolling;
     free(p->i);
     free(p->j);
     free(p->fn);
     free(p->fs);
     free(p->dn);
     free(p->ds);
+    free(p->mr);
+    free(p->tr);
+    free(p->dm);
     free(p->flags);
     memset(p, 0, sizeof *p);
     p->shear = shear;
     p->damping = damping;
+    p->rolling = rolling;
 }
 
 enum bal_status bal_pairs_reserve_chunks(struct bal_sim *s)
@@ -76,6 +84,12 @@ enum bal_status bal_pairs_reserve_chunks(struct bal_sim *s)
     if (!q)
         return BAL_ENOMEM;
     par->chunk_sums = q;
+    if (s->pp.rolling) {
+        q = realloc(par->chunk_roll, (size_t)need * sizeof *q);
+        if (!q)
+            return BAL_ENOMEM;
+        par->chunk_roll = q;
+    }
     par->chunk_cap = need;
     return BAL_OK;
 }
@@ -111,6 +125,12 @@ void bal_pairs_merge_history(struct bal_pairs *fresh, const struct bal_pairs *ol
         if (fresh->damping) {
             fresh->dn[c] = same ? old->dn[a] : 0;
             fresh->ds[c] = same ? old->ds[a] : 0;
+        }
+        if (fresh->rolling) {
+            fresh->mr[c] = same ? old->mr[a] : 0;
+            fresh->tr[c] = same ? old->tr[a] : 0;
+            if (fresh->damping)
+                fresh->dm[c] = same ? old->dm[a] : 0;
         }
     }
 }

@@ -50,6 +50,26 @@ double bal_probes_value(const struct bal_sim *s, int probe)
             return pair_fs(list, c);
         return (list->flags[c] & BAL_PAIR_SLIDING) ? 1 : 0;
     }
+    case BAL_PROBE_CONTACT_MR:
+    case BAL_PROBE_CONTACT_THETA_R:
+    case BAL_PROBE_CONTACT_ROLLING: {
+        /* The rolling moment M (elastic; JYH eq. 28, capped by eq. 35) that
+         * body b exerts on body a is −M: the probe gives M, positive when a
+         * turns counter-clockwise against b.  θ_r is accumulated since the
+         * contact formed; `rolling` is 1 at the cap (Model 1), 2 once the
+         * resistance is lost (Model 2). */
+        const struct bal_pairs *list = NULL;
+        const long c = bal_pairs_find_contact(s, p->a_wall, p->a, p->b_wall, p->b, &list);
+        if (c < 0 || !(list->flags[c] & BAL_PAIR_TOUCHING))
+            return 0;
+        /* The list orders the pair as (lower slot, higher) or (disc, wall):
+         * seen from the other body the signs turn. */
+        const int flip = !p->a_wall && !p->b_wall ? p->a > p->b : p->a_wall;
+        if (p->kind == BAL_PROBE_CONTACT_ROLLING)
+            return (list->flags[c] & BAL_PAIR_BROKEN) ? 2 : (list->flags[c] & BAL_PAIR_ROLLING) ? 1 : 0;
+        const double v = p->kind == BAL_PROBE_CONTACT_MR ? pair_mr(list, c) : pair_tr(list, c);
+        return flip ? -v : v;
+    }
     case BAL_PROBE_WALL_F1:
         return s->walls[p->a].f[0];
     case BAL_PROBE_WALL_F2:
@@ -85,6 +105,7 @@ double bal_probes_value(const struct bal_sim *s, int probe)
     case BAL_PROBE_DISSIPATED_DASHPOT:
     case BAL_PROBE_DISSIPATED_FRICTION:
     case BAL_PROBE_DISSIPATED_GLOBAL:
+    case BAL_PROBE_DISSIPATED_ROLLING:
     case BAL_PROBE_ENERGY_IMBALANCE: {
         struct bal_energy e;
         bal_energy_report(s, &e);
@@ -93,6 +114,7 @@ double bal_probes_value(const struct bal_sim *s, int probe)
         case BAL_PROBE_WORK_GRAVITY: return e.work_gravity;
         case BAL_PROBE_DISSIPATED_DASHPOT: return e.dissipated_dashpot;
         case BAL_PROBE_DISSIPATED_FRICTION: return e.dissipated_friction;
+        case BAL_PROBE_DISSIPATED_ROLLING: return e.dissipated_rolling;
         case BAL_PROBE_DISSIPATED_GLOBAL: return e.dissipated_global;
         default: return e.imbalance;
         }

@@ -89,6 +89,10 @@ const struct bal_key bal_scene_keys[] = {
      "centred verlet gear5",
      "law of motion: centred (C&S eqs 22-23, 35-36), verlet (velocity Verlet), gear5 (Gear "
      "predictor-corrector, MLH Sec. 5.3)"},
+    {BAL_SEC_SETTINGS, "rolling_model", BAL_KEY_ENUM, S(rolling_model), "model1", 0, 0, 0,
+     "model1 model2",
+     "rolling resistance of pairs with material rolling > 0: model1 elasto-plastic (JYH eq. 35), "
+     "model2 elasto-brittle (eq. 36)"},
 
     /* [material NAME] */
     {BAL_SEC_MATERIAL, "kn", BAL_KEY_DOUBLE, M(kn), NULL, 1, KMIN, KBIG, NULL,
@@ -101,6 +105,9 @@ const struct bal_key bal_scene_keys[] = {
      "cohesion c, force; a contact uses the smaller of its two bodies' (C&S eq. 19)"},
     {BAL_SEC_MATERIAL, "density", BAL_KEY_DOUBLE, M(density), "0", 0, 0, BIG, NULL,
      "mass per unit area of a disc (m = density pi r^2); required for disc materials"},
+    {BAL_SEC_MATERIAL, "rolling", BAL_KEY_DOUBLE, M(rolling), "0", 0, 0, 2, NULL,
+     "shape parameter delta of rolling resistance, contact width B = delta r (JYH eq. 24); a pair "
+     "uses the smaller of its two; 0 = none"},
 
     /* [disc NAME] */
     {BAL_SEC_DISC, "x", BAL_KEY_VEC2, D(x), NULL, 1, -BIG, BIG, NULL, "centre x_1 x_2"},
@@ -192,7 +199,8 @@ const struct bal_key bal_scene_keys[] = {
      "disc_x disc_y disc_vx disc_vy disc_theta disc_omega "
      "energy_kinetic energy_elastic work_walls work_gravity dissipated_dashpot "
      "dissipated_friction dissipated_global energy_imbalance unbalanced n_contacts n_sliding "
-     "held_fx held_fy weight_x weight_y",
+     "held_fx held_fy weight_x weight_y contact_mr contact_theta_r contact_rolling "
+     "dissipated_rolling",
      "what the series column holds"},
     {BAL_SEC_PROBE, "a", BAL_KEY_NAME, P(a), "", 0, 0, 0, NULL,
      "body: the disc (disc_*), the wall (wall_*), or the first body of a contact"},

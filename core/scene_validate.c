@@ -217,8 +217,7 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
     for (int i = 0; i < s->n_probes; i++) {
         struct bal_probe_def *p = &s->probes[i];
         int k = p->kind, wa = 0, wb = 0;
-        int contact = k == BAL_PROBE_CONTACT_FN || k == BAL_PROBE_CONTACT_FS ||
-                      k == BAL_PROBE_CONTACT_SLIDING;
+        int contact = bal_probe_is_contact(k);
         int wall = k >= BAL_PROBE_WALL_F1 && k <= BAL_PROBE_WALL_ECC;
         int disc = k >= BAL_PROBE_DISC_X && k <= BAL_PROBE_DISC_OMEGA;
         if (contact || wall || disc) {

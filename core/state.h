@@ -47,15 +47,20 @@ struct bal_wall_controller_type; /* how a stage drives a wall: walls.h */
  * list does.  Read F_s through pair_fs(). */
 struct bal_pairs {
     long n, cap;
-    uint8_t shear, damping; /* which optional columns exist */
+    uint8_t shear, damping, rolling; /* which optional columns exist */
     int32_t *i, *j;        /* disc index; j: disc index or wall index; sorted by
                             * pair_key() ascending */
     double *fn, *fs;       /* F_n (history of the incremental law), F_s */
     double *dn, *ds;       /* dashpot forces D_n, D_s of the last cycle */
+    double *mr, *tr;       /* rolling: the elastic moment M and the relative rotation
+                            * θ_r accumulated since the contact formed (laws.h) */
+    double *dm;            /* rolling: the dashpot's moment M_d of the last cycle (walls) */
     uint8_t *flags;
 };
 
 static inline double pair_fs(const struct bal_pairs *p, long c) { return p->fs ? p->fs[c] : 0.0; }
+static inline double pair_mr(const struct bal_pairs *p, long c) { return p->mr ? p->mr[c] : 0.0; }
+static inline double pair_tr(const struct bal_pairs *p, long c) { return p->tr ? p->tr[c] : 0.0; }
 
 /* The sort key of candidate c, (i << 32) | j. */
 static inline uint64_t pair_key(const struct bal_pairs *p, long c)
@@ -143,6 +148,7 @@ struct bal_audit {
     double glob_sum;       /* Σ (m v_N² + I ω_N²) of this cycle (centred integrator) */
     double dash_sum;       /* Σ (F^D·v_N + M^D ω_N) of this cycle (centred integrator) */
     double d_friction;     /* dissipated by sliding at the Coulomb limit */
+    double d_rolling;      /* dissipated by plastic rolling / lost rolling springs */
     double d_global;       /* dissipated by global damping */
     double d_global_last;  /* ... in the latest cycle */
 };
@@ -181,6 +187,7 @@ struct bal_par {
     struct bal_sum_log *log[BAL_MAX_THREADS];
     long log_n[BAL_MAX_THREADS], log_cap[BAL_MAX_THREADS];
     double *chunk_sums;          /* per chunk of candidates: the friction loss */
+    double *chunk_roll;          /* ... and the rolling loss (only with rolling) */
     long chunk_cap;
     double *block_sums;          /* per block of discs, 2 each: a pass's sums (integrate.c) */
 };
@@ -264,7 +271,8 @@ struct bal_sim {
     double nu, delta0;
     double gamma_n, psi;         /* viscous normal damping of MLH eq. (3) */
     int has_shear;               /* any material pair with k_s and a non-zero cap */
-    int has_damping;             /* β > 0 */
+    int has_damping;             /* β > 0 or γ_n > 0 */
+    int has_rolling;             /* any material pair with rolling δ > 0 (JYH) */
 
     /* pile rows and stresses */
     int32_t *row;                /* row M of a pile disc, -1 otherwise; NULL without piles */
@@ -322,7 +330,9 @@ static inline double bal_mass(const struct bal_sim *s, int i)
  * the pair, as the loops read them. */
 static inline struct bal_law_params bal_law_params_of(const struct bal_sim *s)
 {
-    return (struct bal_law_params){s->normal_law, s->nu, s->delta0, s->gamma_n, s->psi, s->dt};
+    return (struct bal_law_params){s->normal_law, s->nu,  s->delta0,
+                                   s->gamma_n,    s->psi, s->dt,
+                                   s->scene->settings.rolling_model};
 }
 
 static inline double bal_inertia(const struct bal_sim *s, int i)

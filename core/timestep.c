@@ -117,11 +117,13 @@ double bal_timestep_single_spring(const struct bal_sim *s)
 {
     double best = INFINITY;
     for (int i = 0; i < s->n; i++) {
-        double kn = 0, ks = 0;
+        double kn = 0, ks = 0, km = 0;
         for (int m = 0; m < s->n_mat; m++) {
             const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + m];
             kn = fmax(kn, L->kn);
             ks = fmax(ks, L->ks);
+            /* the stiffest rolling spring: against a wall, r = 2 R */
+            km = fmax(km, bal_law_roll_of(L, 2 * s->r[i]).km);
         }
         if (s->normal_law == BAL_NORMAL_POWER)
             kn *= s->nu;
@@ -131,6 +133,8 @@ double bal_timestep_single_spring(const struct bal_sim *s)
             t = fmin(t, 2 * sqrt(m / ks));
             t = fmin(t, 2 * sqrt(bal_inertia(s, i) / (ks * s->r[i] * s->r[i])));
         }
+        if (km > 0)
+            t = fmin(t, 2 * sqrt(bal_inertia(s, i) / km));
         best = fmin(best, t);
     }
     return best;
@@ -207,6 +211,12 @@ static void disc_inv(const struct bal_sim *s, int i, double *inv_m, double *r2_i
     *r2_i = s->r[i] * s->r[i] / bal_inertia(s, i);
 }
 
+/* 1/I of disc i, zero for a held disc. */
+static double inv_inertia(const struct bal_sim *s, int i)
+{
+    return s->fixed[i] ? 0 : 1 / bal_inertia(s, i);
+}
+
 /* Add contact c to the rows of its free discs, with the rotational weight
  * γ (see bal_timestep_detail): the shear term adds k_s S_γ to the
  * translational row and γ k_s S_γ to the rotational one, S_γ = 1/m_a +
@@ -223,6 +233,12 @@ static void add_contact(const struct bal_sim *s, struct dt_acc *acc, const struc
         disc_inv(s, b, &ib, &rb);
     const double A = pair_kn(s, L) * (ia + ib);
     const double B = L->shear ? L->ks * (ia + ib + (ra + rb) / gamma) : 0;
+    /* The rolling spring ½ K_m (θ_a − θ_b)² ≤ K_m (1/I_a + 1/I_b)
+     * (I_a θ_a² + I_b θ_b²): its share of the rotational row. */
+    const double rc = b >= 0 ? bal_law_common_radius(s->r[a], s->r[b]) : 2 * s->r[a];
+    const double Kr = L->rolling > 0 ? bal_law_roll_of(L, rc).km * (inv_inertia(s, a) +
+                                                                    (b >= 0 ? inv_inertia(s, b) : 0))
+                                     : 0;
     const double beta = pair_beta(s, L);
     const double nx = c->nx, ny = c->ny;
     const int ends[2] = {a, b};
@@ -235,7 +251,7 @@ static void add_contact(const struct bal_sim *s, struct dt_acc *acc, const struc
         q->txx += A * nx * nx + B * ny * ny;
         q->tyy += A * ny * ny + B * nx * nx;
         q->txy += (A - B) * nx * ny;
-        q->rot += gamma * B;
+        q->rot += gamma * B + Kr;
         q->beta = fmax(q->beta, beta);
         q->n++;
     }
@@ -406,7 +422,7 @@ static double coordination_omega2(const struct bal_sim *s, int i, struct dt_coor
     }
     double ia, ra;
     disc_inv(s, i, &ia, &ra);
-    double A = 0, B = 0;
+    double A = 0, B = 0, R = 0;
     *beta = 0;
     for (int m = 0; m < s->n_mat; m++) {
         const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + m];
@@ -414,10 +430,14 @@ static double coordination_omega2(const struct bal_sim *s, int i, struct dt_coor
         A = fmax(A, pair_kn(s, L) * (ia + inv_m_max));
         if (L->shear)
             B = fmax(B, L->ks * (ia + inv_m_max + (ra + 2 * inv_m_max) / gamma));
+        /* rolling: K_m (1/I_i + 1/I_j) with the common radius at most 2 R of
+         * either disc, so K_m/I ≤ k_n δ² (2R)²/12 / (m R²/2) = (2/3) k_n δ²/m */
+        if (L->rolling > 0)
+            R = fmax(R, 2.0 / 3 * L->kn * L->rolling * L->rolling * (ia + inv_m_max));
         *beta = fmax(*beta, pair_beta(s, L));
     }
     const double t = A >= B ? B * n + (A - B) * lambda : B * n - (B - A) * (n - lambda);
-    return fmax(t, gamma * B * n);
+    return fmax(t, (gamma * B + R) * n);
 }
 
 /* Rotational weights tried: every one gives a bound, the smallest is used.
@@ -461,6 +481,14 @@ static void contact_blocks(const struct bal_sim *s, const struct dt_contact *c, 
     da[8] = ks * ra * ra;
     db[8] = ks * rb * rb;
     cab[8] = ks * ra * rb;
+    /* The rolling spring ½ K_m (θ_a − θ_b)² (JYH eq. 28; r = 2 r_a against
+     * a wall). */
+    if (L->rolling > 0) {
+        const double km = bal_law_roll_of(L, b >= 0 ? bal_law_common_radius(ra, rb) : 2 * ra).km;
+        da[8] += km;
+        db[8] += km;
+        cab[8] -= km;
+    }
 }
 
 /* Steps of the power iteration for the spectral radius of |A|: at most

@@ -43,6 +43,7 @@ Suite *suite_measure(void);
 Suite *suite_exact(void);
 Suite *suite_energy(void);
 Suite *suite_threads(void);
+Suite *suite_rolling(void);
 
 /* Room for the scene texts the tests format. */
 #define T_TEXT_MAX 8192

@@ -937,7 +937,7 @@ static const struct fuzz_case {
     {"fuzz/regress/kn_overflow.scene", 'p', BAL_EINVAL,
      "kn_overflow.scene:4: kn: 1e+155 is out of range: expected 1e-150 <= value <= 1e+150"},
     {"fuzz/regress/enum_long_message.scene", 'p', BAL_EINVAL,
-     "weight_x weight_y}, got 'no_such_quantity'"},
+     "contact_rolling dissipated_rolling}, got 'no_such_quantity'"},
     {"fuzz/regress/name_clash.scene", 'c', BAL_EINVAL,
      "name_clash.scene:6: [fill f]: makes a wall 'f_top', but a disc or wall has that name"},
     {"fuzz/regress/disc_wall_clash.scene", 'c', BAL_EINVAL,

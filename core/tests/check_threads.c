@@ -20,7 +20,7 @@
 static const char *const packing_fmt =
     "[settings]\ndt = 0.0007926748447693654\nforce_dt = 1\ngravity = 0 -60\n"
     "alpha = 0.5\n%s"
-    "[material grain]\nkn = 1e5\nks = 1e5\nfriction = %g\ndensity = 1\n"
+    "[material grain]\nkn = 1e5\nks = 1e5\nfriction = %g\ndensity = 1\nrolling = %g\n"
     "[material box]\nkn = 1e5\nks = 1e5\nfriction = %g\n"
     "[fill pack]\nn = 12000\ncolumns = %d\nrmin = 0.5\nrmax = 0.75\nseed = 7\nbox = 1\n"
     "headroom = 2\nvmax = 2\nmaterial = grain\nwall_material = box\n"
@@ -28,14 +28,16 @@ static const char *const packing_fmt =
 
 #define CYCLES 1000
 
-/* A variant of the packing: extra settings, the friction, the columns. */
+/* A variant of the packing: extra settings, the friction, the columns, the
+ * grains' rolling resistance δ (JYH; 0: none). */
 struct variant {
     const char *settings;
     double friction;
     int columns;
+    double rolling;
 };
 
-static const struct variant dense = {"beta = 0.001\n", 0.5, 110};
+static const struct variant dense = {"beta = 0.001\n", 0.5, 110, 0};
 static const int cycle_of_counts[] = {3, 1, 2, 16};
 
 /* Run the packing CYCLES cycles on `threads` threads (0: switching between
@@ -43,8 +45,8 @@ static const int cycle_of_counts[] = {3, 1, 2, 16};
  * first logged in one cycle into *logged. */
 static struct tfx *run_on(const struct variant *v, int threads, long *logged)
 {
-    struct tfx *f = tfx_newf("threads", packing_fmt, v->settings, v->friction, v->friction,
-                             v->columns);
+    struct tfx *f = tfx_newf("threads", packing_fmt, v->settings, v->friction, v->rolling,
+                             v->friction, v->columns);
     ck_assert_int_eq(bal_sim_set_threads(f->sim, threads ? threads : 3, &f->err), BAL_OK);
     *logged = 0;
     for (long k = 0; k < CYCLES; k++) {
@@ -118,6 +120,10 @@ static void check_as_one(const struct variant *v, const int *counts, int n_count
         same_doubles(a->pp.fn, b->pp.fn, np, "F_n history", th);
         if (a->pp.fs)
             same_doubles(a->pp.fs, b->pp.fs, np, "F_s history", th);
+        if (a->pp.mr) {
+            same_doubles(a->pp.mr, b->pp.mr, np, "rolling moment history", th);
+            same_doubles(a->pp.tr, b->pp.tr, np, "rolling rotation history", th);
+        }
         ck_assert(memcmp(a->pp.flags, b->pp.flags, np) == 0);
         /* the energy audit's sums over candidates and discs */
         ck_assert(memcmp(&a->audit, &b->audit, sizeof a->audit) == 0);
@@ -138,7 +144,7 @@ END_TEST
  * their order. */
 START_TEST(threads_bitwise_ranges_shorter_than_reach)
 {
-    const struct variant wide = {"beta = 0.001\n", 0.5, 3000};
+    const struct variant wide = {"beta = 0.001\n", 0.5, 3000, 0};
     const int counts[] = {4};
     check_as_one(&wide, counts, 1, 2000, 1);
 }
@@ -149,10 +155,20 @@ END_TEST
  * velocity Verlet, whose passes stay on one thread. */
 START_TEST(threads_bitwise_power_law_verlet)
 {
-    const struct variant bare = {"normal_law = power\nintegrator = verlet\n",
-                                 0, 110};
+    const struct variant bare = {"normal_law = power\nintegrator = verlet\n", 0, 110, 0};
     const int counts[] = {2};
     check_as_one(&bare, counts, 1, 2000, 0);
+}
+END_TEST
+
+/* Rolling resistance (JYH Model 1, δ = 1.6, with the rolling dashpot): its
+ * couples go to the moment sums through the same logs, its losses through
+ * per-chunk sums of their own. */
+START_TEST(threads_bitwise_rolling)
+{
+    const struct variant rolling = {"beta = 0.001\nrolling_model = model1\n", 0.5, 110, 1.6};
+    const int counts[] = {2, 3};
+    check_as_one(&rolling, counts, 2, 2000, 0);
 }
 END_TEST
 
@@ -170,7 +186,7 @@ END_TEST
 START_TEST(threads_count_checked)
 {
     struct tfx *f = tfx_newf("threads", packing_fmt, dense.settings, dense.friction,
-                             dense.friction, dense.columns);
+                             dense.rolling, dense.friction, dense.columns);
     ck_assert_int_eq(bal_sim_set_threads(f->sim, 0, &f->err), BAL_EINVAL);
     ck_assert_msg(t_contains(f->err.msg, "threads"), "%s", f->err.msg);
     ck_assert_int_eq(bal_sim_set_threads(f->sim, BAL_MAX_THREADS + 1, &f->err), BAL_EINVAL);
@@ -192,6 +208,7 @@ Suite *suite_threads(void)
     tcase_add_test(tc, threads_bitwise_ranges_shorter_than_reach);
     tcase_add_test(tc, threads_bitwise_power_law_verlet);
     tcase_add_test(tc, threads_bitwise_when_switched);
+    tcase_add_test(tc, threads_bitwise_rolling);
     tcase_add_test(tc, threads_count_checked);
     suite_add_tcase(s, tc);
     return s;

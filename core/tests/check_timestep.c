@@ -243,6 +243,40 @@ START_TEST(network_disc_on_wall)
 }
 END_TEST
 
+/* Rolling resistance (JYH) adds a rotational spring K_m = k_n (δ r)²/12 per
+ * contact, r = 2 R against a wall: for a frictionless disc on a wall the
+ * rotation has ω² = K_m/I, which with δ = 1.6 is (3.2 R)²/12 k_n/(m R²/2)
+ * = 1.707 k_n/m, above the normal spring's k_n/m: it binds.  With δ = 0.5
+ * (0.167 k_n/m) the normal spring binds again.  Between two free equal
+ * discs (r = R) the rotations see K_m (1/I + 1/I). */
+START_TEST(network_rolling_stiffness)
+{
+    const double deltas[] = {1.6, 0.5};
+    for (int k = 0; k < 2; k++) {
+        struct tfx *f = tfx_newf("ts",
+                                 "[material m]\nkn = %.17g\ndensity = %.17g\nrolling = %.17g\n"
+                                 "[wall w]\np = 0 0\nangle = 0\nh1 = -5\nh2 = 5\nmaterial = m\n"
+                                 "[disc a]\nx = 0 %.17g\nr = %.17g\nmaterial = m\n"
+                                 "[stage s]\ncycles = 1\n",
+                                 KN, RHO, deltas[k], RR, RR);
+        const double m = disc_mass(RR), in = 0.5 * m * RR * RR;
+        const double b = deltas[k] * 2 * RR, km = KN * b * b / 12;
+        ASSERT_REL(bound_of(f), 2 / sqrt(fmax(KN / m, km / in)));
+        tfx_release(f);
+    }
+    struct tfx *f = tfx_newf("ts",
+                             "[material m]\nkn = %.17g\ndensity = %.17g\nrolling = 1.6\n"
+                             "[disc a]\nx = 0 0\nr = %.17g\nmaterial = m\n"
+                             "[disc b]\nx = %.17g 0\nr = %.17g\nmaterial = m\n"
+                             "[stage s]\ncycles = 1\n",
+                             KN, RHO, RR, 2 * RR, RR);
+    const double m = disc_mass(RR), in = 0.5 * m * RR * RR;
+    const double b = 1.6 * RR, km = KN * b * b / 12;
+    /* normal: k_n (2/m); rotation: K_m (2/I) = 0.853 k_n/m: the normal binds */
+    ASSERT_REL(bound_of(f), 2 / sqrt(fmax(2 * KN / m, 2 * km / in)));
+}
+END_TEST
+
 /* C&S Fig. 1: two equal discs between two walls, all touching, frictionless.
  * K/k = [[2, −1], [−1, 2]] along the line: ω² = k/m and 3k/m.  The bound is
  * exact: 3 k/m, √3 below the single-spring step. */
@@ -551,6 +585,7 @@ Suite *suite_timestep(void)
     TCase *net = tcase_create("network");
     tcase_add_checked_fixture(net, NULL, tfx_teardown);
     tcase_add_test(net, network_disc_on_wall);
+    tcase_add_test(net, network_rolling_stiffness);
     tcase_add_test(net, network_two_discs_between_walls);
     tcase_add_test(net, network_damped_limit);
     tcase_add_test(net, network_hexagon);

@@ -488,7 +488,15 @@ static const struct module_config module_configs[] = {
                                   "settings.beta=0", NULL}},
     {"+ nonlinear normal law (nu = 3/2)", {"material.grain.friction=0", "material.box.friction=0",
                                            "settings.beta=0", "settings.alpha=0"}},
-    {"all on", {NULL, NULL, NULL, NULL}},
+    /* rolling resistance rides on the tangential history (the loop that
+     * has it): compare with "+ tangential history" */
+    {"+ tangential + rolling (JYH Model 1, delta 1.6)",
+     {"settings.beta=0", "settings.alpha=0", "material.grain.rolling=1.6", NULL}},
+    {"+ tangential + rolling (JYH Model 2, delta 1.6)",
+     {"settings.beta=0", "settings.alpha=0", "material.grain.rolling=1.6",
+      "settings.rolling_model=model2"}},
+    {"all on (rolling not)", {NULL, NULL, NULL, NULL}},
+    {"all on, rolling Model 1 delta 1.6", {"material.grain.rolling=1.6", NULL, NULL, NULL}},
 };
 
 static int load_config(const char *path, long n, const struct module_config *c, int nonlinear,

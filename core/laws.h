@@ -183,9 +183,9 @@ static inline double bal_law_shear_energy(const struct bal_pair_law *L, double f
 /* --------------------------------------------------------------- rolling */
 
 /* The rolling parameters of a contact of common radius r (JYH eqs 24, 29,
- * 33, 49c): B = δ r, K_m = K_n B²/12, M_0 = F_n B/6, μ_m = μ_n B²/12.
- * Written as K_n B²/12 with B = δ r, in that order, so that the law tester's
- * hand values (check_contacts.c) are the same products. */
+ * 33, 49c): B = δ r, K_m = K_n B²/12, M_0 = F_n B/6, μ_m = μ_n B²/12
+ * (the divisions by 12 and 6 written as products with their reciprocals:
+ * the pair loop avoids a division a contact; round-off of a few ulps). */
 struct bal_roll {
     double b;              /* contact width B */
     double km;             /* rolling stiffness K_m */
@@ -194,7 +194,7 @@ struct bal_roll {
 static inline struct bal_roll bal_law_roll_of(const struct bal_pair_law *L, double r)
 {
     const double b = L->rolling * r;
-    return (struct bal_roll){b, L->kn * b * b / 12};
+    return (struct bal_roll){b, L->kn * b * b * (1.0 / 12)};
 }
 
 /* The common radius 2 r1 r2/(r1 + r2) of two discs (eq. 9b). */
@@ -216,7 +216,7 @@ static inline double bal_law_rolling(const struct bal_law_params *P, struct bal_
     if (*flags & BAL_PAIR_BROKEN)
         return 0;
     double m = m_prev + R.km * dtheta;
-    const double m0 = fn * R.b / 6;
+    const double m0 = fn * R.b * (1.0 / 6);
     if (fabs(m) > m0) {
         if (P->rolling_model == BAL_ROLLING_MODEL2) {
             *lost += m * m / (2 * R.km);
@@ -236,7 +236,7 @@ static inline double bal_law_rolling_dashpot(const struct bal_law_params *P,
                                              const struct bal_pair_law *L, struct bal_roll R,
                                              double delta, double theta_dot)
 {
-    return (L->cn + bal_law_viscous(P, delta)) * R.b * R.b / 12 * theta_dot;
+    return (L->cn + bal_law_viscous(P, delta)) * R.b * R.b * (1.0 / 12) * theta_dot;
 }
 
 /* The energy the rolling spring stores, M²/(2 K_m). */

@@ -89,8 +89,20 @@ def variants(derive):
 def test_every_variant_is_derived(variants):
     case = next(c for c in catalogue.load(ROOT / "cases") if c.name == "rolling_tester")
     assert sorted(variants) == sorted(case.variant_names())
-    assert {(p["model"], p["delta"]) for p in variants.values()} == {
-        (m, Fraction(d)) for m in ("model1", "model2") for d in ("1.6", "0.4")}
+    models = ("model1", "model2")
+    assert sorted((p["kind"], p["model"], p["delta"]) for p in variants.values()) == sorted(
+        [("wall", m, Fraction(d)) for m in models for d in ("1.6", "0.4")] + [("pair", m, Fraction("1.6")) for m in models])
+    pair = variants["pair_model1"]
+    assert pair["r"] == Fraction(3, 5) and pair["d"] == Fraction(1, 4096)     # 2 r1 r2/(r1 + r2), eq. 9b
+
+
+def test_a_flywheel_too_light_to_turn_steadily_is_refused(derive, tmp_path):
+    scene = (ROOT / "cases" / "rolling" / "rolling_pair.scene").read_text()
+    light = tmp_path / "light.scene"
+    light.write_text(scene.replace("density = 1e20", "density = 1e9"))
+    with pytest.raises(AssertionError, match="the flywheel's spin would change"):
+        derive.read_variant(light, [], "light")
+    derive.read_variant(ROOT / "cases" / "rolling" / "rolling_pair.scene", [], "heavy")
 
 
 def test_the_hand_calculation_meets_the_closed_forms(derive, variants):
@@ -129,12 +141,14 @@ def test_the_hand_calculation_meets_the_closed_forms(derive, variants):
 def test_the_figures_draw_the_derivations_nominal_lines(derive, variants):
     case = next(c for c in catalogue.load(ROOT / "cases") if c.name == "rolling_tester")
     moments = [f for f in case.figures if f.x == "theta_r" and f.y == ["mr"]]
-    assert len(moments) == 2
+    assert len(moments) == 3
     for figure in moments:
         for variant in figure.variants:
             km, levels = derive.nominal(variants[variant])
-            expected = [(float(km), 0.0)] + [(0.0, float(s * m)) for m in levels for s in (1, -1)]
-            assert [(slope, intercept) for slope, intercept, _ in figure.lines] == expected, figure.name
+            drawn = [(slope, intercept) for slope, intercept, _ in figure.lines]
+            assert drawn[0] == (float(km), 0.0) and all(slope == 0 for slope, _ in drawn[1:]), figure.name
+            assert [i for _, i in drawn[1:]] in ([float(m) for m in levels],                   # +M_0
+                                                 [float(s * m) for m in levels for s in (1, -1)]), figure.name
 
 
 def test_an_ambiguous_cap_is_refused(derive, variants, monkeypatch):

@@ -2,34 +2,40 @@
 """Derive the reference values of the rolling-resistance law tester (reference/rolling.ref).
 
 This script is the provenance of the numbers in reference/rolling.ref.  It does not run
-ballast.  It reads cases/rolling/rolling_tester.scene and cases/rolling/case.txt (a
-minimal reader, so they cannot disagree) and works the rolling law of Jiang, Yu & Harris
-(2005, JYH) by hand along the wall's prescribed motion, cycle by cycle, in exact rational
-arithmetic (only the cosine of the wall's angle is a float, exact to an ulp):
+ballast.  It reads cases/rolling/case.txt and the scenes its variants name (a minimal
+reader, so they cannot disagree) and works the rolling law of Jiang, Yu & Harris (2005,
+JYH) by hand along the prescribed motion, cycle by cycle, in exact rational arithmetic
+(only the cosine of the wall's angle is a float, exact to an ulp):
 
-1. Kinematics.  The disc is held (it neither moves nor turns) with its centre C = (0, R);
-   the floor wall passes through P = (0, p) at the angle a (0 at the start).  Each cycle
-   the floor moves first (P += V dt, a += omega dt: docs/physics.md, cycle order), so at
-   cycle N the distance from C to the floor's line is (R - p) cos a and the overlap is
+1. Kinematics.  The wall tester (rolling_tester.scene): the disc is held (it neither moves
+   nor turns) with its centre C = (0, R); the floor wall passes through P = (0, p) at the
+   angle a (0 at the start).  Each cycle the floor moves first (P += V dt, a += omega dt:
+   docs/physics.md, cycle order), so at cycle N the distance from C to the floor's line is
+   (R - p) cos a and the overlap is
        d_N = R - (R - p) cos a = p + (R - p) (1 - cos a).
-   The relative rotation of the disc against the wall is theta_r = int (omega_disc -
-   omega_wall) dt (JYH eqs 12-13, eq. 11 for a wall): it grows by -omega dt a cycle.
+   The pair (rolling_pair.scene): a held disc pressed on a flywheel that turns at a constant
+   omega and neither moves nor slows within rounding (asserted below): d is constant.
+   Either way the relative rotation theta_r = int (omega_a - omega_b) dt (JYH eqs 12-13, 11
+   for a wall) of the held disc a against the other body grows by -omega dt a cycle.
 2. The normal force is the power law with nu = 1, delta0 = 1: F_n = k_n d (MLH eq. 2).
-3. The rolling law, JYH Secs 2-3: the contact width B = delta r (eq. 24) with r = 2 R
-   against a wall (eq. 11b); the rolling stiffness K_m = k_n B^2/12 (eq. 29); the peak
-   moment M_0 = F_n B/6 and theta_r0 = M_0/K_m = 2 F_n/(k_n B) (eq. 33).  Model 1 (eq. 35,
-   the 'elasto-perfectly plastic model') as an incremental elasto-plastic spring:
-   M_trial = M_{N-1} + K_m (theta_N - theta_{N-1}); if |M_trial| > M_0(F_n at N) the moment
-   is M_0 with the sign of M_trial, and the plastic rotation (|M_trial| - M_0)/K_m is
-   dissipated against M_0; unloading is elastic.  Model 2 (eq. 36, 'elasto-brittle'):
-   once |M_trial| > M_0 the moment is 0 for good and the spring's energy M_trial^2/(2 K_m)
-   is lost.  The elastic energy stored is k_n d^2/2 (the power law's int F_n dd) plus
-   M^2/(2 K_m) (eq. 28: M = K_m theta_r, the work int M dtheta_r).
+3. The rolling law, JYH Secs 2-3: the contact width B = delta r (eq. 24) with the common
+   radius r = 2 R against a wall (eq. 11b), 2 r1 r2/(r1 + r2) for two discs (eq. 9b); the
+   rolling stiffness K_m = k_n B^2/12 (eq. 29); the peak moment M_0 = F_n B/6 and
+   theta_r0 = M_0/K_m = 2 F_n/(k_n B) (eq. 33).  Model 1 (eq. 35, the 'elasto-perfectly
+   plastic model') as an incremental elasto-plastic spring: M_trial = M_{N-1} + K_m
+   (theta_N - theta_{N-1}); if |M_trial| > M_0(F_n at N) the moment is M_0 with the sign of
+   M_trial, and the plastic rotation (|M_trial| - M_0)/K_m is dissipated against M_0;
+   unloading is elastic.  Model 2 (eq. 36, 'elasto-brittle'): once |M_trial| > M_0 the
+   moment is 0 for good and the spring's energy M_trial^2/(2 K_m) is lost.  The elastic
+   energy stored is k_n d^2/2 (the power law's int F_n dd) plus M^2/(2 K_m) (eq. 28:
+   M = K_m theta_r, the work int M dtheta_r).
 
 The references follow: the slope K_m over each elastic branch, the cycle where each cap
 starts (where K_m theta_r first passes theta_r0 = 2 F_n/(k_n B): a cap that fell within
 1e-6 of a step would make that cycle ambiguous, and is refused here), the plateau
-M = F_n B/6 at both normal forces, the Model 2 loss and that it lasts, the energies.
+M = F_n B/6 at both normal forces, the Model 2 loss and that it lasts, the energies.  At
+the pair's constant F_n the closed forms hold as they stand (the loss of Model 1 is
+M_0 (theta_r - theta_r0) exactly), and the pair's checks are written from them.
 
 The case's figures draw the nominal reference lines K_m theta_r and +-M_0 at F_n = k_n x
 (the press's overlap), printed in the header; harness/tests/test_rolling.py holds the
@@ -45,7 +51,6 @@ from fractions import Fraction as Q
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 CASE_DIR = os.path.join(HERE, "..", "..", "cases", "rolling")
-SCENE = os.path.join(CASE_DIR, "rolling_tester.scene")
 CASE = os.path.join(CASE_DIR, "case.txt")
 CASE_NAME = "rolling_tester"
 
@@ -86,61 +91,94 @@ def read_ini(path):
     return sections
 
 
-def read_inputs():
-    """{variant: parameters}: the scene's numbers with each variant's --set overrides."""
-    sc = read_ini(SCENE)
-    one = lambda sec, key: sc[sec][key][0]
-    settings = sc["settings"]
+def read_variant(scene, sets, name):
+    """One variant's parameters: its scene's numbers with its --set overrides applied."""
+    sc = read_ini(scene)
+    for s in sets:                                         # section.NAME.key=value or section.key=value
+        key, value = (t.strip() for t in s.split("=", 1))
+        parts = key.split(".")
+        section = parts[0] if len(parts) == 2 else f"{parts[0]} {parts[1]}"
+        if parts[0] == "stage" and parts[-1] == "move":
+            sc[section]["move"] = [value]                  # --set replaces the wall's motion
+        elif section in sc and parts[-1] in ("rolling_model", "rolling"):
+            sc[section][parts[-1]] = [value]
+        else:
+            raise SystemExit(f"case.txt: variant {name}: the derivation does not know '{key}'")
+    one = lambda sec, key, default=None: sc[sec][key][0] if key in sc[sec] else default
     assert one("settings", "normal_law") == "power" and Q(one("settings", "nu")) == 1
     assert Q(one("settings", "delta0")) == 1, "F_n = k_n d needs nu = 1, delta0 = 1"
-    assert not any(k in settings for k in ("alpha", "beta", "gamma_n", "gravity")), \
+    assert not any(k in sc["settings"] for k in ("alpha", "beta", "gamma_n", "gravity")), \
         "the hand calculation has no damping and no gravity"
-    mats = [s for s in sc if s.startswith("material ")]
-    walls = [s for s in sc if s.startswith("wall ")]
-    discs = [s for s in sc if s.startswith("disc ")]
-    assert len(mats) == 1 and len(walls) == 1 and len(discs) == 1, "one material, wall, disc"
-    mat, wall, disc = mats[0], walls[0], discs[0]
-    assert "friction" not in sc[mat] and "cohesion" not in sc[mat], "no shear force"
-    r = Q(one(disc, "r"))
-    assert [Q(t) for t in one(disc, "x").split()] == [0, r] and one(disc, "fixed") == "1"
-    assert [Q(t) for t in one(wall, "p").split()] == [0, 0] and Q(one(wall, "angle")) == 0
-    wall_name = wall.split()[1]
-    stages = []
-    for name, sec in sc.items():
-        if name.startswith("stage "):
-            stages.append([name.split()[1], int(sec["cycles"][0]), sec.get("move", [])])
-    base = dict(R=r, kn=Q(one(mat, "kn")), delta=Q(one(mat, "rolling")), dt=Q(one("settings", "dt")),
-                model=one("settings", "rolling_model"))
-    keymap = {"settings.rolling_model": "model", f"material.{mat.split()[1]}.rolling": "delta"}
+    mats = {s.split()[1]: sc[s] for s in sc if s.startswith("material ")}
+    assert len({m["kn"][0] for m in mats.values()}) == 1, "one k_n (the pair's is then k_n)"
+    assert not any("friction" in m or "cohesion" in m for m in mats.values()), "no shear force"
+    discs = {s.split()[1]: sc[s] for s in sc if s.startswith("disc ")}
+    walls = {s.split()[1]: sc[s] for s in sc if s.startswith("wall ")}
+    held = [n for n, d in discs.items() if d.get("fixed", ["0"])[0] == "1"]
+    assert len(held) == 1, "one held disc"
+    probe = sc["probe mr"]
+    assert probe["a"][0] == held[0], "the moment is seen from the held disc (a of the probes)"
+    other = probe["b"][0]
+    vec = lambda sec, key: [Q(t) for t in sec[key][0].split()]
+    p = dict(name=name, model=one("settings", "rolling_model"), dt=Q(one("settings", "dt")),
+             kn=Q(next(iter(mats.values()))["kn"][0]))
+    a = discs[held[0]]
+    ra = Q(a["r"][0])
+    if other in walls:
+        # the wall tester: the disc on the floor, P straight under the centre
+        w = walls[other]
+        assert len(discs) == 1 and vec(a, "x") == [0, ra], "the disc's centre at (0, R)"
+        assert vec(w, "p") == [0, 0] and Q(w["angle"][0]) == 0, "the floor through the origin, level"
+        p.update(kind="wall", R=ra, r=2 * ra, delta=Q(mats[a["material"][0]]["rolling"][0]))
+        moves = []
+        for stage, sec in ((s.split()[1], sc[s]) for s in sc if s.startswith("stage ")):
+            v, omega = Q(0), Q(0)
+            for m in sec.get("move", []):
+                words = m.split()
+                assert words[0] == other and Q(words[1]) == 0, "the floor moves up or turns"
+                v, omega = Q(words[2]), Q(words[3])
+            moves.append((stage, int(sec["cycles"][0]), v, omega))
+        p["moves"] = moves
+        return p
+    # the pair: the held disc pressed on a flywheel that turns at omega whatever the contact does
+    b = discs[other]
+    assert not walls and len(discs) == 2 and one("settings", "allow_overlap") == "1"
+    rb, omega = Q(b["r"][0]), Q(b["omega"][0])
+    xa, xb = vec(a, "x"), vec(b, "x")
+    assert xa[1] == xb[1] and xb[0] > xa[0], "the flywheel to the right of the held disc"
+    d = ra + rb - (xb[0] - xa[0])
+    assert d > 0, "the pair overlaps from the start"
+    delta = min(Q(mats[x["material"][0]]["rolling"][0]) for x in (a, b))   # the smaller of the two
+    p.update(kind="pair", r=2 * ra * rb / (ra + rb), delta=delta, d=d)      # JYH eq. 9b
+    p["moves"] = [(s.split()[1], int(sc[s]["cycles"][0]), Q(0), omega) for s in sc if s.startswith("stage ")]
+    assert all("move" not in sc[s] for s in sc if s.startswith("stage "))
+    # A flywheel: the moment must not change its spin, nor the force its place, within rounding
+    # (each cycle's increment below half an ulp of what it is added to).
+    rho = float(mats[b["material"][0]]["density"][0])
+    mass = rho * math.pi * float(rb) ** 2
+    inertia = mass * float(rb) ** 2 / 2
+    b_, km = constants(p)
+    m0, dt = float(p["kn"] * d * b_ / 6), float(p["dt"])
+    cycles = sum(c for _, c, _, _ in p["moves"])
+    assert m0 * dt / inertia < math.ulp(float(omega)) / 2, "the flywheel's spin would change"
+    assert float(p["kn"] * d) * dt / mass * cycles * dt < math.ulp(float(xb[0])) / 2, "the flywheel would move"
+    return p
+
+
+def read_inputs():
+    """{variant: parameters} of every variant of the case."""
     variants = {}
     for name, sec in read_ini(CASE).items():
-        if not name.startswith("variant "):
-            continue
-        p = dict(base, stages=[list(s) for s in stages])
-        for s in sec.get("set", []):
-            key, value = (t.strip() for t in s.split("=", 1))
-            if key in keymap:
-                p[keymap[key]] = value if key == "settings.rolling_model" else Q(value)
-            elif key.startswith("stage.") and key.endswith(".move"):
-                stage = next(g for g in p["stages"] if g[0] == key.split(".")[1])
-                stage[2] = [value]
-            else:
-                raise SystemExit(f"case.txt: variant {name}: the derivation does not know '{key}'")
-        p["moves"] = []
-        for stage_name, cycles, moves in p["stages"]:
-            v, omega = Q(0), Q(0)
-            for m in moves:
-                words = m.split()
-                assert words[0] == wall_name and Q(words[1]) == 0, "the floor moves up or turns"
-                v, omega = Q(words[2]), Q(words[3])
-            p["moves"].append((stage_name, cycles, v, omega))
-        variants[name.split()[1]] = p
+        if name.startswith("variant "):
+            v = name.split()[1]
+            variants[v] = read_variant(os.path.join(CASE_DIR, sec["scene"][0]), sec.get("set", []), v)
     return variants
 
 
 def constants(p):
-    """B = delta r (eq. 24), r = 2 R (eq. 11b); K_m = k_n B^2/12 (eq. 29)."""
-    b = p["delta"] * 2 * p["R"]
+    """B = delta r (eq. 24), r = 2 R against a wall (eq. 11b), 2 r1 r2/(r1 + r2) for two
+    discs (eq. 9b); K_m = k_n B^2/12 (eq. 29)."""
+    b = p["delta"] * p["r"]
     return b, p["kn"] * b * b / 12
 
 
@@ -160,11 +198,16 @@ def hand(p):
     for stage, cycles, v, omega in p["moves"]:
         for _ in range(cycles):
             cycle += 1
-            P += v * dt                                   # the wall moves first
-            a += omega * dt
-            dtheta = -omega * dt                          # omega_disc = 0 (held)
+            # wall: the floor moves first (P up by V dt, turned by omega dt); pair: the flywheel
+            # turns at omega; the held disc does not turn, so dtheta_r = -omega dt (eqs 12-13)
+            dtheta = -omega * dt
             theta += dtheta
-            d = P + (p["R"] - P) * one_minus_cos(a)
+            if p["kind"] == "wall":
+                P += v * dt
+                a += omega * dt
+                d = P + (p["R"] - P) * one_minus_cos(a)
+            else:
+                d = p["d"]
             assert d > 0, "the contact must stay closed"
             fn = p["kn"] * d                              # MLH eq. 2, nu = 1
             m0 = fn * b / 6                               # JYH eq. 33a
@@ -202,6 +245,8 @@ def stage_ends(p):
 def nominal(p):
     """The figures' reference lines: K_m, and M_0 at F_n = k_n x (each press's overlap)."""
     b, km = constants(p)
+    if p["kind"] == "pair":
+        return km, [p["kn"] * p["d"] * b / 6]
     levels, P = [], Q(0)
     for stage, cycles, v, omega in p["moves"]:
         if v != 0:
@@ -242,26 +287,29 @@ def main():
     variants = read_inputs()
     out = sys.stdout.write
     out("# reference/rolling.ref - what the rolling-resistance law tester is held to.\n")
-    out("# GENERATED by reference/derive/rolling.py from cases/rolling/rolling_tester.scene and\n")
+    out("# GENERATED by reference/derive/rolling.py from cases/rolling/*.scene and\n")
     out("# cases/rolling/case.txt; do not edit by hand (make test checks that this file equals\n")
     out("# the script's output).  JYH = Jiang, Yu & Harris (2005).\n")
-    first = next(iter(variants.values()))
-    ends = stage_ends(first)
-    out("# Stages (cycles): " + ", ".join(f"{s} {a}-{b}" for s, (a, b) in ends.items()) + ".\n")
+    walls = [p for p in variants.values() if p["kind"] == "wall"]
+    ends = stage_ends(walls[0])
+    out("# Wall variants, stages (cycles): " + ", ".join(f"{s} {a}-{b}" for s, (a, b) in ends.items()) + ".\n")
     for name, p in variants.items():
         b, km = constants(p)
         k, levels = nominal(p)
         theta0 = 2 * levels[0] * 6 / b / (p["kn"] * b)
         dtheta = max(abs(o) for _, _, _, o in p["moves"]) * p["dt"]
-        out(f"# {name}: {p['model']}, delta = {float(p['delta']):g}, B = {float(b):g}, K_m = {float(k)!r}, "
-            f"M_0 = {', '.join(f(x) for x in levels)} at F_n = "
+        out(f"# {name}: {p['kind']}, {p['model']}, r = {float(p['r']):g}, delta = {float(p['delta']):g}, "
+            f"B = {float(b):g}, K_m = {float(k)!r}, M_0 = {', '.join(f(x) for x in levels)} at F_n = "
             f"{', '.join(f(x * 6 / b) for x in levels)} (nominal), theta_r0 = {float(theta0):.6g} = "
             f"{float(theta0 / dtheta):.2f} steps of {float(dtheta):g}.\n")
     out("\n")
     w = Writer(out)
     for name, p in variants.items():
-        assert stage_ends(p) == ends, "every variant has the same stages"
         rows = hand(p)
+        if p["kind"] == "pair":
+            pair_checks(w, name, p, rows)
+            continue
+        assert stage_ends(p) == ends, "every wall variant has the same stages"
         if p["model"] == "model1":
             model1_checks(w, name, p, rows, ends)
         else:
@@ -417,6 +465,65 @@ def energy_checks(w, v, p, rows, what):
             "and M: the rolling energy is stored while elastic and goes when M does. The largest relative "
             "difference over all cycles. Tolerance: round-off of three products and two sums, a few u.",
             "0", f"abs {TOL_SPLIT:g}")
+
+
+def pair_checks(w, v, p, rows):
+    """The pair at a constant F_n: the closed forms of JYH hold as they stand (no wall turns)."""
+    b, km = constants(p)
+    fn = p["kn"] * p["d"]
+    m0 = fn * b / 6
+    theta0 = 2 * fn / (p["kn"] * b)                     # eq. 33b
+    dtheta = rows[0]["theta"]
+    onset = math.floor(theta0 / dtheta) + 1            # the first cycle with theta_r > theta_r0
+    assert theta0 / dtheta - (onset - 1) > AMBIGUOUS and rows[onset - 1]["state"] != 0
+    assert all(r["state"] == 0 for r in rows[:onset - 1])
+    last = rows[-1]
+    geometry = (f"r = 2 r1 r2/(r1 + r2) = {f(p['r'])} (eq. 9b), B = delta r = {f(b)} (eq. 24), F_n = k_n d = "
+                f"{f(fn)} (d = {f(p['d'])}, constant: the flywheel neither moves nor slows)")
+    w.check("slope_load", v, f"fit_slope(between(theta_r, 1, {onset - 1}), between(mr, 1, {onset - 1}))",
+            f"JYH eqs 28-29 for two discs: M = K_m theta_r, K_m = k_n B^2/12 = {f(km)} with {geometry}. The "
+            f"least-squares slope of M against theta_r over cycles 1-{onset - 1}, below theta_r0. Tolerance: "
+            "round-off of sums of equal increments.", f(km), f"rel {TOL_SLOPE:g}")
+    name = "cap_onset" if p["model"] == "model1" else "lost_at"
+    state = 1 if p["model"] == "model1" else 2
+    w.check(name, v, f"min(cycle[state == {state}])",
+            f"JYH eq. 33b: theta_r0 = 2 F_n/(k_n B) = {f(theta0)} = {float(theta0 / dtheta):.4f} cycles of "
+            f"dtheta = {f(dtheta)}, so the first cycle past it is {onset}; there Model "
+            f"{'1 caps M (eq. 35b)' if state == 1 else '2 loses M (eq. 36b)'}. Tolerance: none, a cycle number.",
+            onset, "abs 0")
+    if p["model"] == "model1":
+        for which, fn_ in (("max", "largest"), ("min", "smallest")):
+            w.check(f"plateau_{which}", v, f"{which}(abs(mr[state == 1]))",
+                    f"JYH eq. 35b: M = M_0 = F_n B/6 = {f(m0)} on every capped cycle ({geometry}); the {fn_} "
+                    "|M| of them. Tolerance: the rounding of F_n B/6, a few u.", f(m0), "rel 1e-14")
+        plastic = last["theta"] - theta0
+        assert last["lost"] == m0 * plastic
+        w.check("dissipated", v, "last(d_roll)",
+                f"JYH eq. 35b: plastic rolling dissipates M_0 per unit of plastic rotation, exactly at a "
+                f"constant F_n: M_0 (theta_r - theta_r0) = {f(m0)} x {f(plastic)} = {f(last['lost'])} (the "
+                f"scheme dissipates the overshoot of the first capped cycle against M_0, so no step error). "
+                "Tolerance: each cycle's plastic rotation (|M_trial| - M_0)/K_m is rounded to u M_0/(K_m "
+                "dtheta) = 1.5e-14 of itself.", f(last["lost"]), "rel 1e-13")
+        end = "M = M_0 at the end of the twist"
+    else:
+        w.check("zero_after_loss", v, f"max(abs(after(mr, {onset - 1})))",
+                "JYH eq. 36b: M = 0 from the loss on (the contact never opens). Tolerance: none.", "0", "abs 0")
+        w.check("stays_lost", v, f"min(after(state, {onset - 1}))",
+                "JYH eq. 36b: the contact stays flagged lost (contact_rolling = 2). Tolerance: none.", "2", "abs 0")
+        tb = rows[onset - 1]["theta"]
+        w.check("lost_energy", v, "last(d_roll)",
+                f"JYH eqs 28, 36b: the lost spring's energy K_m theta_b^2/2 at the first cycle past theta_r0, "
+                f"theta_b = {onset} dtheta = {f(tb)}: {f(last['lost'])} (the continuum M_0^2/(2 K_m) = "
+                f"F_n^2/(6 k_n) = {f(m0 ** 2 / (2 * km))}). Tolerance: round-off of theta_b.",
+                f(last["lost"]), f"rel {TOL_LOST:g}")
+        end = "M = 0 after the loss"
+    w.check("elastic_energy_end", v, "last(e_el)",
+            f"JYH eq. 28 and MLH eq. 2: the stored energy is k_n d^2/2 + M^2/(2 K_m), {end}: "
+            f"{f(last['e_el'])}. Tolerance: a few u.", f(last["e_el"]), "rel 1e-14")
+    w.check("elastic_energy_split", v,
+            f"max(abs(e_el - fn ** 2 / {f(2 * p['kn'])} - mr ** 2 / {f(2 * km)}) / e_el)",
+            "JYH eq. 28 and MLH eq. 2: on every cycle E_el = F_n^2/(2 k_n) + M^2/(2 K_m). Tolerance: "
+            "round-off of three products and two sums, a few u.", "0", f"abs {TOL_SPLIT:g}")
 
 
 def print_cycles(name):

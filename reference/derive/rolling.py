@@ -270,17 +270,14 @@ def f(x):
 
 
 class Writer:
+    """Writes one [check NAME_VARIANT] section of the .ref file per call."""
+
     def __init__(self, out):
         self.out = out
 
-    def check(self, name, variant, quantity, provenance, value=None, tolerance=None, lo=None, hi=None):
-        text = f"[check {name}_{variant}]\ncase = {CASE_NAME}\nvariant = {variant}\nquantity = {quantity}\n"
-        if value is not None:
-            text += f"value = {value}\n"
-        if lo is not None:
-            text += f"lo = {lo}\nhi = {hi}\n"
-        text += f"tolerance = {tolerance}\nkind = analytic\nprovenance = {provenance}\n\n"
-        self.out(text)
+    def check(self, name, variant, quantity, provenance, value, tolerance):
+        self.out(f"[check {name}_{variant}]\ncase = {CASE_NAME}\nvariant = {variant}\nquantity = {quantity}\n"
+                 f"value = {value}\ntolerance = {tolerance}\nkind = analytic\nprovenance = {provenance}\n\n")
 
 
 def main():

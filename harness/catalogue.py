@@ -9,7 +9,9 @@ Figure kinds (`kind = ...`, default series) and their keys (FIGURE_KIND_KEYS; ev
 takes kind, title, variants and paper; variants default to all of the case's):
 
     series     series.tsv columns against a column:  x = COLUMN, y = COLUMN ...,
-               xlabel, ylabel, xrange, yrange
+               xlabel, ylabel, xrange, yrange; and reference lines, repeatable:
+               line = SLOPE INTERCEPT [TITLE] draws y = SLOPE x + INTERCEPT dashed
+               (a line without a title is drawn like the one before it: +-M pairs)
     network    the force network of one variant's final state (C&S Fig. 5(b));
                exactly one variant
     profile    pile_S(component, row) against pile_X(row) per variant (MLH Figs 3, 6, 7):
@@ -26,6 +28,7 @@ A key that the figure's kind does not use is an error, as is an unknown kind.
 [sweep NAME] sections declare the case's error-against-cost sweeps (keys in sweep_spec.py).
 """
 import ast
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,7 +46,7 @@ FIGURE_KINDS = ("series", "network", "profile", "principal", "points")
 _COMMON = {"kind", "title", "variants", "paper"}
 _AXES = {"xlabel", "ylabel", "xrange", "yrange"}
 FIGURE_KIND_KEYS = {
-    "series": _COMMON | _AXES | {"x", "y"},
+    "series": _COMMON | _AXES | {"x", "y", "line"},
     "network": _COMMON,
     "profile": _COMMON | _AXES | {"y", "row"},
     "principal": _COMMON,
@@ -82,6 +85,7 @@ class Figure:
     paper: str = ""          # the paper's words the figure reproduces, shown beside it
     row: int = 1             # profile: the pile row M of S(M)
     logscale: str = ""       # points: '', 'x', 'y' or 'xy'
+    lines: list = field(default_factory=list)   # series: (slope, intercept, title) reference lines
 
 
 @dataclass
@@ -207,7 +211,21 @@ def _series(section, common):
     return Figure(variants=section.get("variants", "").split(), x=section.require("x"),
                   y=section.require("y").split(), xlabel=section.get("xlabel", section.require("x")),
                   ylabel=section.get("ylabel", ""), xrange=_range(section, "xrange"),
-                  yrange=_range(section, "yrange"), **common)
+                  yrange=_range(section, "yrange"), lines=[_line(section, e) for e in section.all("line")],
+                  **common)
+
+
+def _line(section, entry):
+    """A reference line 'SLOPE INTERCEPT [TITLE]': (slope, intercept, title), both numbers finite."""
+    words = entry.value.split(None, 2)
+    try:
+        slope, intercept = (float(w) for w in words[:2])
+        if not math.isfinite(slope) or not math.isfinite(intercept):
+            raise ValueError
+    except ValueError:
+        raise section.error(f"'line' must be 'SLOPE INTERCEPT [title]' (two finite numbers first), "
+                            f"not '{entry.value}'", entry.line) from None
+    return slope, intercept, words[2] if len(words) > 2 else ""
 
 
 def _profile(section, common):

@@ -2,7 +2,8 @@
 (SCRIPTS; kinds as in catalogue.py), and the running of gnuplot, which the error-against-cost
 diagram (cost_plot.py) shares.
 
-Figure kinds: series (columns of series.tsv against x); network (force network, see
+Figure kinds: series (columns of series.tsv against x, and any reference lines
+y = slope x + intercept, dashed grey); network (force network, see
 network.py); profile (pile_S(component, row) against pile_X(row), lines with points, one
 curve per variant and component, from families/piles.py); principal (MLH Fig. 3(d): the discs of
 the final state and, centred on every free disc, a line along the most compressive
@@ -113,7 +114,19 @@ def _series_script(case, figure, store, workdir, png, svg):
     clauses, notes = figure_data(case, figure, store, workdir)
     if not clauses:
         return None, notes + ["nothing to plot"]
-    return gnuplot_script(figure, clauses, png, svg), notes
+    return gnuplot_script(figure, clauses + line_clauses(figure.lines), png, svg), notes
+
+
+def line_clauses(lines):
+    """A series figure's reference lines y = slope x + intercept, grey and dashed.  Each titled
+    line has a dash pattern of its own; a line without a title is drawn like the one before
+    it and kept out of the key (the lower of a pair +-M)."""
+    clauses, dash = [], 1
+    for k, (slope, intercept, title) in enumerate(lines):
+        dash += 1 if title or k == 0 else 0
+        clauses.append(f"{slope!r} * x + {intercept!r} with lines dt {dash} lw 1.2 lc rgb '#555555' "
+                       + (f"title {gp_string(title)}" if title else "notitle"))
+    return clauses
 
 
 def _network_script(case, figure, store, workdir, png, svg):

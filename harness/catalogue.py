@@ -39,7 +39,7 @@ from .families.piles import COMPONENTS
 from .ini import parse_file
 from .sweep_spec import parse as parse_sweep
 
-CASE_KEYS = {"tier", "title", "checks", "runtime"}
+CASE_KEYS = {"tier", "title", "checks", "runtime", "stability"}
 VARIANT_KEYS = {"scene", "set", "command"}
 COMMANDS = ("run", "exact", "peer")
 FIGURE_KINDS = ("series", "network", "profile", "principal", "points")
@@ -97,6 +97,8 @@ class Case:
     title: str
     checks: str
     runtime: float
+    stability: bool = True   # `stability = no`: its variants have no time-step limit to find
+                             # (held bodies, prescribed motion), so the stability finder skips them
     path: str = ""
     line: int = 0
     variants: list = field(default_factory=list)
@@ -163,9 +165,14 @@ def _case(section, path):
     runtime = section.number("runtime")
     if runtime is None:
         raise section.error("[case] needs 'runtime = <expected seconds>'")
+    stability = section.get("stability", "yes")
+    if stability not in ("yes", "no"):
+        raise section.error(f"stability must be yes or no, not '{stability}'",
+                            section.entry("stability").line)
     return Case(name=section.name, family=path.parent.name, folder=path.parent, tier=tier,
                 title=section.require("title"), checks=section.require("checks"),
-                runtime=runtime, path=section.path, line=section.line)
+                runtime=runtime, stability=stability == "yes", path=section.path,
+                line=section.line)
 
 
 def _add_variant(case, section):

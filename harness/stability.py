@@ -80,9 +80,12 @@ class Target:
 
 
 def targets_for(cases, one_per_case=False):
-    """Every DEM variant (command = run) of the cases; or only the first of each case."""
+    """Every DEM variant (command = run) of the cases; or only the first of each case.  A case
+    that says `stability = no` has none (its motion is prescribed: no limit to find)."""
     out = []
     for c in cases:
+        if not c.stability:
+            continue
         runs = [Target(c.name, v.name, v.scene, list(v.sets)) for v in c.variants if v.command == "run"]
         out += runs[:1] if one_per_case else runs
     return out

@@ -1,7 +1,7 @@
 """The catalogue: reading cases/*/case.txt, validation with file:line, selection by name and tier."""
 import pytest
 
-from harness import catalogue
+from harness import catalogue, stability
 from harness.errors import CatalogueError, IniError
 
 
@@ -104,3 +104,20 @@ def test_several_cases_in_one_file(tmp_path):
     write(tmp_path, "fam", CASE + CASE.replace("[case c1]", "[case c2]").replace("quick", "full"))
     cases = catalogue.load(tmp_path)
     assert [(c.name, c.tier, len(c.variants)) for c in cases] == [("c1", "quick", 2), ("c2", "full", 2)]
+
+
+def test_stability_no_keeps_a_case_from_the_finder(tmp_path):
+    """`stability = no` (a case whose motion is prescribed) has no targets for the finder."""
+    from_case = CASE.replace("runtime = 1\n", "runtime = 1\nstability = no\n")
+    write(tmp_path, "fam", from_case)
+    case = catalogue.load(tmp_path)[0]
+    assert case.stability is False
+    assert stability.targets_for([case]) == []
+    write(tmp_path, "fam", CASE)
+    assert len(stability.targets_for(catalogue.load(tmp_path))) == 2
+
+
+def test_stability_value_is_checked(tmp_path):
+    write(tmp_path, "fam", CASE.replace("runtime = 1\n", "runtime = 1\nstability = maybe\n"))
+    with pytest.raises(IniError, match="stability must be yes or no, not 'maybe'"):
+        catalogue.load(tmp_path)

@@ -38,6 +38,12 @@ Results are appended to reports/bench/<host>/peer.csv and
 reports/bench/<host>/peer_sweep.csv; the scenes, data files, inputs and logs
 of the last run stay in reports/bench/<host>/peer/.
 
+`--check-only --out DIR` runs the cross-check alone and writes it as a run
+(the catalogue's case peer_check); where LAMMPS is absent and cannot be
+installed it writes a skipped run instead (lammps_problem, skip_outputs).
+The writers, readers and comparisons here also serve harness/peer/rolling.py
+(JYH's rolling resistance against LAMMPS's pair granular).
+
 The physics of both sides (the same in both by construction; see
 harness/peer/in.peer for LAMMPS):
   discs of unit thickness, m = density pi r^2, I = m r^2 / 2;

@@ -41,7 +41,7 @@ from .sweep_spec import parse as parse_sweep
 
 CASE_KEYS = {"tier", "title", "checks", "runtime", "stability"}
 VARIANT_KEYS = {"scene", "set", "command"}
-COMMANDS = ("run", "exact", "peer")
+COMMANDS = ("run", "exact", "peer", "peer_rolling")
 FIGURE_KINDS = ("series", "network", "profile", "principal", "points")
 _COMMON = {"kind", "title", "variants", "paper"}
 _AXES = {"xlabel", "ylabel", "xrange", "yrange"}
@@ -66,7 +66,8 @@ class Variant:
     scene: Path
     sets: list
     command: str = "run"     # run: the DEM; exact: the exact static solver (ballast exact);
-                             # peer: the cross-check against LAMMPS (harness/peer/race.py)
+                             # peer: the cross-check against LAMMPS (harness/peer/race.py);
+                             # peer_rolling: JYH's rolling against LAMMPS (harness/peer/rolling.py)
 
 
 @dataclass

@@ -8,6 +8,8 @@ modules of harness/families: signals, variants, piles, networks, collisions).  T
 knows no family: it asks the registry.  evaluate_check() turns one Check into a Verdict;
 anything that goes wrong (missing output, failed run, missing column, an expression that
 raises, a NaN/inf value) is a FAIL whose message says which, never a pass and never a skip.
+The one SKIP: a run that could not be made and says why (RunSkipped: a cross-check against
+LAMMPS where LAMMPS is absent and cannot be installed).
 """
 import ast
 import math
@@ -16,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import EvalError, RunProblem
+from .errors import EvalError, RunProblem, RunSkipped
 from .expressions import functions
 from .tables import load_run
 
@@ -34,19 +36,30 @@ class Verdict:
     provenance: str
     passed: bool
     message: str
+    skipped: bool = False  # SKIP: its run could not be made (passed is False, message says why)
+
+    @property
+    def result(self):
+        """PASS, FAIL or SKIP."""
+        return "SKIP" if self.skipped else "PASS" if self.passed else "FAIL"
 
     def as_dict(self):
-        """The summary.json record (keys as in the spec; non-finite numbers as null)."""
-        return {"case": self.case, "variant": self.variant, "check": self.check,
-                "quantity": self.quantity, "value": _json_number(self.value),
-                "reference": _json_number(self.reference), "tolerance": self.tolerance,
-                "kind": self.kind, "provenance": self.provenance, "pass": self.passed,
-                "message": self.message}
+        """The summary.json record (keys as in the spec; non-finite numbers as null); a
+        skipped check also has "skip": true."""
+        out = {"case": self.case, "variant": self.variant, "check": self.check,
+               "quantity": self.quantity, "value": _json_number(self.value),
+               "reference": _json_number(self.reference), "tolerance": self.tolerance,
+               "kind": self.kind, "provenance": self.provenance, "pass": self.passed,
+               "message": self.message}
+        if self.skipped:
+            out["skip"] = True
+        return out
 
     @classmethod
     def from_dict(cls, d):
         return cls(d["case"], d["variant"], d["check"], d["quantity"], d["value"], d["reference"],
-                   d["tolerance"], d["kind"], d["provenance"], d["pass"], d["message"])
+                   d["tolerance"], d["kind"], d["provenance"], d["pass"], d["message"],
+                   bool(d.get("skip", False)))
 
 
 def _json_number(x):
@@ -249,15 +262,19 @@ def quantity_text(check):
 
 
 def evaluate_check(check, store):
-    """The Verdict of one check; any problem is a FAIL with its reason."""
+    """The Verdict of one check; any problem is a FAIL with its reason, but a run that could
+    not be made (RunSkipped) makes it a SKIP with that run's reason."""
+    skipped = False
     try:
         value, passed, message = JUDGES[check.tolerance](check, store)
+    except RunSkipped as exc:
+        value, passed, message, skipped = None, False, str(exc), True
     except (RunProblem, EvalError) as exc:
         value, passed, message = None, False, str(exc)
     return Verdict(case=check.case, variant=check.variant_label, check=check.name,
                    quantity=quantity_text(check), value=value, reference=reference_of(check),
                    tolerance=check.tolerance_text, kind=check.kind, provenance=check.provenance,
-                   passed=bool(passed), message=message)
+                   passed=bool(passed), message=message, skipped=skipped)
 
 
 def evaluate_all(checks, store):

@@ -6,6 +6,7 @@ an exit status, or a check (harness/compare.py) into a FAIL with its reason:
     IniError        a malformed case.txt, .ref or extremes.txt: 'file:line: what'   exit 2
     CatalogueError  a catalogue problem not tied to one line (an unknown case name) exit 2
     RunProblem      a run's outputs cannot be used: missing, failed or malformed    a FAIL
+    RunSkipped      a run that says it could not run (an outside tool is missing)   a SKIP
     EvalError       a quantity could not be evaluated to one finite number          a FAIL
     WriteError      the harness could not change a file of its own                  exit 3
     Busy            another harness holds the reports folder's lock                 exit 75
@@ -39,6 +40,13 @@ class CatalogueError(ValueError):
 
 class RunProblem(Exception):
     """A run's outputs cannot be used: missing, failed, or malformed."""
+
+
+class RunSkipped(RunProblem):
+    """A run that could not be made and says why in run.json (status 'skipped'): the
+    cross-checks against LAMMPS where LAMMPS is absent and cannot be installed.  Its checks
+    are SKIP, neither PASS nor FAIL; anything else that keeps a check from its value is a
+    FAIL (RunProblem)."""
 
 
 class EvalError(Exception):

@@ -1,8 +1,9 @@
 """The gate: verdicts printed as an aligned table, written as summary.json and junit.xml.
 
 gate() is the `check` command's work once the checks are chosen: evaluate them, print
-the table (last line 'N passed, M failed'), write both files, return the exit status
-(0 iff there is at least one check and every check passes).
+the table (last line 'N passed, M failed', with ', K skipped' when some checks could not
+be made: compare.py), write both files, return the exit status (0 iff at least one check
+passes and none fails).
 """
 import json
 import xml.etree.ElementTree as ET
@@ -37,12 +38,24 @@ def fmt_reference(v):
 def row(v):
     return {"case": v.case, "variant": v.variant, "check": v.check, "value": fmt_number(v.value),
             "reference": fmt_reference(v), "tolerance": v.tolerance, "kind": v.kind,
-            "result": "PASS" if v.passed else "FAIL"}
+            "result": v.result}
 
 
 def tally(verdicts):
+    """(passed, failed); a skipped check is neither (skipped())."""
     passed = sum(v.passed for v in verdicts)
-    return passed, len(verdicts) - passed
+    return passed, len(verdicts) - passed - skipped(verdicts)
+
+
+def skipped(verdicts):
+    return sum(v.skipped for v in verdicts)
+
+
+def counts_text(verdicts):
+    """'N passed, M failed', and ', K skipped' when K > 0."""
+    passed, failed = tally(verdicts)
+    k = skipped(verdicts)
+    return f"{passed} passed, {failed} failed" + (f", {k} skipped" if k else "")
 
 
 def table(verdicts):
@@ -51,14 +64,19 @@ def table(verdicts):
     widths = {c: max([len(c)] + [len(r[c]) for r in rows]) for c in COLUMNS}
     lines = [_line({c: c.upper() for c in COLUMNS}, widths), _line({c: "-" * widths[c] for c in COLUMNS}, widths)]
     lines += [_line(r, widths) for r in rows]
-    failures = [v for v in verdicts if not v.passed]
-    if failures:
+    failures = [v for v in verdicts if v.result == "FAIL"]
+    skips = {}
+    for v in verdicts:
+        if v.skipped:
+            skips.setdefault((v.case, v.message), []).append(v.check)
+    if failures or skips:
         lines.append("")
         lines += [f"FAIL {v.case}/{v.check}: {v.message}" for v in failures]
+        lines += [f"SKIP {case} ({len(names)} check{'s' if len(names) > 1 else ''}): {message}"
+                  for (case, message), names in skips.items()]
     if not verdicts:
         lines.append("no checks selected: nothing was verified")
-    passed, failed = tally(verdicts)
-    lines.append(f"{passed} passed, {failed} failed")
+    lines.append(counts_text(verdicts))
     return "\n".join(lines)
 
 
@@ -78,12 +96,13 @@ def read_summary(path):
 
 
 def junit(verdicts):
-    """junit.xml text: one testsuite per case, one testcase per check, <failure> on failure."""
+    """junit.xml text: one testsuite per case, one testcase per check, <failure> on failure,
+    <skipped> on a skip."""
     root = ET.Element("testsuites", name="ballast", tests=str(len(verdicts)), failures=str(tally(verdicts)[1]))
     for case in dict.fromkeys(v.case for v in verdicts):
         mine = [v for v in verdicts if v.case == case]
         suite = ET.SubElement(root, "testsuite", name=case, tests=str(len(mine)),
-                              failures=str(tally(mine)[1]), errors="0", skipped="0")
+                              failures=str(tally(mine)[1]), errors="0", skipped=str(skipped(mine)))
         for v in mine:
             _testcase(suite, v)
     ET.indent(root)
@@ -96,6 +115,8 @@ def _testcase(suite, v):
               f"tolerance: {v.tolerance}\nkind: {v.kind}\nprovenance: {v.provenance}\n{v.message}")
     if v.passed:
         ET.SubElement(case, "system-out").text = detail
+    elif v.skipped:
+        ET.SubElement(case, "skipped", message=v.message).text = detail
     else:
         ET.SubElement(case, "failure", message=v.message, type="check").text = detail
 
@@ -112,9 +133,9 @@ def _write(path, text):
 
 
 def exit_status(verdicts):
-    """0 iff there is at least one check and all pass."""
+    """0 iff at least one check passes and none fails (skipped checks do neither)."""
     passed, failed = tally(verdicts)
-    return 0 if verdicts and not failed else 1
+    return 0 if passed and not failed else 1
 
 
 def gate(checks, store, reports_dir, out):
@@ -139,4 +160,4 @@ def sweep_table(labels, checks, verdicts_by_label):
 
 
 def _sweep_cell(v):
-    return f"{fmt_number(v.value)} {'PASS' if v.passed else 'FAIL'}"
+    return f"{fmt_number(v.value)} {v.result}"

@@ -45,13 +45,19 @@ from pathlib import Path
 from . import files
 from .children import options as child_options
 from .errors import RunProblem, Stopped, WriteError
-from .tables import read_harness_record, read_run_json, run_failure, unfinished_outputs
+from .tables import read_harness_record, read_run_json, run_failure, skip_reason, unfinished_outputs
 
 STDERR_TAIL = 5
 STOP_GRACE = 10.0    # seconds a terminated run has to write run.json and exit before SIGKILL
 INTERRUPTED = (130, -signal.SIGINT, -signal.SIGTERM)   # how a run that was interrupted ends
 POLL = 0.1           # seconds between the main thread's looks at the runs (see run_all)
-PEER_SCRIPT = Path(__file__).resolve().parent / "peer" / "race.py"
+PEER = Path(__file__).resolve().parent / "peer"
+# The cross-checks against LAMMPS (scripts, not the core): command -> (its command line
+# before --out, the files besides bin/ballast that decide its outputs).
+PEER_COMMANDS = {
+    "peer": (["race.py", "--check-only"], ("race.py", "in.peer")),
+    "peer_rolling": (["rolling.py"], ("rolling.py", "race.py", "in.peer_rolling")),
+}
 
 
 @dataclass
@@ -77,6 +83,7 @@ class Outcome:
     wall: float
     cause: str = ""
     skipped: bool = False   # resumed: a complete run of the same identity was already there
+    skip_reason: str = ""   # the run could not be made and says why (run.json status 'skipped')
     io_error: WriteError = None   # the harness could not prepare or record the folder (files.py)
 
 
@@ -89,9 +96,10 @@ def jobs_for(cases, runs_root):
 
 def command(job, binary):
     """The core's command line for a job."""
-    if job.command == "peer":
-        # The cross-code check against LAMMPS: a Python script, not the core.
-        return ["/usr/bin/python3", str(PEER_SCRIPT), "--check-only", "--out", str(job.out)]
+    if job.command in PEER_COMMANDS:
+        # A cross-code check against LAMMPS: a Python script, not the core.
+        script, *args = PEER_COMMANDS[job.command][0]
+        return ["/usr/bin/python3", str(PEER / script)] + args + ["--out", str(job.out)]
     cmd = [str(binary), job.command, str(job.scene), "--out", str(job.out)]
     for kv in job.sets:
         cmd += ["--set", kv]
@@ -169,6 +177,8 @@ def run_one(job, binary, running=None, resume=False, binary_id=None):
         if cause and running and running.stopping:
             cause = "interrupted: " + cause
         outcome = Outcome(job, not cause, returncode, wall, cause)
+        if not cause:
+            outcome.skip_reason = skip_reason(read_run_json(job.out)) or ""
         _record(outcome, cmd, ident)
     except WriteError as exc:
         # no harness.json: the folder reads as unfinished, and --resume runs it again
@@ -199,13 +209,15 @@ def binary_identity(binary):
 def identity(job, binary, binary_id):
     """Everything that decides a run's outputs: the core's command, the scene (path and the
     hash of its text: scenes include no other file), the --set overrides, the executable.
-    The peer check runs harness/peer/race.py on the repository's bin/ballast: their hashes."""
+    A cross-check against LAMMPS runs a script of harness/peer on the repository's
+    bin/ballast: the hashes of the files it reads (PEER_COMMANDS) and of bin/ballast."""
     ident = {"command": job.command, "scene": str(job.scene), "scene_sha256": sha256_of(job.scene),
              "sets": list(job.sets), "binary": binary_id}
-    if job.command == "peer":
-        root = PEER_SCRIPT.parent.parent.parent
+    if job.command in PEER_COMMANDS:
+        root = PEER.parent.parent
         ident["binary"] = {str(p): sha256_of(p) for p in
-                           (PEER_SCRIPT, PEER_SCRIPT.parent / "in.peer", root / "bin" / "ballast")}
+                           [PEER / name for name in PEER_COMMANDS[job.command][1]]
+                           + [root / "bin" / "ballast"]}
     return ident
 
 
@@ -234,6 +246,8 @@ def stale(job, ident):
         info = read_run_json(job.out)
     except RunProblem as problem:
         return str(problem)
+    if skip_reason(info):
+        return "skipped last time: try again"
     return run_failure(job.out, info) or unfinished_outputs(job.out, job.command)
 
 
@@ -310,6 +324,8 @@ class Progress:
         self.expected_done += outcome.job.expected
         if not outcome.ok:
             self._write(f"FAILED {outcome.job.label}: {outcome.cause}", keep=True)
+        if outcome.skip_reason:
+            self._write(f"SKIPPED {outcome.job.label}: {outcome.skip_reason}", keep=True)
         line = f"[{self.done}/{self.total}] {outcome.job.label}  {outcome.wall:.2f} s  ETA {self.eta():.0f} s"
         self._write(line + ("" if outcome.ok else "  FAILED"), keep=not self.tty)
 

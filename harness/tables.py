@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import RunProblem
+from .errors import RunProblem, RunSkipped
 
 
 @dataclass
@@ -87,9 +87,18 @@ def read_harness_record(folder):
         return None
 
 
+def skip_reason(info):
+    """Why the run could not be made, when its run.json says so (status 'skipped'), else
+    None.  Only the cross-checks against LAMMPS skip (harness/peer/race.py skip_outputs)."""
+    if info.get("status") != "skipped":
+        return None
+    return info.get("message") or "no reason given"
+
+
 def run_failure(folder, info):
-    """Why a run that wrote run.json still failed, or None when it succeeded."""
-    if info.get("status") != "ok":
+    """Why a run that wrote run.json still failed, or None when it succeeded (a skipped run
+    did not fail: its checks are SKIP, see load_run)."""
+    if info.get("status") not in ("ok", "skipped"):
         message = info.get("message") or "no message"
         return f"run failed: status '{info.get('status')}': {message} ({folder})"
     record = read_harness_record(folder)
@@ -98,10 +107,12 @@ def run_failure(folder, info):
     return None
 
 
-# The files a complete run leaves, by the core's command (main.c, output.c, harness/peer/race.py).
+# The files a complete run leaves, by the core's command (main.c, output.c, and for the
+# cross-checks against LAMMPS harness/peer/race.py and rolling.py).
 EXPECTED_OUTPUTS = {"run": ("series.tsv", "stress.tsv", "contacts.tsv", "discs.tsv", "walls.tsv", "run.json"),
                     "exact": ("series.tsv", "contacts.tsv", "discs.tsv", "walls.tsv", "run.json"),
-                    "peer": ("series.tsv", "run.json")}
+                    "peer": ("series.tsv", "run.json"),
+                    "peer_rolling": ("series.tsv", "run.json")}
 
 
 def unfinished_outputs(folder, command=None):
@@ -124,7 +135,8 @@ def unfinished_outputs(folder, command=None):
 
 
 def load_run(folder):
-    """A successful run's outputs; RunProblem says what is missing or failed."""
+    """A successful run's outputs; RunProblem says what is missing or failed, RunSkipped
+    why a run that could not be made was not."""
     folder = Path(folder)
     if not folder.is_dir():
         raise RunProblem(f"run output missing: {folder} does not exist (run the case first)")
@@ -135,6 +147,9 @@ def load_run(folder):
     failure = run_failure(folder, info) or unfinished_outputs(folder, record.get("kind") if record else None)
     if failure:
         raise RunProblem(failure)
+    skipped = skip_reason(info)
+    if skipped:
+        raise RunSkipped(f"skipped: {skipped} ({folder})")
     return Run(folder, info, read_series(folder / "series.tsv"))
 
 

@@ -38,6 +38,12 @@ Results are appended to reports/bench/<host>/peer.csv and
 reports/bench/<host>/peer_sweep.csv; the scenes, data files, inputs and logs
 of the last run stay in reports/bench/<host>/peer/.
 
+`--check-only --out DIR` runs the cross-check alone and writes it as a run
+(the catalogue's case peer_check); where LAMMPS is absent and cannot be
+installed it writes a skipped run instead (lammps_problem, skip_outputs).
+The writers, readers and comparisons here also serve harness/peer/rolling.py
+(JYH's rolling resistance against LAMMPS's pair granular).
+
 The physics of both sides (the same in both by construction; see
 harness/peer/in.peer for LAMMPS):
   discs of unit thickness, m = density pi r^2, I = m r^2 / 2;
@@ -243,25 +249,34 @@ def parse_lammps_log(text):
     return out
 
 
-def parse_dump(text):
-    """The last frame of a LAMMPS text dump (custom or local) -> {column: float array}."""
+def parse_frames(text):
+    """Every frame of a LAMMPS text dump (custom or local), in order: a list of
+    {column: float array, "_step": step}."""
     lines = text.splitlines()
     starts = [k for k, l in enumerate(lines) if l.startswith("ITEM: TIMESTEP")]
-    if not starts:
+    frames = []
+    for k in starts:
+        step = int(lines[k + 1])
+        count = int(lines[k + 3])
+        head = next(j for j in range(k, len(lines)) if lines[j].startswith("ITEM: ATOMS")
+                    or lines[j].startswith("ITEM: ENTRIES"))
+        names = lines[head].split()[2:]
+        body = lines[head + 1:head + 1 + count]
+        if len(body) != count or any(l.startswith("ITEM:") for l in body):
+            raise ValueError(f"dump frame of step {step} is cut short: announced {count} rows")
+        data = np.array([l.split() for l in body], dtype=float).reshape(count, len(names))
+        out = {n: data[:, j] for j, n in enumerate(names)}
+        out["_step"] = step
+        frames.append(out)
+    return frames
+
+
+def parse_dump(text):
+    """The last frame of a LAMMPS text dump (custom or local) -> {column: float array}."""
+    frames = parse_frames(text)
+    if not frames:
         raise ValueError("no frame in the dump")
-    frame = lines[starts[-1]:]
-    step = int(frame[1])
-    head = next(k for k, l in enumerate(frame) if l.startswith("ITEM: ATOMS")
-                or l.startswith("ITEM: ENTRIES"))
-    names = frame[head].split()[2:]
-    count = int(frame[3])
-    rows = [l.split() for l in frame[head + 1:head + 1 + count]]
-    if len(rows) != count:
-        raise ValueError(f"dump frame has {len(rows)} rows, announced {count}")
-    data = np.array(rows, dtype=float).reshape(count, len(names))
-    out = {n: data[:, k] for k, n in enumerate(names)}
-    out["_step"] = step
-    return out
+    return frames[-1]
 
 
 # --------------------------------------------------------------------------
@@ -273,20 +288,37 @@ def fmt(v):
     return repr(float(v))
 
 
-def ballast_scene(state, box, dt, steps, title, kn=KN, kt=KT, mu=MU, g=G, density=DENSITY):
-    """A ballast scene listing every disc, the box walls and one stage."""
+def ballast_scene(state, box, dt, steps, title, kn=KN, kt=KT, mu=MU, g=G, density=DENSITY,
+                  rolling=0.0, wall_rolling=None, rolling_model="model1", output_every=None,
+                  probes=(), wall_mu=None, beta=0.0):
+    """A ballast scene listing every disc, the box walls and one stage.
+
+    wall_mu: the walls' friction when not mu; beta: contact damping (C&S eq. 28,
+    c_n = beta k_n, c_s = beta k_s), none by default.  rolling > 0 gives the discs (and, unless
+    wall_rolling says otherwise, the walls) JYH's shape parameter delta with
+    rolling_model (harness/peer/rolling.py); output_every
+    (default: one row at the end) and probes, (name, quantity, a, b) with b None for a
+    disc's, add series.tsv rows and columns."""
     xlo, xhi, ylo, yhi = box
+    wall_rolling = rolling if wall_rolling is None else wall_rolling
+    wall_mu = mu if wall_mu is None else wall_mu
+    every = max(1, int(steps)) if output_every is None else int(output_every)
     out = [f"# {title}", "# written by harness/peer/race.py: one [disc] per disc, the fill's box",
            "# walls, F_n = k_n overlap, no damping (the physics of harness/peer/in.peer)",
            "", "[settings]", f"dt = {fmt(dt)}", f"gravity = 0 {fmt(-g)}",
-           "normal_law = power", "nu = 1", "delta0 = 1", "beta = 0", "alpha = 0",
-           "gamma_n = 0", f"output_every = {max(1, int(steps))}",
+           "normal_law = power", "nu = 1", "delta0 = 1", f"beta = {fmt(beta) if beta else 0}", "alpha = 0",
+           "gamma_n = 0", f"output_every = {every}",
            "# the step and the state are LAMMPS's: a settled packing (discs in contact) and",
            "# the peer's dt, which ballast's contact-network bound may call too large",
-           "allow_overlap = 1", "force_dt = 1", "",
-           "[material grain]", f"kn = {fmt(kn)}", f"ks = {fmt(kt)}", f"friction = {fmt(mu)}",
-           f"density = {fmt(density)}", "",
-           "[material box]", f"kn = {fmt(kn)}", f"ks = {fmt(kt)}", f"friction = {fmt(mu)}", ""]
+           "allow_overlap = 1", "force_dt = 1"]
+    if rolling > 0 or wall_rolling > 0:
+        out.append(f"rolling_model = {rolling_model}")
+    out += ["", "[material grain]", f"kn = {fmt(kn)}", f"ks = {fmt(kt)}", f"friction = {fmt(mu)}",
+            f"density = {fmt(density)}"]
+    out += [f"rolling = {fmt(rolling)}"] if rolling > 0 else []
+    out += ["", "[material box]", f"kn = {fmt(kn)}", f"ks = {fmt(kt)}", f"friction = {fmt(wall_mu)}"]
+    out += [f"rolling = {fmt(wall_rolling)}"] if wall_rolling > 0 else []
+    out.append("")
     walls = (("bottom", xlo, ylo, 0, xhi - xlo), ("right", xhi, ylo, 90, yhi - ylo),
              ("top", xlo, yhi, 0, xhi - xlo), ("left", xlo, ylo, 90, yhi - ylo))
     for name, px, py, angle, length in walls:
@@ -298,6 +330,9 @@ def ballast_scene(state, box, dt, steps, title, kn=KN, kt=KT, mu=MU, g=G, densit
         out += [f"[disc d{k}]", f"x = {fmt(x[k])} {fmt(y[k])}", f"r = {fmt(r[k])}",
                 f"v = {fmt(vx[k])} {fmt(vy[k])}", f"omega = {fmt(w[k])}", "material = grain", ""]
     out += ["[stage race]", f"cycles = {int(steps)}", ""]
+    for name, quantity, a, b in probes:
+        out += [f"[probe {name}]", f"quantity = {quantity}", f"a = {a}"] + \
+            ([f"b = {b}"] if b is not None else []) + [""]
     return "\n".join(out)
 
 
@@ -349,7 +384,7 @@ dump_modify     pairs format float %.17g"""
 # Comparing the cross-check runs
 # --------------------------------------------------------------------------
 
-def ballast_forces(state, contacts_tsv, g=G):
+def ballast_forces(state, contacts_tsv, g=G, arm="radius"):
     """Per-disc force (contacts + gravity) and torque at the final step of a
     ballast run, from contacts.tsv, and the disc-disc contacts
     {(lower id, higher id): (f_n, f_t)} where f_t is the tangential force on
@@ -357,7 +392,15 @@ def ballast_forces(state, contacts_tsv, g=G):
 
     contacts.tsv: for disc a and body b, e = (nx, ny) from a to b; the force
     on a is -(fn + dn) e - (fs + ds) t_ab, t_ab = (ny, -nx); on b the
-    opposite; the moment on both discs is (fs + ds) r."""
+    opposite; the moment on both discs is (fs + ds) r.  With rolling
+    resistance (columns mr, md), a also gets the couple -(mr + md) and a disc b
+    +(mr + md).
+
+    arm: where the tangential force of a disc-disc contact acts -- "radius"
+    (ballast, C&S, and LAMMPS's gran/hooke/history: at r from each centre) or
+    "contact" (LAMMPS's pair granular: at the middle of the overlap, r - overlap/2;
+    wall contacts at r in both).  "contact" gives the torques LAMMPS's
+    pair granular would compute from ballast's forces."""
     n = len(state["x"])
     fx = np.zeros(n)
     fy = -state["m"] * g
@@ -367,7 +410,9 @@ def ballast_forces(state, contacts_tsv, g=G):
     if cols is None or not cols.get("a"):
         return fx, fy, tq, pairs
     nx, ny, fn, fs, dn, ds = numeric(cols, "nx", "ny", "fn", "fs", "dn", "ds")
+    couple = (numeric(cols, "mr")[0] + numeric(cols, "md")[0]) if "mr" in cols else np.zeros(len(fn))
     idx = lambda name: int(name[1:])
+    x, y, r = state["x"], state["y"], state["r"]
     for k in range(len(fn)):
         a = idx(cols["a"][k])
         ftn, fts = fn[k] + dn[k], fs[k] + ds[k]
@@ -375,13 +420,18 @@ def ballast_forces(state, contacts_tsv, g=G):
         cy = ftn * ny[k] - fts * nx[k]
         fx[a] -= cx
         fy[a] -= cy
-        tq[a] += fts * state["r"][a]
-        if cols["kind"][k] == "disc":
-            b = idx(cols["b"][k])
-            fx[b] += cx
-            fy[b] += cy
-            tq[b] += fts * state["r"][b]
-            pairs[(min(a, b), max(a, b))] = (fn[k], -fs[k])
+        if cols["kind"][k] != "disc":
+            tq[a] += fts * r[a] - couple[k]
+            continue
+        b = idx(cols["b"][k])
+        half = 0.0
+        if arm == "contact":
+            half = 0.5 * (r[a] + r[b] - math.hypot(x[b] - x[a], y[b] - y[a]))
+        tq[a] += fts * (r[a] - half) - couple[k]
+        fx[b] += cx
+        fy[b] += cy
+        tq[b] += fts * (r[b] - half) + couple[k]
+        pairs[(min(a, b), max(a, b))] = (fn[k], -fs[k])
     return fx, fy, tq, pairs
 
 
@@ -410,12 +460,12 @@ def lammps_pairs(local, atoms):
     return out
 
 
-def compare(state, contacts_tsv, discs_tsv, atoms, local, dt, g=G):
+def compare(state, contacts_tsv, discs_tsv, atoms, local, dt, g=G, arm="radius"):
     """The cross-check figures: ballast's final state against LAMMPS's dump.
 
     `state` is the initial state (velocities v_{1/2}); `touched` counts the
     discs whose final velocity is not that of free flight in ballast's run
-    (those that met another disc or a wall on the way)."""
+    (those that met another disc or a wall on the way); arm: ballast_forces()."""
     b = disc_state(discs_tsv)
     order = np.argsort(atoms["id"])
     L = {k: v[order] for k, v in atoms.items() if k != "_step"}
@@ -423,7 +473,7 @@ def compare(state, contacts_tsv, discs_tsv, atoms, local, dt, g=G):
         raise ValueError("LAMMPS lost or renumbered atoms")
     mean_d = 2 * float(np.mean(state["r"]))
     mean_r = 0.5 * mean_d
-    fx, fy, tq, bp = ballast_forces(b, contacts_tsv, g)
+    fx, fy, tq, bp = ballast_forces(b, contacts_tsv, g, arm)
     lp = lammps_pairs(local, atoms)
     fscale = max([v[0] for v in bp.values()] + [1e-300])
     speed = float(np.max(np.hypot(b["vx"], b["vy"])))
@@ -549,21 +599,68 @@ def extend_skin(skins, rates, lo, hi):
 # Running the codes
 # --------------------------------------------------------------------------
 
-def ensure_lammps():
-    """Install LAMMPS (Debian package `lammps`) when `lmp` is missing, and
-    check that it has pair gran/hooke/history (the GRANULAR package)."""
+# apt-get's command line for LAMMPS (a test replaces it to see the skip path).
+INSTALL = ("apt-get", "install", "-y", "-qq", "--no-install-recommends", "lammps")
+
+
+def install_lammps():
+    """apt-get install lammps (after an apt-get update if the first try fails: a machine
+    that never ran one has no package lists); '' when it worked, else why not."""
+    print("peer: installing LAMMPS (apt-get install lammps)", flush=True)
+    sudo = [] if os.geteuid() == 0 else ["sudo"]
+    env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
+    install = sudo + list(INSTALL)
+    try:
+        if subprocess.run(install, env=env).returncode == 0:
+            return ""
+        subprocess.run(sudo + [INSTALL[0], "update", "-qq"], env=env, check=True)
+        subprocess.run(install, env=env, check=True)
+    except (OSError, subprocess.CalledProcessError) as exc:
+        return f"`{' '.join(install)}` failed ({exc})"
+    return ""
+
+
+def lammps_problem(styles=("gran/hooke/history",)):
+    """Why LAMMPS cannot run a cross-check ('' when it can), installing it first when `lmp`
+    is missing: not installed and the install failed, or no `lmp -h` listing these
+    styles of the GRANULAR package (pair or fix styles)."""
     if shutil.which(LMP) is None:
-        print("peer: installing LAMMPS (apt-get install lammps)", flush=True)
-        sudo = [] if os.geteuid() == 0 else ["sudo"]
-        env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
-        install = sudo + ["apt-get", "install", "-y", "-qq", "--no-install-recommends", "lammps"]
-        if subprocess.run(install, env=env).returncode != 0:
-            # A machine that never ran apt-get update has no package lists.
-            subprocess.run(sudo + ["apt-get", "update", "-qq"], env=env, check=True)
-            subprocess.run(install, env=env, check=True)
-    help_text = subprocess.run([LMP, "-h"], capture_output=True, text=True).stdout
-    if "GRANULAR" not in help_text or "gran/hooke/history" not in help_text:
-        sys.exit("peer: this LAMMPS lacks the GRANULAR package (pair gran/hooke/history)")
+        failed = install_lammps()
+        if failed or shutil.which(LMP) is None:
+            return (f"LAMMPS is not installed (no `{LMP}` on PATH) and "
+                    f"{failed or 'the install left no ' + LMP + ' on PATH'}")
+    try:
+        help_text = subprocess.run([LMP, "-h"], capture_output=True, text=True).stdout
+    except OSError as exc:
+        return f"`{LMP} -h` cannot run ({exc})"
+    missing = [s for s in styles if not re.search(rf"(?<![\w/]){re.escape(s)}(?![\w/])", help_text)]
+    if "GRANULAR" not in help_text or missing:
+        return (f"this LAMMPS ({shutil.which(LMP)}) lacks the GRANULAR package's "
+                f"{', '.join(missing or styles)}")
+    return ""
+
+
+def ensure_lammps():
+    """The race's lammps_problem(): a problem ends the script (exit status 1)."""
+    problem = lammps_problem()
+    if problem:
+        sys.exit(f"peer: {problem}")
+
+
+def skip_outputs(reason):
+    """A cross-check that could not run, as a run's outputs (series.tsv, run.json): no
+    rows, and status 'skipped' with the reason, which the harness reports as SKIP for
+    every check of the case (harness/tables.py)."""
+    return "cycle\ttime\n", {"status": "skipped", "message": reason, "steps": 0, "n_discs": 0}
+
+
+def write_outputs(out, series, info):
+    """series.tsv and run.json into out, each written whole (a .tmp, then a rename)."""
+    out = Path(out)
+    for name, text in (("series.tsv", series), ("run.json", json.dumps(info, indent=1) + "\n")):
+        tmp = out / (name + ".tmp")
+        tmp.write_text(text)
+        tmp.rename(out / name)
 
 
 def run_ballast(args, out):
@@ -807,18 +904,20 @@ def check_outputs(results, ok):
 
 
 def check_only(out, template):
-    """`--check-only --out DIR`: the cross-check alone, written like a run."""
+    """`--check-only --out DIR`: the cross-check alone, written like a run; a skipped
+    run when LAMMPS cannot run it (lammps_problem())."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    problem = lammps_problem()
+    if problem:
+        print(f"peer: skipped: {problem}", flush=True)
+        write_outputs(out, *skip_outputs(problem))
+        return 0
     global BALLAST_RUN
     BALLAST_RUN = out / "ballast"
     shutil.copy2(BALLAST, BALLAST_RUN)
     ok, _ = cross_check(out / "work", template)
-    series, info = check_outputs(cross_check.results, ok)
-    for name, text in (("series.tsv", series), ("run.json", json.dumps(info, indent=1) + "\n")):
-        tmp = out / (name + ".tmp")
-        tmp.write_text(text)
-        tmp.rename(out / name)
+    write_outputs(out, *check_outputs(cross_check.results, ok))
     return 0 if ok else 1
 
 
@@ -835,7 +934,6 @@ def main(argv=None):
             sys.exit("peer: --check-only needs --out DIR")
         if not BALLAST.exists():
             sys.exit("peer: build the core first (make bin/ballast)")
-        ensure_lammps()
         return check_only(a.out, TEMPLATE.read_text())
     if not BALLAST.exists():
         sys.exit("peer: build the core first (make bin/ballast)")

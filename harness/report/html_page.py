@@ -7,7 +7,7 @@ import base64
 import html
 
 from .. import sweep
-from ..gate import fmt_number, fmt_reference, tally
+from ..gate import counts_text, fmt_number, fmt_reference, tally
 from .contents import ENERGY_COLUMNS, energy_cells, stability_tables
 
 CSS = """
@@ -16,10 +16,13 @@ h1{margin-bottom:.2em} h2{border-bottom:2px solid #ccc;padding-bottom:.2em;margi
 table{border-collapse:collapse;margin:.5em 0 1em;font-size:.9em}
 th,td{border:1px solid #ccc;padding:.25em .5em;text-align:left;vertical-align:top}
 th{background:#f2f2f2} td.num{text-align:right;font-family:monospace;white-space:nowrap}
-.PASS{background:#d9f2d9;font-weight:bold} .FAIL{background:#f8d0d0;font-weight:bold}
+.PASS{background:#d9f2d9;font-weight:bold} .FAIL{background:#f8d0d0;font-weight:bold} .SKIP{background:#eeeeee;font-weight:bold}
 .bad{color:#a00} figure{margin:1em 0} figure img{max-width:100%;border:1px solid #ddd}
 figcaption{font-size:.9em;color:#444} blockquote{margin:.4em 0 0 1em;padding-left:.8em;border-left:3px solid #bbb;font-style:italic} code{background:#f4f4f4;padding:0 .2em} .meta{color:#555}
 """
+
+# The class of a run's status cell: a run that could not be made (skipped) is neither.
+RUN_CLASS = {"ok": "PASS", "skipped": "SKIP"}
 
 
 def esc(text):
@@ -50,7 +53,7 @@ def image_html(figure):
 
 
 def _runs_html(r):
-    rows = [[cell(x["variant"]), cell(x["status"], "PASS" if x["status"] == "ok" else "FAIL"),
+    rows = [[cell(x["variant"]), cell(x["status"], RUN_CLASS.get(x["status"], "FAIL")),
              cell(fmt_number(x["wall"]), "num"), cell(fmt_number(x["steps"]), "num"), cell(fmt_number(x["dt"]), "num"),
              cell(fmt_number(x["n_discs"]), "num"), cell(x["message"])] for x in r.runs]
     return table_html(["variant", "status", "wall s", "steps", "dt", "discs", "message"], rows)
@@ -70,7 +73,7 @@ def _energy_html(r):
 def _checks_html(r):
     rows = [[cell(v.check), cell(v.variant), cell(v.quantity), cell(fmt_number(v.value), "num"),
              cell(fmt_reference(v), "num"), cell(v.tolerance), cell(v.kind), cell(v.provenance),
-             cell("PASS" if v.passed else "FAIL", "PASS" if v.passed else "FAIL"), cell(v.message)]
+             cell(v.result, v.result), cell(v.message)]
             for v in r.verdicts]
     if not rows:
         return "<p>(no checks for this case)</p>"
@@ -80,11 +83,10 @@ def _checks_html(r):
 
 def _case_html(r):
     c = r.case
-    passed, failed = tally(r.verdicts)
     return "\n".join([
         f"<section id=\"case-{esc(c.name)}\"><h2>{esc(c.name)}: {esc(c.title)}</h2>",
         f"<p><b>Checks:</b> {esc(c.checks)}</p>",
-        f"<p class=\"meta\">tier {esc(c.tier)} &middot; {passed} passed, {failed} failed &middot; "
+        f"<p class=\"meta\">tier {esc(c.tier)} &middot; {counts_text(r.verdicts)} &middot; "
         f"defined at <code>{esc(c.source)}</code></p>",
         "<h3>Runs</h3>", _runs_html(r), _energy_html(r),
         "<h3>Figures</h3>" if r.figures else "", *[image_html(f) for f in r.figures],
@@ -97,21 +99,23 @@ def _index_html(reports):
     for r in reports:
         passed, failed = tally(r.verdicts)
         runs_ok = sum(x["status"] == "ok" for x in r.runs)
-        state = "PASS" if r.verdicts and not failed else "FAIL"
+        state = "FAIL" if failed or not r.verdicts else "PASS" if passed else "SKIP"
         rows.append([f"<td><a href=\"#case-{esc(r.case.name)}\">{esc(r.case.name)}</a></td>", cell(r.case.title),
                      cell(r.case.tier), cell(f"{runs_ok}/{len(r.runs)}", "num"),
-                     cell(f"{passed} passed, {failed} failed", state)])
+                     cell(counts_text(r.verdicts), state)])
     return table_html(["case", "title", "tier", "runs ok", "checks"], rows)
 
 
 def page(reports, revision, date):
-    passed, failed = tally([v for r in reports for v in r.verdicts])
+    verdicts = [v for r in reports for v in r.verdicts]
+    passed, failed = tally(verdicts)
     return "\n".join([
         "<!DOCTYPE html>", "<html lang=\"en\"><head><meta charset=\"utf-8\">",
         "<title>ballast validation report</title>", f"<style>{CSS}</style></head><body>",
         "<header><h1>ballast validation report</h1>",
         f"<p class=\"meta\">git revision <code>{esc(revision)}</code> &middot; {esc(date)} &middot; "
-        f"<span class=\"{'PASS' if passed and not failed else 'FAIL'}\">{passed} passed, {failed} failed</span></p>",
+        f"<span class=\"{'FAIL' if failed or not verdicts else 'PASS' if passed else 'SKIP'}\">"
+        f"{counts_text(verdicts)}</span></p>",
         "</header>", _index_html(reports), *[_case_html(r) for r in reports], "</body></html>", ""])
 
 

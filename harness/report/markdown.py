@@ -1,14 +1,13 @@
 """reports/summary.md: the report as markdown, from what contents.py gathered."""
 from .. import sweep
-from ..gate import fmt_number, fmt_reference, tally
+from ..gate import counts_text, fmt_number, fmt_reference
 from .contents import ENERGY_COLUMNS, energy_cells, stability_tables
 from .cost_plot import UNSTABLE
 
 
 def markdown(reports, revision, date):
     verdicts = [v for r in reports for v in r.verdicts]
-    passed, failed = tally(verdicts)
-    lines = ["# ballast validation report", "", f"Revision `{revision}`, {date}. **{passed} passed, {failed} failed.**", ""]
+    lines = ["# ballast validation report", "", f"Revision `{revision}`, {date}. **{counts_text(verdicts)}.**", ""]
     for r in reports:
         lines += _markdown_case(r)
     return "\n".join(lines) + "\n"
@@ -41,7 +40,7 @@ def _markdown_case(r):
               "| check | variant | value | reference | tolerance | kind | result | provenance | message |",
               "|---|---|---|---|---|---|---|---|---|"]
     lines += [f"| {v.check} | {v.variant} | {fmt_number(v.value)} | {fmt_reference(v)} | {v.tolerance} | {v.kind} | "
-              f"{'PASS' if v.passed else '**FAIL**'} | {_md(v.provenance)} | {_md(v.message)} |" for v in r.verdicts]
+              f"{'**FAIL**' if v.result == 'FAIL' else v.result} | {_md(v.provenance)} | {_md(v.message)} |" for v in r.verdicts]
     if not r.verdicts:
         lines.append("| *(no checks for this case)* | | | | | | | | |")
     return lines + [""] + _cost_markdown(r.cost)

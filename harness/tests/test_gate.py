@@ -131,3 +131,47 @@ def test_broken_reference_file_is_a_usage_error(project, capsys):
     ref.write_text(ref.read_text().replace("tolerance = abs 1e-12", "tolerance = abz 1e-12"))
     assert main(["check"]) == 2
     assert "springs.ref:7: unknown tolerance 'abz'" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------- SKIP: a run that could not be made
+
+def skip(check="s", case="peer", message="skipped: LAMMPS is not installed"):
+    return Verdict(case, "check", check, "last(x)", None, [None, 1.0], "interval", "exact", "p", False,
+                   message, skipped=True)
+
+
+def test_a_skipped_check_is_neither_pass_nor_fail():
+    verdicts = [v(), skip("a"), skip("b")]
+    lines = table(verdicts).splitlines()
+    assert lines[-1] == "1 passed, 0 failed, 2 skipped"
+    result_col = lines[0].index("RESULT")
+    assert [r[result_col:result_col + 4] for r in lines[2:5]] == ["PASS", "SKIP", "SKIP"]
+    assert "SKIP peer (2 checks): skipped: LAMMPS is not installed" in lines   # one line per reason
+    assert not any(line.startswith("FAIL") for line in lines)
+    assert exit_status(verdicts) == 0
+    assert exit_status([skip()]) == 1                   # nothing verified is not a pass
+    assert exit_status([skip(), v("d", passed=False)]) == 1
+
+
+def test_a_skip_round_trips_and_is_a_junit_skip(tmp_path):
+    write_summary([v(), skip()], tmp_path / "summary.json")
+    records = json.loads((tmp_path / "summary.json").read_text())
+    assert "skip" not in records[0] and records[1]["skip"] is True and records[1]["pass"] is False
+    back = read_summary(tmp_path / "summary.json")
+    assert [x.result for x in back] == ["PASS", "SKIP"]
+    root = ET.fromstring(junit([v(), skip(case="spring")]).split("?>", 1)[1])
+    suite = root.find("testsuite")
+    assert suite.get("skipped") == "1" and suite.get("failures") == "0"
+    assert suite.findall("testcase")[1].find("skipped").get("message") == "skipped: LAMMPS is not installed"
+
+
+def test_check_skips_the_checks_of_a_run_that_says_it_was_skipped(project, runs, capsys):
+    write_spring_runs(runs)
+    write_run(runs / "spring" / "soft", spring_columns(1), status="skipped",
+              message="LAMMPS is not installed")
+    status, out = check_cli(capsys)
+    assert out.splitlines()[-1] == "1 passed, 0 failed, 5 skipped"   # rel_last reads stiff alone
+    assert "SKIP spring (5 checks): skipped: LAMMPS is not installed" in out
+    assert status == 0
+    records = json.loads((project / "reports" / "summary.json").read_text())
+    assert sum(r.get("skip", False) for r in records) == 5

@@ -136,3 +136,28 @@ def test_unwritable_output_folder_is_a_failed_run(project, tmp_path):
     job = Job("c", "v", project / "cases" / "springs" / "spring.scene", [], blocker / "out")
     outcome = run_all([job], project / "bin" / "ballast", 1, io.StringIO())[0]
     assert not outcome.ok and "cannot prepare" in outcome.cause
+
+
+def test_a_run_that_says_it_was_skipped_is_ok_is_reported_and_is_tried_again(project, runs, capsys):
+    """run.json status 'skipped' (a cross-check against LAMMPS without LAMMPS): the run did
+    what it could, so it is not FAILED; the reason is printed; --resume does not keep it."""
+    add_sets(project, "soft", "status=skipped")
+    assert main(["run", "spring"]) == 0
+    out = capsys.readouterr().out
+    assert "SKIPPED spring/soft: no reason given" in out and "FAILED" not in out
+    assert out.splitlines()[-1].startswith("3 runs: 3 ok, 0 failed")
+    assert main(["run", "spring", "--resume"]) == 0
+    out = capsys.readouterr().out
+    assert "spring/stiff  done before, kept (--resume)" in out
+    assert "spring/soft  done before" not in out and "SKIPPED spring/soft" in out
+
+
+def test_the_cross_checks_run_their_scripts(project, runs):
+    """command = peer and peer_rolling run harness/peer's scripts, not the core."""
+    job = Job("peer_rolling", "check", project / "x.scene", [], runs / "peer_rolling" / "check",
+              command="peer_rolling")
+    cmd = command(job, "bin/ballast")
+    assert cmd[0] == "/usr/bin/python3" and cmd[1].endswith("harness/peer/rolling.py")
+    assert cmd[2:] == ["--out", str(job.out)]
+    job.command = "peer"
+    assert command(job, "bin/ballast")[1:3][1] == "--check-only"

@@ -1,0 +1,323 @@
+"""harness/peer/rolling.py (the case peer_rolling): the mapping of JYH's Model 1 onto LAMMPS's
+pair granular `rolling sds` with hand values, the inputs it writes to both codes, the
+conventions by which it reads their outputs, its figures and verdicts, and the skip path
+when LAMMPS is absent.  No LAMMPS run here; the skip path runs nothing either."""
+import importlib.util
+import json
+import math
+import pathlib
+import re
+import sys
+
+import numpy as np
+import pytest
+
+from harness.compare import RunStore, evaluate_check
+from harness.errors import RunSkipped
+from harness.references import load_file
+from harness.tables import load_run
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+PEER = ROOT / "harness" / "peer"
+
+
+def load(name):
+    spec = importlib.util.spec_from_file_location(f"peer_{name}", PEER / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+rolling = load("rolling")
+race = rolling.race          # the race.py rolling.py imports (harness/peer on sys.path)
+
+
+# ---- the mapping ------------------------------------------------------------------------
+
+def test_lammps_coefficients_of_delta_08_by_hand():
+    m = rolling.lammps_rolling(0.8, 1e5, mu_n=100.0)
+    assert m["k_roll"] == pytest.approx(1e5 * 0.64 / 3)          # 21333.3
+    assert m["mu_roll"] == pytest.approx(0.8 / 3)                # 0.26667
+    assert m["gamma_roll"] == pytest.approx(100.0 * 0.64 / 3)    # 21.333
+    assert rolling.lammps_rolling(0.8, 1e5)["gamma_roll"] == 0.0
+
+
+def test_two_discs_constants_by_hand_agree_in_both_codes():
+    # r1 = 0.5, r2 = 0.75: JYH r = 2 r1 r2/(r1 + r2) = 0.6, B = 0.8 r = 0.48,
+    # K_m = 1e5 * 0.48^2 / 12 = 1920, M_0 / F_n = B/6 = 0.08, mu_m = 100 * 0.48^2/12 = 1.92;
+    # LAMMPS's R_eff = 0.3: k_roll R_eff^2 = 21333.3 * 0.09 = 1920, mu_roll R_eff = 0.08.
+    c = rolling.contact_constants(0.8, 1e5, 0.5, 0.75, mu_n=100.0)
+    assert (c["r"], c["R_eff"]) == pytest.approx((0.6, 0.3))
+    assert (c["B"], c["K_m"], c["M0_per_Fn"], c["mu_m"]) == pytest.approx((0.48, 1920.0, 0.08, 1.92))
+    assert c["k_roll_R2"] == pytest.approx(c["K_m"], rel=1e-15)
+    assert c["mu_roll_R"] == pytest.approx(c["M0_per_Fn"], rel=1e-15)
+    assert c["gamma_roll_R2"] == pytest.approx(c["mu_m"], rel=1e-15)
+
+
+def test_a_flat_wall_takes_the_same_coefficients():
+    # JYH r = 2 r1 = 1 against a wall (eq. 11b), B = 0.8; LAMMPS's R_eff = r1 = 0.5:
+    # K_m = 1e5 * 0.64 / 12 = 5333.3 = k_roll * 0.25, M_0 / F_n = 0.8/6 = mu_roll * 0.5.
+    c = rolling.contact_constants(0.8, 1e5, 0.5)
+    assert (c["r"], c["R_eff"], c["B"]) == pytest.approx((1.0, 0.5, 0.8))
+    assert c["K_m"] == pytest.approx(1e5 * 0.64 / 12) == pytest.approx(c["k_roll_R2"])
+    assert c["M0_per_Fn"] == pytest.approx(0.8 / 6) == pytest.approx(c["mu_roll_R"])
+
+
+@pytest.mark.parametrize("r1,r2", [(0.5, 0.5), (0.5, 0.75), (0.1, 7.0), (1e-3, 1.0)])
+def test_one_atom_type_serves_every_pair_of_radii(r1, r2):
+    c = rolling.contact_constants(0.3, 2e7, r1, r2, mu_n=5.0)
+    assert c["r"] == pytest.approx(2 * c["R_eff"], rel=1e-15)
+    assert c["k_roll_R2"] == pytest.approx(c["K_m"], rel=1e-14)
+    assert c["mu_roll_R"] == pytest.approx(c["M0_per_Fn"], rel=1e-14)
+    assert c["gamma_roll_R2"] == pytest.approx(c["mu_m"], rel=1e-14)
+
+
+# ---- the inputs ------------------------------------------------------------------------------
+
+def commands(text):
+    return [line.split("#")[0].split() for line in text.splitlines() if line.split("#")[0].strip()]
+
+
+def test_lammps_input_has_the_mapped_rolling_all_pairs_and_no_sorting():
+    text = rolling.lammps_text(rolling.TEMPLATE.read_text(), "data.lmp", (0.0, 36.0, 0.0, 21.5),
+                               7.9e-4, 500, "", mu=0.5, g=9.81)
+    assert "@" not in text
+    cmds = commands(text)
+    coeff = next(c for c in cmds if c[0] == "pair_coeff")
+    assert coeff == ["pair_coeff", "*", "*", "hooke", "100000.0", "0.0", "tangential", "linear_history",
+                     "100000.0", "0.0", "0.5", "rolling", "sds", repr(1e5 * (0.8 * 0.8) / 3), "0.0",
+                     repr(0.8 / 3), "damping", "velocity"]
+    assert ["pair_style", "granular"] in cmds and ["atom_modify", "sort", "0", "0"] in cmds
+    assert next(c for c in cmds if c[0] == "neighbor")[2] == "nsq"
+    walls = [c for c in cmds if c[0] == "fix" and c[3] == "wall/gran"]
+    assert [w[4] for w in walls] == ["granular", "granular"]
+    for w in walls:
+        assert w[w.index("rolling"):w.index("rolling") + 5] == coeff[11:16]
+    assert walls[0][-3:] == ["xplane", "0.0", "36.0"] and walls[1][-3:] == ["yplane", "0.0", "21.5"]
+    assert next(c for c in cmds if c[:2] == ["fix", "integrate"])[-1] == "disc"
+
+
+def test_lammps_input_walls_without_rolling_and_with_damping():
+    text = rolling.lammps_text(rolling.TEMPLATE.read_text(), "d", (0.0, 1.0, 0.0, 1.0), 1e-4, 10, "",
+                               mu=0.0, g=0.0, wall_rolling=False, beta=1e-3)
+    cmds = commands(text)
+    coeff = next(c for c in cmds if c[0] == "pair_coeff")
+    assert coeff[5] == "100.0" and coeff[9] == "1.0"              # eta_n = beta k_n, x_gamma = 1
+    assert float(coeff[14]) == pytest.approx(100.0 * 0.64 / 3)    # gamma_roll = eta_n delta^2/3
+    for w in (c for c in cmds if c[0] == "fix" and c[3] == "wall/gran"):
+        assert "rolling" not in w and w[7] == "100.0"
+
+
+def sections(text):
+    out = []
+    for line in text.splitlines():
+        line = line.split("#")[0].strip()
+        if not line:
+            continue
+        if line.startswith("["):
+            out.append((line, {}))
+        else:
+            k, v = (p.strip() for p in line.split("=", 1))
+            out[-1][1][k] = v
+    return out
+
+
+def test_ballast_scene_with_rolling_damping_and_probes():
+    state, box = rolling.two_disc_state(20.0)
+    secs = sections(race.ballast_scene(state, box, 1e-4, 1200, "t", mu=0.0, g=0.0, rolling=0.8,
+                                       wall_rolling=0.0, output_every=1, probes=rolling.TWO_PROBES,
+                                       beta=1e-3))
+    d = dict(secs)
+    assert d["[settings]"]["rolling_model"] == "model1" and d["[settings]"]["beta"] == "0.001"
+    assert d["[settings]"]["output_every"] == "1" and d["[settings]"]["gravity"] == "0 -0.0"
+    assert d["[material grain]"]["rolling"] == "0.8" and "rolling" not in d["[material box]"]
+    assert d["[probe m]"] == {"quantity": "contact_mr", "a": "d0", "b": "d1"}
+    assert d["[probe w1]"] == {"quantity": "disc_omega", "a": "d1"}
+    assert [h for h, _ in secs].index("[stage race]") < [h for h, _ in secs].index("[probe m]")
+    plain = dict(sections(race.ballast_scene(state, box, 1e-4, 5, "t")))   # the race's: no rolling
+    assert "rolling_model" not in plain["[settings]"] and "rolling" not in plain["[material grain]"]
+    assert plain["[settings]"]["beta"] == "0"
+
+
+def test_two_disc_state_balances_every_overlap():
+    state, (xlo, xhi, ylo, yhi) = rolling.two_disc_state(20.0)
+    (xa, xb), (ra, rb) = state["x"], state["r"]
+    overlaps = (ra - (xa - xlo), ra + rb - (xb - xa), rb - (xhi - xb))
+    assert overlaps == pytest.approx((rolling.TWO_OVERLAP,) * 3, abs=1e-15)
+    assert state["omega"].tolist() == [20.0, 0.0] and state["y"][0] - rb > ylo and state["y"][0] + rb < yhi
+
+
+def test_lammps_spins_come_back_to_ballasts_after_the_first_half_kick():
+    state, _ = rolling.two_disc_state(3.0)
+    mu_m, dt = 1.92, 1e-4
+    w0 = rolling.lammps_spins(state, mu_m, dt)["omega"]
+    inertia = 0.5 * state["m"] * state["r"] ** 2
+    couple = -mu_m * (w0[0] - w0[1])                     # the dashpot at t = 0, on disc 0
+    half = w0 + 0.5 * dt * np.array([couple, -couple]) / inertia
+    assert half == pytest.approx(state["omega"], rel=1e-15, abs=1e-15)
+    assert rolling.lammps_spins(state, 0.0, dt)["omega"].tolist() == state["omega"].tolist()
+
+
+# ---- reading the outputs ---------------------------------------------------------------------
+
+CONTACTS = """a\tb\tkind\tx\ty\tnx\tny\tfn\tfs\tdn\tds\tsliding\tmr\tmd\ttheta_r\trolling
+d1\td0\tdisc\t0.5\t0\t-1\t0\t10\t2\t0\t0\t0\t3\t0.5\t0.01\t1
+d0\tbottom\twall\t0\t-0.5\t0\t-1\t5\t0\t0\t0\t0\t-1\t0\t-0.002\t0
+"""
+
+
+def test_ballast_forces_add_the_rolling_couples_and_take_lammps_arm():
+    # d0 at the origin, d1 at (0.9, 0): overlap 0.6 + 0.6 - 0.9 = 0.3.  Row 1: a = d1 gets
+    # fs r - (mr + md) = 2 * 0.6 - 3.5, b = d0 gets 2 * 0.6 + 3.5; at LAMMPS's arm each r is
+    # r - 0.15.  Row 2: the wall couple -(mr + md) = +1 on d0.
+    s = {"x": np.array([0.0, 0.9]), "y": np.zeros(2), "r": np.array([0.6, 0.6]), "m": np.zeros(2)}
+    _, _, tq, pairs = race.ballast_forces(s, CONTACTS, g=0.0)
+    assert tq.tolist() == pytest.approx([1.2 + 3.5 + 1, 1.2 - 3.5])
+    _, _, tq, _ = race.ballast_forces(s, CONTACTS, g=0.0, arm="contact")
+    assert tq.tolist() == pytest.approx([2 * 0.45 + 3.5 + 1, 2 * 0.45 - 3.5])
+    assert pairs == {(0, 1): (10.0, -2.0)}
+    assert rolling.ballast_couples(CONTACTS) == {(0, 1): 3.5}     # on d0, the lower id
+
+
+def test_lammps_couples_from_the_rolling_pseudo_force():
+    # atoms 1 (r 0.5) at the origin and 2 (r 0.75) at (1.2, 0): R_eff = 0.3.  For (i, j) =
+    # (2, 1), n = (1, 0) and F_roll = (0, 10): the couple on 2 is R_eff (n x F)_z = 3, on the
+    # lower id (atom 1, 0-based 0) -3.
+    atoms = {"id": np.array([1.0, 2.0]), "x": np.array([0.0, 1.2]), "y": np.zeros(2),
+             "radius": np.array([0.5, 0.75])}
+    local = {"c_ids[1]": np.array([2.0, 1.0]), "c_ids[2]": np.array([1.0, 2.0]),
+             "c_pairs[2]": np.array([10.0, 0.0]), "c_pairs[6]": np.array([0.0, 0.0]),
+             "c_pairs[7]": np.array([10.0, 0.0])}
+    assert rolling.lammps_couples(local, atoms) == {(0, 1): pytest.approx(-3.0)}
+    assert rolling.lammps_couples({}, atoms) == {}
+
+
+def test_parse_frames_reads_every_frame_in_order():
+    frame = "ITEM: TIMESTEP\n{s}\nITEM: NUMBER OF ATOMS\n1\nITEM: BOX BOUNDS ff ff pp\n0 1\n0 1\n0 1\n" \
+            "ITEM: ATOMS id omegaz\n1 {w}\n"
+    frames = race.parse_frames(frame.format(s=0, w=1.5) + frame.format(s=1, w=2.5))
+    assert [(f["_step"], f["omegaz"].tolist()) for f in frames] == [(0, [1.5]), (1, [2.5])]
+    with pytest.raises(ValueError, match="cut short"):
+        race.parse_frames(frame.format(s=0, w=1) + frame.format(s=1, w=2).rsplit("\n", 2)[0])
+
+
+# ---- figures and verdicts --------------------------------------------------------------------
+
+def test_two_disc_figures_and_verdicts():
+    cycle = np.arange(0.0, 1201.0)
+    m = np.minimum(cycle * 0.5, 80.0)
+    m[300:] = 40.0
+    capped = ((cycle >= 160) & (cycle < 300)).astype(float)
+    capped[700] = 1                                          # a turning point touching the cap
+    w0, w1 = np.full(1201, 20.0), np.zeros(1201)
+    frames = {int(s): {"_step": int(s), "id": np.array([2.0, 1.0]), "omegaz": np.array([0.0, 20.0]),
+                       "tqz": np.array([m[int(s)], -m[int(s)]])} for s in cycle}
+    frames[600]["omegaz"] = np.array([0.0, 20.0 + 1e-9])
+    c = rolling.two_disc_figures(cycle, m, capped, w0, w1, frames, m0=80.0, omega0=20.0)
+    assert c["compared"] == 1200 and c["max_dM"] == 0 and c["max_dw"] == pytest.approx(5e-11)
+    assert (c["peak"], c["capped"], c["plastic_end"]) == (1.0, 141, 299)
+    assert rolling.two_disc_verdict(c)
+    assert not rolling.two_disc_verdict(dict(c, max_dw=2e-10))
+    assert not rolling.two_disc_verdict(dict(c, plastic_end=1100))  # never unloaded
+    assert not rolling.two_disc_verdict(c, damped=True)             # damped must stay elastic
+    assert rolling.two_disc_verdict(dict(c, capped=0, peak=0.42, plastic_end=-1), damped=True)
+
+
+def test_collision_figures_want_first_order_in_the_overlap():
+    runs = {1: dict(diff=1.4e-3, overlap=4.66e-3, capped=60, sliding=46),
+            4: dict(diff=0.69e-3, overlap=2.3e-3, capped=59, sliding=46),
+            16: dict(diff=0.348e-3, overlap=1.2e-3, capped=59, sliding=46)}
+    c = rolling.collision_figures(runs)
+    assert (c["ratio_k4"], c["ratio_k16"]) == pytest.approx((0.69 / 1.4, 0.348 / 0.69))
+    assert c["bound"] == pytest.approx(4.66e-3 / 1.0)               # overlap / (2 r_min)
+    assert rolling.collision_verdict(c)
+    runs[16]["diff"] = 0.69e-3                                      # does not fall: O(1)
+    assert not rolling.collision_verdict(rolling.collision_figures(runs))
+
+
+def test_check_outputs_one_column_per_figure():
+    res = {"two_discs": dict(max_dM=1e-14, max_dw=2e-14, peak=1.0, capped=196, plastic_end=215),
+           "two_damped": dict(max_dM=1e-15, max_dw=2e-15, peak=0.42, capped=0),
+           "packing": dict({k: 1e-12 for k in rolling.PACK_FIGURES}, contacts_ballast=17,
+                           contacts_only_one=0, rolling_contacts=17, at_cap=3, n=300),
+           "collision": {"diff_k1": 1.4e-3, "diff_k4": 7e-4, "diff_k16": 3.5e-4, "ratio_k4": 0.5,
+                         "ratio_k16": 0.5, "bound": 4.7e-3, "capped": 60, "sliding": 46},
+           "friction_packing": {k: 1e-3 for k in rolling.PACK_FIGURES}}
+    series, info = rolling.check_outputs(res, True)
+    head, row = series.splitlines()
+    names, values = head.split("\t"), [float(v) for v in row.split("\t")]
+    assert names[:2] == ["cycle", "time"] and len(names) == len(values) == len(set(names))
+    assert values[names.index("two_discs_plastic_end")] == 215
+    assert values[names.index("collision_ratio_k16")] == 0.5
+    assert values[names.index("packing_max_dM")] == 1e-12
+    assert info["status"] == "ok" and info["n_discs"] == 300
+    assert rolling.check_outputs(res, False)[1]["status"] == "failed"
+
+
+def test_every_column_the_references_read_is_written():
+    """reference/peer_rolling.ref reads only columns that check_outputs() writes."""
+    ref = (ROOT / "reference" / "peer_rolling.ref").read_text()
+    read = set(re.findall(r"last\((\w+)\)", ref))
+    written = {f"{t}_{k}" for t, k in rolling.COLUMNS}
+    assert read and read <= written
+
+
+# ---- the skip path: no LAMMPS -------------------------------------------------------------
+
+@pytest.fixture
+def no_lammps(monkeypatch, tmp_path):
+    """No lmp on PATH, and an install that fails."""
+    monkeypatch.setattr(race, "LMP", "lmp-that-is-not-installed")
+    monkeypatch.setattr(race, "INSTALL", (str(tmp_path / "no-apt-get"), "install", "lammps"))
+    return tmp_path
+
+
+def test_lammps_problem_says_why(no_lammps, capsys):
+    problem = race.lammps_problem()
+    assert "LAMMPS is not installed (no `lmp-that-is-not-installed` on PATH)" in problem
+    assert "no-apt-get install lammps` failed" in problem
+
+
+def test_a_lammps_without_the_styles_is_a_problem(monkeypatch, tmp_path):
+    fake = tmp_path / "lmp"
+    fake.write_text("#!/bin/sh\necho 'Installed packages:'\necho 'GRANULAR'\necho 'gran/hooke'\n")
+    fake.chmod(0o755)
+    monkeypatch.setattr(race, "LMP", str(fake))
+    assert "lacks the GRANULAR package's granular" in race.lammps_problem(("granular",))
+    assert "gran/hooke/history" in race.lammps_problem()
+
+
+@pytest.mark.skipif(not (ROOT / "bin" / "ballast").exists(), reason="bin/ballast not built")
+def test_without_lammps_the_case_is_skipped_not_failed(no_lammps, capsys):
+    out = no_lammps / "run"
+    assert rolling.main(["--out", str(out)]) == 0
+    assert "peer rolling: skipped: LAMMPS is not installed" in capsys.readouterr().out
+    info = json.loads((out / "run.json").read_text())
+    assert info["status"] == "skipped" and "LAMMPS is not installed" in info["message"]
+    assert (out / "series.tsv").read_text() == "cycle\ttime\n"
+    assert not (out / "work").exists()                         # nothing ran
+    with pytest.raises(RunSkipped, match="skipped: LAMMPS is not installed"):
+        load_run(out)
+
+
+def test_a_skipped_run_makes_its_checks_skip(tmp_path):
+    folder = tmp_path / "peer_rolling" / "check"
+    folder.mkdir(parents=True)
+    series, info = race.skip_outputs("LAMMPS is not installed")
+    race.write_outputs(folder, series, info)
+    check = load_file(ROOT / "reference" / "peer_rolling.ref")[0]
+    verdict = evaluate_check(check, RunStore(lambda case, variant: tmp_path / case / variant))
+    assert verdict.skipped and verdict.result == "SKIP" and not verdict.passed
+    assert "LAMMPS is not installed" in verdict.message
+
+
+def test_race_check_only_skips_too(no_lammps):
+    out = no_lammps / "race"
+    assert race.check_only(out, race.TEMPLATE.read_text()) == 0
+    assert json.loads((out / "run.json").read_text())["status"] == "skipped"
+
+
+def test_rolling_imports_the_race_beside_it():
+    assert pathlib.Path(race.__file__).resolve() == PEER / "race.py"
+    assert str(PEER) in sys.path
+    assert math.isclose(rolling.KN, race.KN) and rolling.MU == race.MU

@@ -198,17 +198,33 @@ struct bal_pile_def {
 /* How a stage drives a wall: its controller (walls.c), named by the stage
  * key that gives the wall's line. */
 enum bal_wall_control {
-    BAL_CONTROL_PRESCRIBED = 0  /* `move`: P moves with v, the wall turns about P with omega */
+    BAL_CONTROL_PRESCRIBED = 0, /* `move`: P moves with v, the wall turns about P with omega */
+    BAL_CONTROL_SERVO = 1,      /* `servo`: the wall holds a target normal stress */
+    BAL_CONTROL_STRAIN_RATE = 2 /* `strain_rate`: the gap to another wall shrinks at a rate */
 };
 
+/* Most other walls a controller's line names (the servo's two span walls). */
+#define BAL_CONTROL_WALLS_MAX 2
+
 /* A stage's line for one wall: its controller and the controller's
- * parameters, in the order its key takes them after the wall's name. */
+ * parameters, in the order its key takes them after the wall's name: its
+ * numbers go to consecutive doubles from the key's offset, the other walls
+ * it names to `walls`, in order. */
 struct bal_move_def {
     char wall[BAL_NAME_MAX];  /* wall name */
     int line;
     int control;              /* enum bal_wall_control (prescribed) */
+    char walls[BAL_CONTROL_WALLS_MAX][BAL_NAME_MAX]; /* servo: the two walls whose
+                               * distance is the span; strain_rate: the wall it moves
+                               * towards (walls[0]) */
     double v[2];              /* prescribed: velocity of P */
     double omega;             /* prescribed: angular velocity about P, rad/time */
+    double sigma;             /* servo: target normal stress, force/length (per unit
+                               * thickness), compression positive */
+    double gain;              /* servo: share α of the stress error removed per cycle */
+    double vmax;              /* servo: speed cap, length/time; 0: BAL_SERVO_CAP_SHARE of the
+                               * smallest radius per time step (walls.c) */
+    double rate;              /* strain_rate: -d(gap)/dt / gap, 1/time (> 0 compresses) */
 };
 
 struct bal_stage_def {
@@ -218,6 +234,9 @@ struct bal_stage_def {
     long ramp;                /* 1: gravity rises linearly from 0 over the stage (0) */
     double stop_ke;           /* stop when E_k <= stop_ke E_el (0: off) */
     double stop_stress;       /* ... and the stresses change by <= this (0: off) */
+    double stop_servo;        /* ... and every servo wall is within this share of its
+                               * target stress (0: off) */
+    double stop_unbalanced;   /* ... and ΔF/F (bal_measure_unbalanced) <= this (0: off) */
     long check_every;         /* cycles between checks of the stop rule (100) */
     int n_moves;              /* walls the stage drives; the others stay at rest */
     struct bal_move_def moves[BAL_MAX_MOVES];

@@ -262,6 +262,7 @@ enum bal_status bal_build_discs(struct bal_sim *s, struct bal_error *err)
     double r_min = INFINITY;
     for (int i = 0; i < n; i++)
         r_min = fmin(r_min, d.r[i]);
+    s->r_min = r_min;
     s->overlap_sieve = s->overlap_budget * r_min; /* INFINITY when the budget is off */
 
     int ok = 1;
@@ -524,8 +525,20 @@ enum bal_status bal_build_stages(struct bal_sim *s, struct bal_error *err)
     s->log = calloc((size_t)(sc->n_stages ? sc->n_stages : 1), sizeof *s->log);
     if (!s->log)
         return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
-    for (int g = 0; g < sc->n_stages; g++)
-        s->log[g] = (struct bal_stage_log){0, 0, -1, -1};
+    for (int g = 0; g < sc->n_stages; g++) {
+        s->log[g] = (struct bal_stage_log){0, 0, -1, -1, -1, -1};
+        /* A strain rate whose step rate dt reaches 1 would carry the wall
+         * onto (or past) the other in one cycle (walls.c). */
+        for (int m = 0; m < sc->stages[g].n_moves; m++) {
+            const struct bal_move_def *mv = &sc->stages[g].moves[m];
+            if (mv->control == BAL_CONTROL_STRAIN_RATE && !(mv->rate * s->dt < 1))
+                return bal_error(err, BAL_EINVAL,
+                                 "%s:%d: strain_rate: rate %g with the time step %g gives rate "
+                                 "dt = %g; expected rate dt < 1 (the gap shrinks by 1 - rate dt "
+                                 "a cycle)", sc->path, mv->line > 0 ? mv->line : sc->stages[g].line,
+                                 mv->rate, s->dt, mv->rate * s->dt);
+        }
+    }
     s->stage = -1; /* none yet: bal_sim_run or bal_sim_step selects the first */
     s->gfac = 1;
     return BAL_OK;

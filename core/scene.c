@@ -241,15 +241,25 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
         return where_error(err, w, key->name, "%s", msg);
     }
     case BAL_KEY_CONTROL: {
-        /* A wall's name, then as many numbers as the key's form has words
-         * after "WALL" (key->choices: "WALL v1 v2 omega"). */
+        /* A wall's name, then what the key's form (key->choices, e.g.
+         * "WALL sigma gain vmax WALL_A WALL_B") has after "WALL": a word
+         * that starts with WALL is the name of another wall, any other
+         * word a finite number. */
         static const char *const counts[BAL_CONTROL_VALUES_MAX + 1] = {
             "no", "one", "two", "three", "four", "five", "six", "seven", "eight"};
         struct bal_stage_def *st = item;
-        int n_values = 0;
-        for (const char *c = key->choices; (c = strchr(c, ' ')) != NULL; c++)
-            n_values++;
+        int n_values = 0, n_walls = 0;
+        char is_wall[BAL_CONTROL_VALUES_MAX + BAL_CONTROL_WALLS_MAX];
+        int n_words = 0;
+        for (const char *c = key->choices; (c = strchr(c, ' ')) != NULL && n_words < (int)sizeof is_wall;) {
+            c++;
+            is_wall[n_words] = strncmp(c, "WALL", 4) == 0;
+            n_walls += is_wall[n_words];
+            n_values += !is_wall[n_words];
+            n_words++;
+        }
         double values[BAL_CONTROL_VALUES_MAX];
+        char walls[BAL_CONTROL_WALLS_MAX][BAL_NAME_MAX + 1];
         char wall[BAL_NAME_MAX + 1], msg[BAL_MSG_MAX];
         int n_read = 0;
         if (sscanf(value, "%48s%n", wall, &n_read) != 1 || !valid_name(wall)) {
@@ -257,22 +267,36 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
             return where_error(err, w, key->name, "%s", msg);
         }
         p = value + n_read;
-        int ok = 1;
-        for (int k = 0; k < n_values && ok; k++)
-            ok = parse_number(&p, &values[k]);
+        int ok = 1, nv = 0, nw = 0;
+        for (int k = 0; k < n_words && ok; k++) {
+            if (!is_wall[k]) {
+                ok = parse_number(&p, &values[nv++]);
+                continue;
+            }
+            int got = 0;
+            ok = sscanf(p, "%48s%n", walls[nw], &got) == 1 && valid_name(walls[nw]);
+            p += got;
+            nw++;
+        }
         if (!ok || !at_end(p)) {
-            snprintf(msg, sizeof msg, "expected '%s' with %s finite numbers, got '%s'",
-                     key->choices, counts[n_values], value);
+            char names[32] = "";
+            if (n_walls > 0)
+                snprintf(names, sizeof names, " and %s wall name%s", counts[n_walls],
+                         n_walls > 1 ? "s" : "");
+            snprintf(msg, sizeof msg, "expected '%s' with %s finite number%s%s, got '%s'",
+                     key->choices, counts[n_values], n_values == 1 ? "" : "s", names, value);
             return where_error(err, w, key->name, "%s", msg);
         }
-        /* In a file a wall is moved once per stage; --set (line 0) replaces
-         * the wall's motion, so a variant can change a loading speed. */
+        /* In a file a wall has one line per stage, whatever its controller;
+         * --set (line 0) replaces the wall's line, so a variant can change a
+         * loading speed (or the controller). */
         struct bal_move_def *m = NULL;
         for (int i = 0; i < st->n_moves; i++) {
             if (strcmp(st->moves[i].wall, wall) != 0)
                 continue;
             if (w.line > 0)
-                return where_error(err, w, key->name, "wall '%s' is moved twice in this stage", wall);
+                return where_error(err, w, key->name,
+                                   "wall '%s' is driven twice in this stage", wall);
             m = &st->moves[i];
         }
         if (!m) {
@@ -280,10 +304,13 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
                 return where_error(err, w, key->name, "more than %s moves in one stage", "16");
             m = &st->moves[st->n_moves++];
         }
+        memset(m, 0, sizeof *m);
         strcpy(m->wall, wall);
         m->line = w.line;
         m->control = bal_scene_key_control(key->name);
         memcpy((char *)m + key->offset, values, (size_t)n_values * sizeof(double));
+        for (int k = 0; k < n_walls; k++)
+            strcpy(m->walls[k], walls[k]);
         return BAL_OK;
     }
     }

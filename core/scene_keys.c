@@ -38,9 +38,13 @@
 #define P(field) offsetof(struct bal_probe_def, field)
 #define MV(field) offsetof(struct bal_move_def, field)
 
-/* `move` stores its three numbers from v on: v[0], v[1], omega. */
+/* A controller's numbers are consecutive doubles of struct bal_move_def from
+ * its key's offset on: `move` v[0], v[1], omega; `servo` sigma, gain, vmax;
+ * `strain_rate` rate. */
 _Static_assert(offsetof(struct bal_move_def, omega) == MV(v) + 2 * sizeof(double),
                "the numbers of `move` are consecutive doubles of struct bal_move_def");
+_Static_assert(MV(gain) == MV(sigma) + sizeof(double) && MV(vmax) == MV(sigma) + 2 * sizeof(double),
+               "the numbers of `servo` are consecutive doubles of struct bal_move_def");
 
 const struct bal_key bal_scene_keys[] = {
     /* [settings] */
@@ -186,12 +190,27 @@ const struct bal_key bal_scene_keys[] = {
      "... and the disc stresses change by <= this share of the largest between checks"},
     {BAL_SEC_STAGE, "check_every", BAL_KEY_LONG, G(check_every), "100", 0, 1, 1e15, NULL,
      "cycles between checks of the stop rule"},
+    {BAL_SEC_STAGE, "stop_servo", BAL_KEY_DOUBLE, G(stop_servo), "0", 0, 0, BIG, NULL,
+     "... and every servo wall of the stage is within this share of its target stress (0: off)"},
+    {BAL_SEC_STAGE, "stop_unbalanced", BAL_KEY_DOUBLE, G(stop_unbalanced), "0", 0, 0, BIG, NULL,
+     "... and the unbalanced-force ratio (probe unbalanced, C&S dF/F) is <= this (0: off)"},
     /* A wall controller's key (walls.c; bal_scene_controls says which): its
      * numbers go, in order, to consecutive doubles of struct bal_move_def
-     * from `offset` on. */
+     * from `offset` on; the words of its form that start with WALL after
+     * the first are the names of other walls (struct bal_move_def, walls). */
     {BAL_SEC_STAGE, "move", BAL_KEY_CONTROL, MV(v), NULL, 0, -BIG, BIG, "WALL v1 v2 omega",
      "repeatable: WALL v1 v2 omega; velocity of P and angular velocity about P (C&S p. 53); "
      "walls not named are at rest; --set replaces the named wall's motion"},
+    {BAL_SEC_STAGE, "servo", BAL_KEY_CONTROL, MV(sigma), NULL, 0, -BIG, BIG,
+     "WALL sigma gain vmax WALL_A WALL_B",
+     "repeatable: the wall holds the normal stress sigma (its normal force from the discs over "
+     "the distance between WALL_A and WALL_B), removing the share gain (0 < gain < 2; <= 1 "
+     "monotone) of the error per cycle, at most vmax fast (0: 1e-3 of the smallest radius per "
+     "step)"},
+    {BAL_SEC_STAGE, "strain_rate", BAL_KEY_CONTROL, MV(rate), NULL, 0, -BIG, BIG,
+     "WALL rate WALL_TO",
+     "repeatable: the wall moves along its normal towards WALL_TO at rate x their distance "
+     "(a logarithmic strain rate, 1/time; < 0 moves away)"},
 
     /* [probe NAME] */
     {BAL_SEC_PROBE, "quantity", BAL_KEY_ENUM, P(kind), NULL, 1, 0, 0,
@@ -213,6 +232,8 @@ const size_t bal_scene_n_keys = sizeof bal_scene_keys / sizeof bal_scene_keys[0]
 /* Each wall controller's stage key (a BAL_KEY_CONTROL row above). */
 const struct bal_control_key bal_scene_controls[] = {
     {"move", BAL_CONTROL_PRESCRIBED},
+    {"servo", BAL_CONTROL_SERVO},
+    {"strain_rate", BAL_CONTROL_STRAIN_RATE},
 };
 
 const size_t bal_scene_n_controls = sizeof bal_scene_controls / sizeof bal_scene_controls[0];

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "scene.h"
+#include "walls.h"
 
 static int line_of(void *item, enum bal_section_kind k, const char *key)
 {
@@ -206,13 +207,28 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
                                           "add e.g. [stage run] with cycles = N", s->path);
     for (int i = 0; i < s->n_stages; i++) {
         struct bal_stage_def *g = &s->stages[i];
+        int servos = 0;
         for (int m = 0; m < g->n_moves; m++) {
             const struct bal_move_def *mv = &g->moves[m];
+            const char *key = bal_scene_key_for_control(mv->control);
+            /* A line from --set has no line of its own: the stage's header. */
+            const int line = mv->line > 0 ? mv->line : g->line;
             int is_wall = 0;
             if (!body_exists(s, mv->wall, &is_wall) || !is_wall)
                 return bal_error(err, BAL_EINVAL, "%s:%d: %s: no wall named '%s'", s->path,
-                                 mv->line, bal_scene_key_for_control(mv->control), mv->wall);
+                                 line, key, mv->wall);
+            for (int q = 0; q < BAL_CONTROL_WALLS_MAX; q++)
+                if (*mv->walls[q] && (!body_exists(s, mv->walls[q], &is_wall) || !is_wall))
+                    return bal_error(err, BAL_EINVAL, "%s:%d: %s: no wall named '%s'", s->path,
+                                     line, key, mv->walls[q]);
+            char why[BAL_MSG_MAX / 2];
+            if (bal_walls_check(mv, why, sizeof why))
+                return bal_error(err, BAL_EINVAL, "%s:%d: %s: %s", s->path, line, key, why);
+            servos += mv->control == BAL_CONTROL_SERVO;
         }
+        if (g->stop_servo > 0 && servos == 0)
+            return FAIL_AT(g, BAL_SEC_STAGE, "stop_servo", "%s",
+                           "no wall of this stage has a servo to be within the tolerance");
     }
     for (int i = 0; i < s->n_probes; i++) {
         struct bal_probe_def *p = &s->probes[i];

@@ -82,6 +82,15 @@ struct bal_wall {
                             * the stage leaves the wall at rest (walls.c) */
     const struct bal_move_def *move; /* the stage's line for the wall: the controller's
                             * parameters (scene data), or NULL */
+    /* What a controller keeps between cycles (walls.c), set when its stage
+     * begins. */
+    int other[BAL_CONTROL_WALLS_MAX]; /* indices of the walls its line names */
+    double toward[2];      /* unit normal of the wall along which it moves: towards the
+                            * discs (servo) or the other wall (strain_rate) */
+    double vcap;           /* servo: the speed cap */
+    double stress;         /* servo: the normal stress measured in the last cycle */
+    double stress_error;   /* servo: |stress − target| / target of the last cycle
+                            * (INFINITY before the first) */
     /* Resultant of the contact forces exerted by the discs on the wall,
      * accumulated in the last cycle. */
     double f[2];           /* F1, F2 */
@@ -129,6 +138,9 @@ struct bal_stage_log {
     double ke_over_ee;     /* E_k / E_el at the last check (-1: never checked) */
     double stress_change;  /* largest change of a disc's stress moment between the
                             * last two checks, over the largest (-1: never) */
+    double servo_error;    /* the largest |stress − target|/target of the stage's servo
+                            * walls at the last check (-1: never) */
+    double unbalanced;     /* ΔF/F at the last check (-1: never) */
 };
 
 /* Running sums of the energy audit (energy.c), from the first cycle. */
@@ -233,7 +245,7 @@ struct bal_sim {
     double *x_ref, *y_ref;       /* positions at the last rebuild */
     int32_t *mat;
     uint8_t *fixed;
-    double r_max;
+    double r_max, r_min;         /* largest and smallest radius */
 
     /* walls */
     int n_walls;

@@ -147,9 +147,9 @@ START_TEST(scene_parse_values)
 END_TEST
 
 /* Every wall controller's key names a controller, takes at most
- * BAL_CONTROL_VALUES_MAX numbers after the wall's name (the parser's
- * buffer), and stores them within struct bal_move_def; every controller
- * has a key. */
+ * BAL_CONTROL_VALUES_MAX numbers and BAL_CONTROL_WALLS_MAX other walls
+ * after the wall's name (the parser's buffers), and stores its numbers
+ * within struct bal_move_def; every controller has a key. */
 START_TEST(scene_control_keys)
 {
     int keys = 0;
@@ -165,10 +165,15 @@ START_TEST(scene_control_keys)
         ck_assert_str_eq(bal_scene_key_for_control(control), key->name);
         ck_assert_msg(strncmp(key->choices, "WALL ", 5) == 0, "%s: form '%s'", key->name,
                       key->choices);
-        size_t n = 0;
-        for (const char *c = key->choices; (c = strchr(c, ' ')) != NULL; c++)
-            n++;
+        size_t n = 0, walls = 0;
+        for (const char *c = key->choices; (c = strchr(c, ' ')) != NULL; c++) {
+            if (strncmp(c + 1, "WALL", 4) == 0)
+                walls++;
+            else
+                n++;
+        }
         ck_assert_msg(n >= 1 && n <= BAL_CONTROL_VALUES_MAX, "%s: %zu numbers", key->name, n);
+        ck_assert_msg(walls <= BAL_CONTROL_WALLS_MAX, "%s: %zu walls", key->name, walls);
         ck_assert(key->offset + n * sizeof(double) <= sizeof(struct bal_move_def));
     }
     ck_assert_int_eq(keys, (int)bal_scene_n_controls);
@@ -285,6 +290,14 @@ struct bad_scene {
     char refused_by;      /* 'p': bal_scene_parse, 'v': bal_scene_validate, 'c': bal_sim_create */
     const char *expect;   /* substring of the message */
 };
+
+/* Bad lines of the wall controllers: after HEAD (7 lines) and BOX (lines
+ * 8-27), four walls around the disc; the stage header is line 28. */
+#define BOX "[wall bottom]\np = -2 -1\nangle = 0\nh1 = 0\nh2 = 4\nmaterial = m\n" \
+            "[wall top]\np = -2 1\nangle = 0\nh1 = 0\nh2 = 4\nmaterial = m\n" \
+            "[wall left]\np = -1 -2\nangle = 90\nh1 = 0\nh2 = 4\nmaterial = m\n" \
+            "[wall right]\np = 1 -2\nangle = 90\nh1 = 0\nh2 = 4\nmaterial = m\n"
+#define BOX_STAGE HEAD BOX "[stage s]\ncycles = 3\n"
 
 static const struct bad_scene bad_scenes[] = {
     {"unknown key", "[material m]\nkn = 1e5\nfrction = 0.3\n", 'p',
@@ -446,6 +459,53 @@ static const struct bad_scene bad_scenes[] = {
      "[material m]\nkn = 1e5\ndensity = 2\n[fill f]\nn = 4\ncolumns = 2\nrmin = 0.5\n"
      "rmax = 0.5\nmaterial = m\nbox = 1\n" STAGE,
      'v', "bad:4: wall_material: required with box = 1"},
+    /* Issue 21: the wall controllers' lines and the servo stop rules. */
+    {"servo without its span walls", BOX_STAGE "servo = top 1e3 0.5 0\n", 'p',
+     "bad:34: servo: expected 'WALL sigma gain vmax WALL_A WALL_B' with three finite numbers "
+     "and two wall names, got 'top 1e3 0.5 0'"},
+    {"servo with a number for a wall (a name of digits)", BOX_STAGE
+     "servo = top 1e3 0.5 0 left 7\n", 'v', "bad:34: servo: no wall named '7'"},
+    {"servo with a wall for a number", BOX_STAGE "servo = top 1e3 left 0 right bottom\n", 'p',
+     "bad:34: servo: expected 'WALL sigma gain vmax WALL_A WALL_B'"},
+    {"servo with a bad wall name", BOX_STAGE "servo = top 1e3 0.5 0 left a.b\n", 'p',
+     "bad:34: servo: expected 'WALL sigma gain vmax WALL_A WALL_B'"},
+    {"strain_rate without its wall", BOX_STAGE "strain_rate = top 0.01\n", 'p',
+     "bad:34: strain_rate: expected 'WALL rate WALL_TO' with one finite number and one wall "
+     "name, got 'top 0.01'"},
+    {"a wall driven twice", BOX_STAGE "move = top 0 -1 0\nservo = top 1e3 0.5 0 left right\n",
+     'p', "bad:35: servo: wall 'top' is driven twice in this stage"},
+    {"servo naming a missing span wall", BOX_STAGE "servo = top 1e3 0.5 0 left ghost\n", 'v',
+     "bad:34: servo: no wall named 'ghost'"},
+    {"servo spanning a disc", BOX_STAGE "servo = top 1e3 0.5 0 a right\n", 'v',
+     "bad:34: servo: no wall named 'a'"},
+    {"servo of a missing wall", BOX_STAGE "servo = lid 1e3 0.5 0 left right\n", 'v',
+     "bad:34: servo: no wall named 'lid'"},
+    {"servo with a gain of 2", BOX_STAGE "servo = top 1e3 2 0 left right\n", 'v',
+     "bad:34: servo: the gain must be in (0, 2)"},
+    {"servo with a gain of 0", BOX_STAGE "servo = top 1e3 0 0 left right\n", 'v',
+     "bad:34: servo: the gain must be in (0, 2)"},
+    {"servo with a tensile target", BOX_STAGE "servo = top -1e3 0.5 0 left right\n", 'v',
+     "bad:34: servo: the target stress sigma must be > 0, got -1000"},
+    {"servo with a negative cap", BOX_STAGE "servo = top 1e3 0.5 -1 left right\n", 'v',
+     "bad:34: servo: the speed cap vmax must be >= 0"},
+    {"servo spanning itself", BOX_STAGE "servo = top 1e3 0.5 0 top bottom\n", 'v',
+     "bad:34: servo: the span is the distance between two other walls"},
+    {"servo spanning one wall twice", BOX_STAGE "servo = top 1e3 0.5 0 left left\n", 'v',
+     "bad:34: servo: the span is the distance between two other walls"},
+    {"strain_rate towards itself", BOX_STAGE "strain_rate = top 0.01 top\n", 'v',
+     "bad:34: strain_rate: wall 'top' cannot move towards itself"},
+    {"strain_rate towards a missing wall", BOX_STAGE "strain_rate = top 0.01 floor\n", 'v',
+     "bad:34: strain_rate: no wall named 'floor'"},
+    {"stop_servo without a servo", BOX_STAGE "stop_servo = 0.01\nmove = top 0 -1 0\n", 'v',
+     "bad:34: stop_servo: no wall of this stage has a servo"},
+    {"strain rate of a whole gap per step",
+     "[settings]\ndt = 1e-3\n" BOX_STAGE "strain_rate = top 1000 bottom\n", 'c',
+     "bad:36: strain_rate: rate 1000 with the time step 0.001 gives rate dt = 1; expected "
+     "rate dt < 1"},
+    {"stop_servo out of range", BOX_STAGE "stop_servo = -0.01\n", 'p',
+     "bad:34: stop_servo: -0.01 is out of range"},
+    {"stop_unbalanced out of range", BOX_STAGE "stop_unbalanced = -1\n", 'p',
+     "bad:34: stop_unbalanced: -1 is out of range"},
 };
 
 /* What the refusals let through: touching bodies, two held discs that
@@ -478,9 +538,8 @@ START_TEST(scene_allowed_overlaps_and_forced_steps)
 }
 END_TEST
 
-START_TEST(scene_bad_scene_refused)
+static void check_refused(const struct bad_scene *b)
 {
-    const struct bad_scene *b = &bad_scenes[_i];
     struct bal_scene sc;
     struct bal_error err = {0};
     bal_scene_default(&sc);
@@ -514,6 +573,11 @@ START_TEST(scene_bad_scene_refused)
                   b->expect);
     if (stage == 'v')
         ck_assert_msg(st_create == BAL_EINVAL, "%s: bal_sim_create accepted it", b->what);
+}
+
+START_TEST(scene_bad_scene_refused)
+{
+    check_refused(&bad_scenes[_i]);
 }
 END_TEST
 

@@ -255,8 +255,16 @@ enum bal_probe_kind {
     BAL_PROBE_HELD_FX, BAL_PROBE_HELD_FY, BAL_PROBE_WEIGHT_X, BAL_PROBE_WEIGHT_Y,
     BAL_PROBE_CONTACT_MR, BAL_PROBE_CONTACT_THETA_R, BAL_PROBE_CONTACT_ROLLING,
     BAL_PROBE_DISSIPATED_ROLLING,
+    BAL_PROBE_WALL_PX, BAL_PROBE_WALL_PY, BAL_PROBE_WALL_GAP, BAL_PROBE_WALL_STRESS,
     BAL_PROBE_COUNT
 };
+
+/* Does a probe of this kind read one wall (body a; wall_gap also b)? */
+static inline int bal_probe_is_wall(int kind)
+{
+    return (kind >= BAL_PROBE_WALL_F1 && kind <= BAL_PROBE_WALL_ECC) ||
+           (kind >= BAL_PROBE_WALL_PX && kind <= BAL_PROBE_WALL_STRESS);
+}
 
 /* Does a probe of this kind read one contact (bodies a and b)? */
 static inline int bal_probe_is_contact(int kind)

@@ -13,7 +13,13 @@
  * discs exert on the wall; the moment is about P, counter-clockwise; the
  * eccentricity e/(L/2) is the distance, along the wall, from the wall's
  * centre to the point where the resultant normal force acts, divided by
- * half the wall length (footnote 1 of Table 1).  held_fx, held_fy sum the
+ * half the wall length (footnote 1 of Table 1).  wall_px, wall_py are the
+ * wall's point P; wall_gap the distance from wall a to the midpoint of wall
+ * b along a's normal (walls.c, bal_walls_gap: the distance between the
+ * parallel walls of a box, as the controllers measure it); wall_stress the
+ * normal stress a servo measured on the wall in the last cycle (its normal
+ * force over its span, compression positive; 0 when no servo drives the
+ * wall).  held_fx, held_fy sum the
  * contact forces on held discs; weight_x, weight_y the gravity on the free
  * ones (with the current ramp).
  */
@@ -21,6 +27,7 @@
 
 #include "measure.h"
 #include "pairs.h"
+#include "walls.h"
 
 /* Contacts whose flags include `flag` (touching, or sliding). */
 static long count_contacts(const struct bal_sim *s, uint8_t flag)
@@ -76,6 +83,18 @@ double bal_probes_value(const struct bal_sim *s, int probe)
         return s->walls[p->a].f[1];
     case BAL_PROBE_WALL_MOMENT:
         return s->walls[p->a].moment;
+    case BAL_PROBE_WALL_PX:
+        return s->walls[p->a].p[0];
+    case BAL_PROBE_WALL_PY:
+        return s->walls[p->a].p[1];
+    case BAL_PROBE_WALL_GAP:
+        return bal_walls_gap(&s->walls[p->a], &s->walls[p->b], NULL);
+    case BAL_PROBE_WALL_STRESS: {
+        /* What the wall's servo measured in the last cycle; 0 for a wall no
+         * servo drives in the current stage. */
+        const struct bal_wall *W = &s->walls[p->a];
+        return W->move && W->move->control == BAL_CONTROL_SERVO ? W->stress : 0;
+    }
     case BAL_PROBE_WALL_ECC: {
         const struct bal_wall *W = &s->walls[p->a];
         if (W->fn_sum == 0)

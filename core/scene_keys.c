@@ -219,12 +219,12 @@ const struct bal_key bal_scene_keys[] = {
      "energy_kinetic energy_elastic work_walls work_gravity dissipated_dashpot "
      "dissipated_friction dissipated_global energy_imbalance unbalanced n_contacts n_sliding "
      "held_fx held_fy weight_x weight_y contact_mr contact_theta_r contact_rolling "
-     "dissipated_rolling",
+     "dissipated_rolling wall_px wall_py wall_gap wall_stress",
      "what the series column holds"},
     {BAL_SEC_PROBE, "a", BAL_KEY_NAME, P(a), "", 0, 0, 0, NULL,
      "body: the disc (disc_*), the wall (wall_*), or the first body of a contact"},
     {BAL_SEC_PROBE, "b", BAL_KEY_NAME, P(b), "", 0, 0, 0, NULL,
-     "second body of a contact (contact_*)"},
+     "second body of a contact (contact_*), or the second wall of wall_gap"},
 };
 
 const size_t bal_scene_n_keys = sizeof bal_scene_keys / sizeof bal_scene_keys[0];

@@ -234,7 +234,7 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
         struct bal_probe_def *p = &s->probes[i];
         int k = p->kind, wa = 0, wb = 0;
         int contact = bal_probe_is_contact(k);
-        int wall = k >= BAL_PROBE_WALL_F1 && k <= BAL_PROBE_WALL_ECC;
+        int wall = bal_probe_is_wall(k);
         int disc = k >= BAL_PROBE_DISC_X && k <= BAL_PROBE_DISC_OMEGA;
         if (contact || wall || disc) {
             if (!*p->a)
@@ -257,8 +257,16 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
                 return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "two walls never make a contact");
             if (strcmp(p->a, p->b) == 0)
                 return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "a body cannot touch itself");
+        } else if (k == BAL_PROBE_WALL_GAP) {
+            if (!*p->b)
+                return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "wall_gap needs a second wall in 'b'");
+            if (!body_exists(s, p->b, &wb) || !wb)
+                return FAIL_AT(p, BAL_SEC_PROBE, "b", "no wall named '%s'", p->b);
+            if (strcmp(p->a, p->b) == 0)
+                return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "the gap of a wall to itself is 0");
         } else if (*p->b) {
-            return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "only contact probes take a second body");
+            return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s",
+                           "only contact probes and wall_gap take a second body");
         }
     }
     if (s->n_discs == 0 && s->n_fills == 0 && s->n_piles == 0)

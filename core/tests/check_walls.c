@@ -538,6 +538,37 @@ START_TEST(walls_servo_column)
 }
 END_TEST
 
+/* The probes of a biaxial test's walls: P (wall_px, wall_py), the
+ * distance between two walls as the controllers measure it (wall_gap: the
+ * lid's height above the floor, 2 between the upright walls), and the
+ * stress the lid's servo measured (wall_stress; 0 on a wall no servo
+ * drives). */
+START_TEST(walls_probes)
+{
+    char text[T_TEXT_MAX];
+    column_text(text, sizeof text, "0.5",
+                "[probe px]\nquantity = wall_px\na = top\n"
+                "[probe py]\nquantity = wall_py\na = top\n"
+                "[probe width]\nquantity = wall_gap\na = left\nb = right\n"
+                "[probe height]\nquantity = wall_gap\na = top\nb = bottom\n"
+                "[probe sv]\nquantity = wall_stress\na = top\n"
+                "[probe sb]\nquantity = wall_stress\na = bottom\n");
+    struct tfx *f = tfx_new(text, "probes");
+    t_steps(f, 600);
+    const struct bal_wall *top = &f->sim->walls[1];
+    ck_assert(top->p[1] < 6.5);
+    ck_assert_double_eq(t_probe_value(f, "px"), -2.0);
+    ck_assert_double_eq(t_probe_value(f, "py"), top->p[1]);
+    /* the upright walls' e = (cos 90°, sin 90°) has a cosine of 6e-17 */
+    ck_assert_double_eq_tol(t_probe_value(f, "width"), 2.0, 1e-15);
+    ck_assert_double_eq_tol(t_probe_value(f, "height"), top->p[1], 1e-15);
+    ck_assert_double_eq(t_probe_value(f, "sv"), top->stress);
+    ck_assert_double_eq_tol(t_probe_value(f, "sv"), top->f[1] / 2, 1e-12 * top->f[1]);
+    ck_assert(top->stress > 0);
+    ck_assert_double_eq(t_probe_value(f, "sb"), 0.0);
+}
+END_TEST
+
 /* The stop rule of a consolidation: every servo wall within stop_servo of
  * its target and ΔF/F within stop_unbalanced, checked every check_every
  * cycles, all given rules together.  Each rule alone stops the column at
@@ -650,6 +681,7 @@ Suite *suite_walls(void)
     tcase_add_test(tc, walls_servo_gain);
     tcase_add_test(tc, walls_servo_empty_wall);
     tcase_add_test(tc, walls_servo_column);
+    tcase_add_test(tc, walls_probes);
     tcase_add_test(tc, walls_servo_stop_rule);
     tcase_add_test(tc, walls_strain_rate);
     suite_add_tcase(s, tc);

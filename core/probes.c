@@ -17,9 +17,9 @@
  * wall's point P; wall_gap the distance from wall a to the midpoint of wall
  * b along a's normal (walls.c, bal_walls_gap: the distance between the
  * parallel walls of a box, as the controllers measure it); wall_stress the
- * normal stress a servo measured on the wall in the last cycle (its normal
- * force over its span, compression positive; 0 when no servo drives the
- * wall).  held_fx, held_fy sum the
+ * normal stress a servo measured on the wall in the last cycle (the normal
+ * force of its contact springs over its span, compression positive: at rest
+ * the whole force; 0 when no servo drives the wall).  held_fx, held_fy sum the
  * contact forces on held discs; weight_x, weight_y the gravity on the free
  * ones (with the current ramp).
  */

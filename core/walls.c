@@ -40,7 +40,8 @@
  *                `toward` is its normal on the side of the discs' centroid
  *                when the stage begins.  In each cycle it measures
  *                  σ = −F·toward / L,  L = gap(WALL_A, WALL_B)
- *                (F the force of the discs on it; the span L is the length
+ *                (F the force of the discs' contact springs on it, without
+ *                the dashpots' share: see below; the span L is the length
  *                of specimen it bears on: the left wall's is the distance
  *                between the top and bottom walls) and moves towards the
  *                discs with the speed
@@ -70,6 +71,15 @@
  *                it.  0 < α < 2 is thus necessary, not sufficient; α ≤ 1
  *                keeps the controller itself from overshooting, and the
  *                check_walls tests hold a damped column to its closed form.
+ *                Contact dashpots answer the wall's velocity within the
+ *                cycle: c_n ṅ changes by c_n Δv, α c_n/(K Δt) = α β/Δt
+ *                times the error, 35 for JYH's stiffness with β = 2e-5 at
+ *                Δt = 2.8e-7; measured with them, the servo swings between
+ *                its caps.  So σ is the springs' force (f − dash_f), which
+ *                is the whole force once the specimen is at rest; the
+ *                dashpots then damp the wall's contacts like any other.
+ *                The energy audit prices the dashpots' loss with the wall's
+ *                centred velocity (bal_walls_control).
  *
  *   strain_rate  `strain_rate = WALL rate WALL_TO`: moves along its normal
  *                towards WALL_TO (rate > 0; away for rate < 0) at the speed
@@ -215,7 +225,10 @@ static void servo_control(struct bal_sim *s, struct bal_wall *w)
     const struct bal_move_def *mv = w->move;
     const int k = (int)(w - s->walls);
     const double span = bal_walls_gap(&s->walls[w->other[0]], &s->walls[w->other[1]], NULL);
-    const double force = -(w->f[0] * w->toward[0] + w->f[1] * w->toward[1]);
+    /* The springs' force: the dashpots' share answers the wall's velocity
+     * within the cycle (the header), and vanishes at rest. */
+    const double force = -((w->f[0] - w->dash_f[0]) * w->toward[0] +
+                           (w->f[1] - w->dash_f[1]) * w->toward[1]);
     double stiffness = 0;
     const struct bal_pairs *p = &s->pw;
     for (long c = 0; c < p->n; c++) {
@@ -354,7 +367,20 @@ void bal_walls_control(struct bal_sim *s)
         return; /* no wall of this stage changes its velocity as it goes */
     for (int k = 0; k < s->n_walls; k++) {
         struct bal_wall *w = &s->walls[k];
-        if (w->controller && w->controller->control)
-            w->controller->control(s, w);
+        if (!w->controller || !w->controller->control)
+            continue;
+        const double vx = w->v[0], vy = w->v[1], om = w->omega;
+        w->controller->control(s, w);
+        /* The energy audit prices the dashpots' loss at t_N with the discs'
+         * centred velocities (v_{N-1/2} + v_{N+1/2})/2 (energy.c); a wall's
+         * V_N is its v_{N-1/2}, the one it moved with, and the velocity just
+         * set its v_{N+1/2}.  A prescribed wall keeps its velocity, so V_N
+         * is its centred one; a wall whose velocity changes every cycle needs
+         * the mean, else the loss is off by D·ΔV Δt/2 a cycle (a servo
+         * bouncing between its caps "created" four times the energy its
+         * walls put in). */
+        if (s->dash)
+            s->audit.wall_dash += 0.5 * (w->dash_f[0] * (w->v[0] - vx) +
+                                         w->dash_f[1] * (w->v[1] - vy) + w->dash_m * (w->omega - om));
     }
 }

@@ -195,6 +195,64 @@ struct bal_pile_def {
     BAL_SECTION_TAIL;
 };
 
+/* A generator: n discs placed at random without overlap (random sequential
+ * addition, the largest first) in the rectangle from `origin` of the given
+ * size, with diameters from a grading curve given by area ("percent finer"
+ * by area in 2D): the share of the discs' area in discs of diameter <= d is
+ * 0, 0.1, 0.5, 0.6, 1 at dmin, d10, d50, d60, dmax, linear in between
+ * (specimen.c); with box = 1, four walls NAME_bottom/_right/_top/_left on
+ * the rectangle's sides, each reaching `overhang` beyond the corners. */
+struct bal_grains_def {
+    char name[BAL_NAME_MAX];
+    int line;
+    long n;               /* number of discs (required) */
+    double origin[2];     /* lower-left corner of the region (0 0) */
+    double size[2];       /* width and height of the region (required) */
+    double dmin, d10, d50, d60, dmax; /* the grading curve (required) */
+    unsigned long seed;   /* seed of GSL's gsl_rng_mt19937 (1) */
+    long tries;           /* random places tried for one disc before refusing (100000) */
+    long box;             /* 1: enclose with four walls (0) */
+    double overhang;      /* how far the box walls reach beyond the corners; -1: dmax (-1) */
+    char material[BAL_NAME_MAX];
+    char wall_material[BAL_NAME_MAX];
+    BAL_SECTION_TAIL;
+};
+
+/* Longest path of a data file a scene names. */
+#define BAL_PATH_MAX 512
+
+/* Columns of an imported disc, in struct bal_import_def's disc_data. */
+enum { BAL_IMPORT_X, BAL_IMPORT_Y, BAL_IMPORT_R, BAL_IMPORT_THETA, BAL_IMPORT_VX, BAL_IMPORT_VY,
+       BAL_IMPORT_OMEGA, BAL_IMPORT_FIXED, BAL_IMPORT_COLUMNS };
+
+/* A wall of an imported walls.tsv: its name and end points A, B. */
+struct bal_import_wall {
+    char name[BAL_NAME_MAX];
+    double a[2], b[2];
+    int row;              /* line of the data file */
+};
+
+/* A prepared state: the discs of a discs.tsv and the walls of a walls.tsv a
+ * run wrote, loaded unchanged.  The files are read when their keys are
+ * parsed (scene.c, import.c), so the scene holds their data. */
+struct bal_import_def {
+    char name[BAL_NAME_MAX];
+    int line;
+    char discs[BAL_PATH_MAX]; /* discs.tsv, relative to the scene's directory (required) */
+    char walls[BAL_PATH_MAX]; /* walls.tsv, likewise ("": no walls) */
+    char material[BAL_NAME_MAX];
+    char wall_material[BAL_NAME_MAX];
+    long velocities;      /* 1: read vx vy omega; 0: the discs start at rest (0) */
+    /* read from the files (owned by the scene, freed by bal_scene_free): */
+    long n;               /* discs */
+    int velocity_columns; /* 1: the discs.tsv has vx, vy, omega */
+    double *disc_data;    /* n x BAL_IMPORT_COLUMNS */
+    int *disc_row;        /* the data file's line of each disc */
+    int n_walls;
+    struct bal_import_wall *wall_data;
+    BAL_SECTION_TAIL;
+};
+
 /* How a stage drives a wall: its controller (walls.c), named by the stage
  * key that gives the wall's line. */
 enum bal_wall_control {
@@ -285,13 +343,16 @@ struct bal_probe_def {
 struct bal_scene {
     char path[512];                 /* file the scene came from */
     struct bal_settings settings;
-    int n_materials, n_discs, n_walls, n_fills, n_piles, n_stages, n_probes;
-    int cap_materials, cap_discs, cap_walls, cap_fills, cap_piles, cap_stages, cap_probes;
+    int n_materials, n_discs, n_walls, n_fills, n_piles, n_grains, n_imports, n_stages, n_probes;
+    int cap_materials, cap_discs, cap_walls, cap_fills, cap_piles, cap_grains, cap_imports,
+        cap_stages, cap_probes;
     struct bal_material_def *materials;
     struct bal_disc_def *discs;
     struct bal_wall_def *walls;
     struct bal_fill_def *fills;
     struct bal_pile_def *piles;
+    struct bal_grains_def *grains;
+    struct bal_import_def *imports;
     struct bal_stage_def *stages;
     struct bal_probe_def *probes;
 };

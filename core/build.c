@@ -6,8 +6,9 @@
  *              beyond BAL_MAX_DISCS, naming the generator that passes it
  *   materials  the contact parameters of every pair of materials
  *              (C&S eqs 16–19, 28)
- *   walls      [wall] sections, then four walls per boxed [fill] and a floor
- *              per smooth [pile]
+ *   walls      [wall] sections, then four walls per boxed [fill], a floor
+ *              per smooth [pile], four walls per boxed [grains] and the walls
+ *              of each [import]
  *   discs      laid out in scene order (specimen.c), sorted into cell order
  *              when the grid is used; everything derived from them checked
  *              to be a finite number
@@ -84,6 +85,16 @@ enum bal_status bal_build_settings(struct bal_sim *s, const struct bal_scene *sc
                 snprintf(where, sizeof where, "%s:%d: L: [pile %s]", sc->path,
                          sc->piles[p].key_line[bal_scene_key_index(BAL_SEC_PILE, "L")],
                          sc->piles[p].name);
+        for (int g = 0; g < sc->n_grains && seen <= BAL_MAX_DISCS; g++)
+            if ((seen += sc->grains[g].n) > BAL_MAX_DISCS)
+                snprintf(where, sizeof where, "%s:%d: n: [grains %s]", sc->path,
+                         sc->grains[g].key_line[bal_scene_key_index(BAL_SEC_GRAINS, "n")],
+                         sc->grains[g].name);
+        for (int i = 0; i < sc->n_imports && seen <= BAL_MAX_DISCS; i++)
+            if ((seen += sc->imports[i].n) > BAL_MAX_DISCS)
+                snprintf(where, sizeof where, "%s:%d: discs: [import %s]", sc->path,
+                         sc->imports[i].key_line[bal_scene_key_index(BAL_SEC_IMPORT, "discs")],
+                         sc->imports[i].name);
         return bal_error(err, BAL_EINVAL, "%s: the scene has %ld discs; at most %ld", where,
                          n_total, BAL_MAX_DISCS);
     }
@@ -157,6 +168,10 @@ enum bal_status bal_build_walls(struct bal_sim *s, struct bal_error *err)
         n_walls += sc->fills[f].box ? 4 : 0;
     for (int p = 0; p < sc->n_piles; p++)
         n_walls += sc->piles[p].bottom == 0;
+    for (int g = 0; g < sc->n_grains; g++)
+        n_walls += sc->grains[g].box ? 4 : 0;
+    for (int i = 0; i < sc->n_imports; i++)
+        n_walls += sc->imports[i].n_walls;
     s->walls = calloc((size_t)(n_walls ? n_walls : 1), sizeof *s->walls);
     if (!s->walls)
         return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
@@ -193,6 +208,35 @@ enum bal_status bal_build_walls(struct bal_sim *s, struct bal_error *err)
         snprintf(nm, sizeof nm, "%s_floor", pd->name);
         add_wall(s, nm, pd->origin[0], pd->origin[1], 0, -pd->d, (double)(pd->L + 1) * pd->d,
                  bal_scene_find(sc, BAL_SEC_MATERIAL, pd->wall_material));
+    }
+    for (int g = 0; g < sc->n_grains; g++) {
+        const struct bal_grains_def *gd = &sc->grains[g];
+        if (!gd->box)
+            continue;
+        /* The region's sides, each reaching `overhang` beyond the corners, so
+         * that a side wall that moves out leaves no gap at a corner. */
+        const int m = bal_scene_find(sc, BAL_SEC_MATERIAL, gd->wall_material);
+        const double o = gd->overhang < 0 ? gd->dmax : gd->overhang;
+        const double ox = gd->origin[0], oy = gd->origin[1], wd = gd->size[0], ht = gd->size[1];
+        char nm[2 * BAL_NAME_MAX];
+        snprintf(nm, sizeof nm, "%s_bottom", gd->name);
+        add_wall(s, nm, ox, oy, 0, -o, wd + o, m);
+        snprintf(nm, sizeof nm, "%s_right", gd->name);
+        add_wall(s, nm, ox + wd, oy, BAL_PI / 2, -o, ht + o, m);
+        snprintf(nm, sizeof nm, "%s_top", gd->name);
+        add_wall(s, nm, ox, oy + ht, 0, -o, wd + o, m);
+        snprintf(nm, sizeof nm, "%s_left", gd->name);
+        add_wall(s, nm, ox, oy, BAL_PI / 2, -o, ht + o, m);
+    }
+    for (int i = 0; i < sc->n_imports; i++) {
+        const struct bal_import_def *im = &sc->imports[i];
+        const int m = bal_scene_find(sc, BAL_SEC_MATERIAL, im->wall_material);
+        for (int k = 0; k < im->n_walls; k++) {
+            /* From A to B: P = A, h1 = 0, h2 = |B - A| (import.c). */
+            const struct bal_import_wall *w = &im->wall_data[k];
+            const double dx = w->b[0] - w->a[0], dy = w->b[1] - w->a[1];
+            add_wall(s, w->name, w->a[0], w->a[1], atan2(dy, dx), 0, hypot(dx, dy), m);
+        }
     }
     return BAL_OK;
 }

@@ -27,6 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "import.h"
 #include "scene.h"
 
 /* Longest line a scene file may hold; longer lines are refused, not cut. */
@@ -61,6 +62,12 @@ static struct section_array section_array(struct bal_scene *s,
         break;
     case BAL_SEC_PILE:
         a = (struct section_array){(void **)&s->piles, &s->n_piles, &s->cap_piles};
+        break;
+    case BAL_SEC_GRAINS:
+        a = (struct section_array){(void **)&s->grains, &s->n_grains, &s->cap_grains};
+        break;
+    case BAL_SEC_IMPORT:
+        a = (struct section_array){(void **)&s->imports, &s->n_imports, &s->cap_imports};
         break;
     case BAL_SEC_STAGE:
         a = (struct section_array){(void **)&s->stages, &s->n_stages, &s->cap_stages};
@@ -313,6 +320,61 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
             strcpy(m->walls[k], walls[k]);
         return BAL_OK;
     }
+    case BAL_KEY_FILE: {
+        /* The path as written; the file, relative to the scene's directory,
+         * is read now into the section (import.c), and only a file read
+         * whole replaces what the section held. */
+        if (!*value) { /* the default: no file */
+            *field = '\0';
+            return BAL_OK;
+        }
+        if (strlen(value) >= BAL_PATH_MAX)
+            return where_error(err, w, key->name, "%s", "expected a path of at most 511 characters");
+        char path[2 * BAL_PATH_MAX + 1];
+        const char *slash = strrchr(w.file, '/');
+        if (value[0] == '/' || !slash)
+            snprintf(path, sizeof path, "%s", value);
+        else
+            snprintf(path, sizeof path, "%.*s/%s", (int)(slash - w.file), w.file, value);
+        char msg[BAL_MSG_MAX];
+        const enum bal_status st = bal_import_read(item, key->choices, path, msg, sizeof msg);
+        if (st != BAL_OK) {
+            where_error(err, w, key->name, "%s", msg);
+            err->code = st;
+            return st;
+        }
+        strcpy(field, value);
+        return BAL_OK;
+    }
+    case BAL_KEY_FLAGS: {
+        /* "none", or words of key->choices separated by spaces: bit k for
+         * the k-th word. */
+        int bits = 0;
+        char words[LINE_MAX_CHARS];
+        snprintf(words, sizeof words, "%s", value);
+        for (char *save = NULL, *word = strtok_r(words, " \t", &save); word;
+             word = strtok_r(NULL, " \t", &save)) {
+            if (strcmp(word, "none") == 0)
+                continue;
+            int idx = 0, found = -1;
+            for (const char *c = key->choices; *c; idx++) {
+                const char *e = strchr(c, ' ');
+                const size_t len = e ? (size_t)(e - c) : strlen(c);
+                if (len == strlen(word) && strncmp(c, word, len) == 0)
+                    found = idx;
+                c += len + (e ? 1 : 0);
+            }
+            if (found < 0) {
+                char msg[BAL_MSG_MAX];
+                snprintf(msg, sizeof msg, "expected 'none' or words of {%s}, got '%s'",
+                         key->choices, word);
+                return where_error(err, w, key->name, "%s", msg);
+            }
+            bits |= 1 << found;
+        }
+        memcpy(field, &bits, sizeof bits);
+        return BAL_OK;
+    }
     }
     return where_error(err, w, key->name, "%s", "unknown key type");
 }
@@ -348,6 +410,10 @@ void bal_scene_free(struct bal_scene *s)
     free(s->walls);
     free(s->fills);
     free(s->piles);
+    free(s->grains);
+    for (int i = 0; i < s->n_imports; i++)
+        bal_import_free(&s->imports[i]);
+    free(s->imports);
     free(s->stages);
     free(s->probes);
     memset(s, 0, sizeof *s);
@@ -493,7 +559,7 @@ enum bal_status bal_scene_parse(struct bal_scene *s, const char *text,
             if (k < 0)
                 return bal_error(err, BAL_EINVAL,
                                  "%s:%d: [%s]: unknown section; expected one of settings, "
-                                 "material, disc, wall, fill, pile, stage, probe",
+                                 "material, disc, wall, fill, pile, grains, import, stage, probe",
                                  w.file, w.line, inner);
             if (bal_scene_sections[k].named && !*sec_name)
                 return bal_error(err, BAL_EINVAL, "%s:%d: [%s]: a name is required: [%s NAME]",

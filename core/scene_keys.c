@@ -35,6 +35,8 @@
 #define F(field) offsetof(struct bal_fill_def, field)
 #define G(field) offsetof(struct bal_stage_def, field)
 #define Q(field) offsetof(struct bal_pile_def, field)
+#define R(field) offsetof(struct bal_grains_def, field)
+#define I(field) offsetof(struct bal_import_def, field)
 #define P(field) offsetof(struct bal_probe_def, field)
 #define MV(field) offsetof(struct bal_move_def, field)
 
@@ -179,6 +181,50 @@ const struct bal_key bal_scene_keys[] = {
     {BAL_SEC_PILE, "wall_material", BAL_KEY_NAME, Q(wall_material), "", 0, 0, 0, NULL,
      "material of the floor (required with bottom = smooth)"},
 
+    /* [grains NAME] */
+    {BAL_SEC_GRAINS, "n", BAL_KEY_LONG, R(n), NULL, 1, 1, 100000000.0, NULL, "number of discs"},
+    {BAL_SEC_GRAINS, "origin", BAL_KEY_VEC2, R(origin), "0 0", 0, -BIG, BIG, NULL,
+     "lower-left corner of the region"},
+    {BAL_SEC_GRAINS, "size", BAL_KEY_VEC2, R(size), NULL, 1, 1e-300, BIG, NULL,
+     "width and height of the region (every disc lies inside it)"},
+    {BAL_SEC_GRAINS, "dmin", BAL_KEY_DOUBLE, R(dmin), NULL, 1, 1e-300, BIG, NULL,
+     "smallest diameter: 0 % of the discs' area is finer"},
+    {BAL_SEC_GRAINS, "d10", BAL_KEY_DOUBLE, R(d10), NULL, 1, 1e-300, BIG, NULL,
+     "diameter than which 10 % of the discs' area is finer (grading by area, linear between "
+     "the given points)"},
+    {BAL_SEC_GRAINS, "d50", BAL_KEY_DOUBLE, R(d50), NULL, 1, 1e-300, BIG, NULL,
+     "... 50 % (the median by area)"},
+    {BAL_SEC_GRAINS, "d60", BAL_KEY_DOUBLE, R(d60), NULL, 1, 1e-300, BIG, NULL,
+     "... 60 % (C_u = d60/d10)"},
+    {BAL_SEC_GRAINS, "dmax", BAL_KEY_DOUBLE, R(dmax), NULL, 1, 1e-300, BIG, NULL,
+     "largest diameter: 100 % of the area is finer"},
+    {BAL_SEC_GRAINS, "seed", BAL_KEY_LONG, R(seed), "1", 0, 0, 4294967295.0, NULL,
+     "seed of GSL's gsl_rng_mt19937 (same seed, same discs on every machine; 0 is GSL's 4357)"},
+    {BAL_SEC_GRAINS, "tries", BAL_KEY_LONG, R(tries), "100000", 0, 1, 1e7, NULL,
+     "random places tried for one disc before the generator gives up (a larger region helps)"},
+    {BAL_SEC_GRAINS, "box", BAL_KEY_LONG, R(box), "0", 0, 0, 1, NULL,
+     "1: add four walls on the region's sides (named NAME_bottom/_right/_top/_left)"},
+    {BAL_SEC_GRAINS, "overhang", BAL_KEY_DOUBLE, R(overhang), "-1", 0, -1, BIG, NULL,
+     "how far each box wall reaches beyond the corners (so the side walls can move out); "
+     "-1 = dmax"},
+    {BAL_SEC_GRAINS, "material", BAL_KEY_NAME, R(material), NULL, 1, 0, 0, NULL,
+     "material of the discs"},
+    {BAL_SEC_GRAINS, "wall_material", BAL_KEY_NAME, R(wall_material), "", 0, 0, 0, NULL,
+     "material of the box walls (required with box = 1)"},
+
+    /* [import NAME] */
+    {BAL_SEC_IMPORT, "discs", BAL_KEY_FILE, I(discs), NULL, 1, 0, 0, "discs",
+     "a discs.tsv a run wrote (columns x y r theta, and vx vy omega fixed if present), relative "
+     "to the scene's directory: its discs, in its order, named NAME.k"},
+    {BAL_SEC_IMPORT, "walls", BAL_KEY_FILE, I(walls), "", 0, 0, 0, "walls",
+     "a walls.tsv a run wrote (columns name ax ay bx by): its walls, from A to B, with their names"},
+    {BAL_SEC_IMPORT, "material", BAL_KEY_NAME, I(material), NULL, 1, 0, 0, NULL,
+     "material of the discs"},
+    {BAL_SEC_IMPORT, "wall_material", BAL_KEY_NAME, I(wall_material), "", 0, 0, 0, NULL,
+     "material of the walls (required with walls)"},
+    {BAL_SEC_IMPORT, "velocities", BAL_KEY_LONG, I(velocities), "0", 0, 0, 1, NULL,
+     "1: the discs start with the file's vx vy omega; 0: at rest"},
+
     /* [stage NAME] */
     {BAL_SEC_STAGE, "cycles", BAL_KEY_LONG, G(cycles), NULL, 1, 0, 1e15, NULL,
      "number of calculation cycles in this stage (0: the stage is skipped)"},
@@ -203,8 +249,8 @@ const struct bal_key bal_scene_keys[] = {
      "walls not named are at rest; --set replaces the named wall's motion"},
     {BAL_SEC_STAGE, "servo", BAL_KEY_CONTROL, MV(sigma), NULL, 0, -BIG, BIG,
      "WALL sigma gain vmax WALL_A WALL_B",
-     "repeatable: the wall holds the normal stress sigma (its normal force from the discs over "
-     "the distance between WALL_A and WALL_B), removing the share gain (0 < gain < 2; <= 1 "
+     "repeatable: the wall holds the normal stress sigma (the normal force of its contact springs "
+     "over the distance between WALL_A and WALL_B), removing the share gain (0 < gain < 2; <= 1 "
      "monotone) of the error per cycle, at most vmax fast (0: 1e-3 of the smallest radius per "
      "step)"},
     {BAL_SEC_STAGE, "strain_rate", BAL_KEY_CONTROL, MV(rate), NULL, 0, -BIG, BIG,
@@ -248,6 +294,10 @@ const struct bal_section_info bal_scene_sections[BAL_SEC_COUNT] = {
     {"wall", 1, SEC(bal_wall_def), "a straight rigid wall (C&S Fig. 4)"},
     {"fill", 1, SEC(bal_fill_def), "a generator of many discs on a lattice"},
     {"pile", 1, SEC(bal_pile_def), "a generator of a pile on a triangular lattice (MLH Fig. 2)"},
+    {"grains", 1, SEC(bal_grains_def),
+     "a generator of discs from a grading curve, placed at random without overlap"},
+    {"import", 1, SEC(bal_import_def),
+     "a prepared state: the discs and walls of the files a run wrote"},
     {"stage", 1, SEC(bal_stage_def), "a stage of the loading protocol, run in file order"},
     {"probe", 1, SEC(bal_probe_def), "a column of series.tsv, in file order"},
 };
@@ -297,7 +347,7 @@ const struct bal_key *bal_scene_key_at(enum bal_section_kind sec, int k)
 void bal_scene_print_keys(FILE *out)
 {
     static const char *const type_names[] = {"number", "integer", "two numbers", "name",
-                                             "word", NULL};
+                                             "word", NULL, "file", "words"};
     for (int k = 0; k < BAL_SEC_COUNT; k++) {
         const struct bal_section_info *sec = &bal_scene_sections[k];
         fprintf(out, "\n`[%s%s]` — %s\n\n", sec->name, sec->named ? " NAME" : "", sec->doc);
@@ -312,6 +362,8 @@ void bal_scene_print_keys(FILE *out)
             const char *shown = range;
             if (key->type == BAL_KEY_ENUM)
                 shown = key->choices;
+            else if (key->type == BAL_KEY_FLAGS)
+                snprintf(range, sizeof range, "none, or any of: %s", key->choices);
             else if (key->type == BAL_KEY_DOUBLE || key->type == BAL_KEY_LONG) {
                 char lo[32] = "", hi[32] = "";
                 if (key->min > -1e300)

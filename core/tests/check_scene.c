@@ -298,6 +298,15 @@ struct bad_scene {
             "[wall left]\np = -1 -2\nangle = 90\nh1 = 0\nh2 = 4\nmaterial = m\n" \
             "[wall right]\np = 1 -2\nangle = 90\nh1 = 0\nh2 = 4\nmaterial = m\n"
 #define BOX_STAGE HEAD BOX "[stage s]\ncycles = 3\n"
+/* A [grains g] section (lines 4-12 after a material of three lines): its
+ * region size, its diameters dmin d10 d50 d60 dmax (lines 8-12), as text,
+ * and more keys from line 13. */
+#define GRAINS(d, size, more) \
+    "[material m]\nkn = 1e5\ndensity = 2\n[grains g]\nsize = " size "\nn = 40\n" \
+    "material = m\n" d more
+#define D5(a, b, c, e, f) "dmin = " a "\nd10 = " b "\nd50 = " c "\nd60 = " e "\ndmax = " f "\n"
+/* An [import p] section (line 4) after a material, and its keys. */
+#define IMPORT(keys) "[material m]\nkn = 1e5\ndensity = 2\n[import p]\n" keys "material = m\n"
 
 static const struct bad_scene bad_scenes[] = {
     {"unknown key", "[material m]\nkn = 1e5\nfrction = 0.3\n", 'p',
@@ -510,6 +519,67 @@ static const struct bad_scene bad_scenes[] = {
      'v', "bad:37: b: the gap of a wall to itself is 0"},
     {"wall_stress of a disc", BOX_STAGE "[probe g]\nquantity = wall_stress\na = a\n", 'v',
      "bad:36: a: 'a' is a disc; this quantity needs a wall"},
+    /* Issue 21: the [grains] generator and [import] (data files under
+     * scenes/import/, named relative to the directory of the scene: "bad"
+     * has none, so the tests' own). */
+    {"grains with d50 < d10", GRAINS(D5("1", "2", "1.5", "3", "4"), "4 4", "") STAGE, 'v',
+     "bad:10: d50: expected dmin <= d10 <= d50 <= d60 <= dmax (the share finer by area rises "
+     "with d), got d50 = 1.5 < d10 = 2"},
+    {"grains with dmax < d60", GRAINS(D5("1", "2", "2.5", "3", "2.9"), "4 4", "") STAGE, 'v',
+     "bad:12: dmax: expected dmin <= d10"},
+    {"grains region narrower than dmax", GRAINS(D5("1", "2", "2.5", "3", "4"), "3.5 40", "") STAGE, 'v',
+     "bad:5: size: the region 3.5 x 40 must be at least dmax = 4 wide and high"},
+    {"grains box without wall material", GRAINS(D5("1", "2", "2.5", "3", "4"), "40 40", "box = 1\n") STAGE, 'v',
+     "bad:4: wall_material: required with box = 1"},
+    {"grains box wall named like a wall",
+     GRAINS(D5("1", "2", "2.5", "3", "4"), "40 40", "box = 1\nwall_material = m\n")
+     "[wall g_top]\np = 0 0\nangle = 0\nh1 = 0\nh2 = 1\nmaterial = m\n" STAGE, 'v',
+     "bad:4: [grains g]: makes a wall 'g_top', but a disc or wall has that name already"},
+    {"grains with too many discs for the region", GRAINS(D5("1", "2", "2.5", "3", "4"), "8 8", "tries = 200\n")
+     STAGE, 'c', "bad:6: n: [grains g]: placed "},
+    {"grains overhang below -1", GRAINS(D5("1", "2", "2.5", "3", "4"), "40 40", "overhang = -2\n") STAGE, 'p',
+     "bad:13: overhang: -2 is out of range"},
+    {"import of a missing file", IMPORT("discs = scenes/import/nothing.tsv\n") STAGE, 'p',
+     "bad:5: discs: scenes/import/nothing.tsv: cannot open: No such file or directory"},
+    {"import of a directory", IMPORT("discs = scenes/import\n") STAGE, 'p',
+     "bad:5: discs: scenes/import: not a regular file"},
+    {"import of a bad number", IMPORT("discs = scenes/import/bad_row.tsv\n") STAGE, 'p',
+     "bad:5: discs: scenes/import/bad_row.tsv:3: y: expected a finite number, got 'abc'"},
+    {"import without a column", IMPORT("discs = scenes/import/no_y.tsv\n") STAGE, 'p',
+     "bad:5: discs: scenes/import/no_y.tsv:1: no column 'y' in the header"},
+    {"import of a short row", IMPORT("discs = scenes/import/short_row.tsv\n") STAGE, 'p',
+     "bad:5: discs: scenes/import/short_row.tsv:2: expected 6 columns as in the header, got 5"},
+    {"import of a negative radius", IMPORT("discs = scenes/import/negative_r.tsv\n") STAGE, 'p',
+     "bad:5: discs: scenes/import/negative_r.tsv:2: r: expected a radius > 0, got -0.25"},
+    {"import of no disc", IMPORT("discs = scenes/import/header_only.tsv\n") STAGE, 'p',
+     "bad:5: discs: scenes/import/header_only.tsv:1: no disc rows after the header"},
+    {"import without its discs", IMPORT("walls = scenes/import/walls.tsv\nwall_material = m\n")
+     STAGE, 'v', "bad:4: [import p]: discs: required key is missing"},
+    {"import of velocities the file lacks",
+     IMPORT("discs = scenes/import/no_velocities.tsv\nvelocities = 1\n") STAGE, 'v',
+     "bad:6: velocities: the discs file scenes/import/no_velocities.tsv has no columns vx, vy, "
+     "omega"},
+    {"import of walls without their material",
+     IMPORT("discs = scenes/import/discs.tsv\nwalls = scenes/import/walls.tsv\n") STAGE, 'v',
+     "bad:4: wall_material: required with walls"},
+    {"import of a wall named twice",
+     IMPORT("discs = scenes/import/discs.tsv\nwalls = scenes/import/walls_twice.tsv\n") STAGE,
+     'p', "bad:6: walls: scenes/import/walls_twice.tsv:3: name: wall 'floor' is also on line 2"},
+    {"import of walls without a column",
+     IMPORT("discs = scenes/import/discs.tsv\nwalls = scenes/import/walls_no_by.tsv\n") STAGE,
+     'p', "bad:6: walls: scenes/import/walls_no_by.tsv:1: no column 'by'"},
+    {"import of a wall of no length",
+     IMPORT("discs = scenes/import/discs.tsv\nwalls = scenes/import/walls_no_length.tsv\n") STAGE,
+     'p', "bad:6: walls: scenes/import/walls_no_length.tsv:2: bx: the wall 'floor' has A = B"},
+    {"import of a wall named like a wall",
+     IMPORT("discs = scenes/import/discs.tsv\nwalls = scenes/import/walls.tsv\n"
+            "wall_material = m\n")
+     "[wall roof]\np = 0 0\nangle = 0\nh1 = 0\nh2 = 1\nmaterial = m\n" STAGE, 'v',
+     "bad:4: [import p]: makes a wall 'roof', but a disc or wall has that name already"},
+    {"import of discs onto a wall",
+     IMPORT("discs = scenes/import/discs.tsv\n")
+     "[wall w]\np = 0 0.4\nangle = 0\nh1 = 0\nh2 = 1\nmaterial = m\n" STAGE, 'c',
+     "bad:5: discs: disc p.0 of [import p] (line 2 of scenes/import/discs.tsv): overlaps wall w"},
     {"stop_servo out of range", BOX_STAGE "stop_servo = -0.01\n", 'p',
      "bad:34: stop_servo: -0.01 is out of range"},
     {"stop_unbalanced out of range", BOX_STAGE "stop_unbalanced = -1\n", 'p',

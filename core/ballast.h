@@ -143,8 +143,16 @@ struct bal_disc_def {
     double omega;         /* angular velocity, rad/time (0) */
     char material[BAL_NAME_MAX];
     long fixed;           /* 1: held in place (velocity stays zero) (0) */
+    int hold;             /* BAL_HOLD_* bits: components of the motion held at zero (none);
+                           * all three are fixed = 1 */
     BAL_SECTION_TAIL;
 };
+
+/* The components of a disc's motion `hold` can keep at zero. */
+#define BAL_HOLD_X 1u         /* v_x: x stays */
+#define BAL_HOLD_Y 2u         /* v_y: y stays */
+#define BAL_HOLD_ROTATION 4u  /* ω: θ stays */
+#define BAL_HOLD_ALL 7u
 
 struct bal_wall_def {
     char name[BAL_NAME_MAX];

@@ -327,6 +327,10 @@ enum bal_status bal_build_discs(struct bal_sim *s, struct bal_error *err)
     s->slot = calloc((size_t)(n ? n : 1), sizeof *s->slot);
     s->mat = calloc((size_t)(n ? n : 1), sizeof *s->mat);
     s->fixed = calloc((size_t)(n ? n : 1), sizeof *s->fixed);
+    int partly_held = 0;
+    for (int i = 0; i < n; i++)
+        partly_held |= d.hold[i] != 0;
+    s->hold = partly_held ? calloc((size_t)n, sizeof *s->hold) : NULL;
     s->grid.cell = calloc((size_t)(n ? n : 1), sizeof *s->grid.cell);
     s->grid.list = calloc((size_t)(n ? n : 1), sizeof *s->grid.list);
     s->row = sc->n_piles ? calloc((size_t)(n ? n : 1), sizeof *s->row) : NULL;
@@ -336,7 +340,8 @@ enum bal_status bal_build_discs(struct bal_sim *s, struct bal_error *err)
     s->moment = stress_rule ? calloc((size_t)(4 * n + 4), sizeof *s->moment) : NULL;
     s->moment_prev = stress_rule ? calloc((size_t)(4 * n + 4), sizeof *s->moment_prev) : NULL;
     s->new2old = calloc((size_t)(n ? n : 1), sizeof *s->new2old);
-    if (!ok || !s->id || !s->slot || !s->mat || !s->fixed || !s->grid.cell || !s->grid.list ||
+    if (!ok || !s->id || !s->slot || !s->mat || !s->fixed || (partly_held && !s->hold) ||
+        !s->grid.cell || !s->grid.list ||
         (sc->n_piles && !s->row) || (stress_rule && (!s->moment || !s->moment_prev)) || !s->new2old) {
         bal_specimen_free(&d);
         return bal_error(err, BAL_ENOMEM, "%s: out of memory for %d discs", sc->path, n);
@@ -365,6 +370,8 @@ enum bal_status bal_build_discs(struct bal_sim *s, struct bal_error *err)
         s->w[i] = d.w[k];
         s->mat[i] = d.mat[k];
         s->fixed[i] = d.fixed[k];
+        if (s->hold)
+            s->hold[i] = d.hold[k];
         if (s->row)
             s->row[i] = d.row[k];
         s->inv_m[i] = 1 / bal_mass(s, i);
@@ -397,7 +404,7 @@ static double start_energy(const struct bal_sim *s, const struct bal_scene *sc)
     double e = 0, px = 0, py = 0, m = 0;
     int held = 0;
     for (int i = 0; i < s->n; i++) {
-        held |= s->fixed[i];
+        held |= s->fixed[i] || (s->hold && s->hold[i]);
         if (s->fixed[i])
             continue;
         const double mi = bal_mass(s, i);
@@ -407,8 +414,9 @@ static double start_energy(const struct bal_sim *s, const struct bal_scene *sc)
         py += mi * s->vy[i];
         m += mi;
     }
-    /* Without walls or held discs the momentum is conserved: the motion of
-     * the centre of mass can never go into a contact. */
+    /* Without walls or held discs (partly held ones included) the momentum
+     * is conserved: the motion of the centre of mass can never go into a
+     * contact. */
     if (!held && s->n_walls == 0 && m > 0)
         e -= 0.5 * (px * px + py * py) / m;
     return e > 0 ? e : 0;

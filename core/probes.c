@@ -20,8 +20,9 @@
  * normal stress a servo measured on the wall in the last cycle (the normal
  * force of its contact springs over its span, compression positive: at rest
  * the whole force; 0 when no servo drives the wall).  held_fx, held_fy sum the
- * contact forces on held discs; weight_x, weight_y the gravity on the free
- * ones (with the current ramp).
+ * contact forces on the discs held along the axis (fixed = 1, or a `hold`
+ * with x or y); weight_x, weight_y the gravity on the discs free along it
+ * (with the current ramp).
  */
 #include <math.h>
 
@@ -146,18 +147,23 @@ double bal_probes_value(const struct bal_sim *s, int probe)
         return (double)count_contacts(s, BAL_PAIR_SLIDING);
     case BAL_PROBE_HELD_FX:
     case BAL_PROBE_HELD_FY: {
+        /* the discs held along the axis: fixed ones, and partly held ones
+         * whose hold includes it */
         double f = 0;
         const int k = p->kind == BAL_PROBE_HELD_FX ? 0 : 1;
+        const unsigned axis = k == 0 ? BAL_HOLD_X : BAL_HOLD_Y;
         for (int i = 0; i < s->n; i++)
-            if (s->fixed[i])
+            if (s->fixed[i] || (s->hold && (s->hold[i] & axis)))
                 f += s->f[3 * i + k];
         return f;
     }
     case BAL_PROBE_WEIGHT_X:
     case BAL_PROBE_WEIGHT_Y: {
+        /* the discs free along the axis */
         double m = 0;
+        const unsigned axis = p->kind == BAL_PROBE_WEIGHT_X ? BAL_HOLD_X : BAL_HOLD_Y;
         for (int i = 0; i < s->n; i++)
-            if (!s->fixed[i])
+            if (!s->fixed[i] && !(s->hold && (s->hold[i] & axis)))
                 m += bal_mass(s, i);
         return m * s->g[p->kind == BAL_PROBE_WEIGHT_X ? 0 : 1] * s->gfac;
     }

@@ -128,6 +128,9 @@ const struct bal_key bal_scene_keys[] = {
      "initial angular velocity, rad/time, counter-clockwise"},
     {BAL_SEC_DISC, "fixed", BAL_KEY_LONG, D(fixed), "0", 0, 0, 1, NULL,
      "1: the disc is held (its velocity stays zero; it still feels forces)"},
+    {BAL_SEC_DISC, "hold", BAL_KEY_FLAGS, D(hold), NULL, 0, 0, 0, "x y rotation",
+     "components of the disc's motion held at zero, e.g. 'x rotation' (all three: fixed = 1); "
+     "the held coordinates stay, the others move (docs/physics.md)"},
 
     /* [wall NAME] */
     {BAL_SEC_WALL, "p", BAL_KEY_VEC2, W(p), NULL, 1, -BIG, BIG, NULL,

@@ -205,6 +205,11 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
         if (d->fixed && (d->v[0] != 0 || d->v[1] != 0 || d->omega != 0))
             return FAIL_AT(d, BAL_SEC_DISC, "fixed", "%s",
                            "a held disc cannot have a velocity (v and omega must be 0)");
+        if (((d->hold & BAL_HOLD_X) && d->v[0] != 0) || ((d->hold & BAL_HOLD_Y) && d->v[1] != 0) ||
+            ((d->hold & BAL_HOLD_ROTATION) && d->omega != 0))
+            return FAIL_AT(d, BAL_SEC_DISC, "hold", "%s",
+                           "a held component cannot have a velocity (v1 with x, v2 with y, omega "
+                           "with rotation must be 0)");
     }
     for (int i = 0; i < s->n_walls; i++) {
         struct bal_wall_def *w = &s->walls[i];

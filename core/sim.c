@@ -102,6 +102,7 @@ void bal_sim_free(struct bal_sim *s)
     free(s->slot);
     free(s->mat);
     free(s->fixed);
+    free(s->hold);
     free(s->walls);
     free(s->law);
     free(s->probes);
@@ -412,6 +413,8 @@ void bal_sim_memory(const struct bal_sim *s, double *disc_bytes, double *pair_by
     const double n = s->n;
     /* 14 double columns, id, slot, mat, fixed, grid cell and list, new2old */
     double d = n * (14 * sizeof(double) + 3 * sizeof(int32_t) + 1 + 3 * sizeof(int32_t));
+    if (s->hold)
+        d += n * sizeof *s->hold;
     if (s->row)
         d += n * sizeof *s->row;
     if (s->moment)

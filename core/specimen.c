@@ -134,7 +134,11 @@ static int lay_discs(const struct bal_scene *sc, struct bal_specimen *d, int k)
         d->th[k] = dd->theta * (BAL_PI / 180);
         d->w[k] = dd->omega;
         d->mat[k] = bal_scene_find(sc, BAL_SEC_MATERIAL, dd->material);
-        d->fixed[k] = (uint8_t)(dd->fixed != 0);
+        /* Holding every component is holding the disc: fixed = 1, with
+         * everything that goes with it (no pair of held discs, no weight). */
+        const unsigned hold = (unsigned)dd->hold & BAL_HOLD_ALL;
+        d->fixed[k] = (uint8_t)(dd->fixed != 0 || hold == BAL_HOLD_ALL);
+        d->hold[k] = (uint8_t)(d->fixed[k] ? 0 : hold);
     }
     return k;
 }
@@ -401,8 +405,9 @@ enum bal_status bal_specimen_generate(const struct bal_scene *sc, int n, struct 
     d->w = alloc_doubles((size_t)n, &ok);
     d->mat = calloc((size_t)(n ? n : 1), sizeof *d->mat);
     d->fixed = calloc((size_t)(n ? n : 1), sizeof *d->fixed);
+    d->hold = calloc((size_t)(n ? n : 1), sizeof *d->hold);
     d->row = malloc((size_t)(n ? n : 1) * sizeof *d->row);
-    if (!ok || !d->mat || !d->fixed || !d->row)
+    if (!ok || !d->mat || !d->fixed || !d->hold || !d->row)
         return bal_error(err, BAL_ENOMEM, "%s: out of memory for %d discs", sc->path, n);
     for (int i = 0; i < n; i++)
         d->row[i] = -1;
@@ -436,6 +441,7 @@ void bal_specimen_free(struct bal_specimen *d)
     free(d->w);
     free(d->mat);
     free(d->fixed);
+    free(d->hold);
     free(d->row);
 }
 

@@ -20,6 +20,7 @@ struct bal_specimen {
     double *x, *y, *r, *vx, *vy, *th, *w;
     int32_t *mat;                /* material index in the scene */
     uint8_t *fixed;              /* 1: held */
+    uint8_t *hold;               /* BAL_HOLD_* bits of a partly held disc, else 0 */
     int32_t *row;                /* row M of a pile disc, -1 otherwise */
 };
 

@@ -246,7 +246,10 @@ struct bal_sim {
                                   * pair loop of a large packing reads fewer streams) */
     double *x_ref, *y_ref;       /* positions at the last rebuild */
     int32_t *mat;
-    uint8_t *fixed;
+    uint8_t *fixed;              /* 1: held (every component of its motion) */
+    uint8_t *hold;               /* BAL_HOLD_* bits of the components held at zero of a partly
+                                  * held disc (0 for the others); NULL when no disc is partly
+                                  * held, so the passes of other scenes test nothing */
     double r_max, r_min;         /* largest and smallest radius */
 
     /* walls */

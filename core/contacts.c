@@ -516,6 +516,9 @@ void bal_contacts_walls(struct bal_sim *s)
     }
     double lost_fric = 0, lost_roll = 0, wall_dash = 0;
     const int roll = p->rolling;
+    /* the dashpots' resultant per wall, for walls whose controller sets
+     * their velocity every cycle (walls.c); not kept otherwise */
+    const int track_dash = s->walls_controlled != 0;
     for (long c = 0; c < p->n; c++) {
         const int i = p->i[c];
         struct bal_wall *W = &s->walls[p->j[c]];
@@ -591,10 +594,12 @@ void bal_contacts_walls(struct bal_sim *s)
                 wall_dash += md * W->omega;
             /* ... and their resultant on the wall, for a controller that
              * changes the wall's velocity (walls.c, bal_walls_control) */
-            const double dfx = dn * ex + ds * tx, dfy = dn * ey + ds * ty;
-            W->dash_f[0] += dfx;
-            W->dash_f[1] += dfy;
-            W->dash_m += (cx - W->p[0]) * dfy - (cy - W->p[1]) * dfx + (roll ? md : 0);
+            if (track_dash) {
+                const double dfx = dn * ex + ds * tx, dfy = dn * ey + ds * ty;
+                W->dash_f[0] += dfx;
+                W->dash_f[1] += dfy;
+                W->dash_m += (cx - W->p[0]) * dfy - (cy - W->p[1]) * dfx + (roll ? md : 0);
+            }
         }
         p->fn[c] = fn;
         p->fs[c] = fs;

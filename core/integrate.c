@@ -173,10 +173,11 @@ static struct bal_moves centred_positions(struct bal_sim *s)
 }
 
 /* A partly held disc's held components were zero in the last cycle too
- * (the force on them went into the hold, not into a velocity). */
+ * (the force on them went into the hold, not into a velocity): the
+ * `previous` of a scene with partly held discs (integrators_held below). */
 static inline void zero_held(const struct bal_sim *s, int i, double *vx, double *vy, double *w)
 {
-    const unsigned h = s->hold ? s->hold[i] : 0;
+    const unsigned h = s->hold[i];
     if (h & BAL_HOLD_X)
         *vx = 0;
     if (h & BAL_HOLD_Y)
@@ -199,13 +200,11 @@ static void centred_previous(const struct bal_sim *s, int i, double *vx, double 
         *vx = s->vx[i] - ax;
         *vy = s->vy[i] - ay;
         *w = s->w[i] - aw;
-        zero_held(s, i, vx, vy, w);
         return;
     }
     *vx = (s->vx[i] * (1 + half) - ax) / (1 - half);
     *vy = (s->vy[i] * (1 + half) - ay) / (1 - half);
     *w = (s->w[i] * (1 + half) - aw) / (1 - half);
-    zero_held(s, i, vx, vy, w);
 }
 
 
@@ -412,7 +411,6 @@ static void verlet_previous(const struct bal_sim *s, int i, double *vx, double *
     *vx = s->vx[i] * undo - (s->f[3 * i] * s->inv_m[i] + s->g[0] * s->gfac) * hdt;
     *vy = s->vy[i] * undo - (s->f[3 * i + 1] * s->inv_m[i] + s->g[1] * s->gfac) * hdt;
     *w = s->w[i] * undo - s->f[3 * i + 2] * s->inv_i[i] * hdt;
-    zero_held(s, i, vx, vy, w);
 }
 
 /* ------------------------------------------------------------------ */
@@ -568,6 +566,30 @@ static const struct bal_integrator_type integrators[] = {
     [BAL_INTEGRATOR_GEAR5] = {"gear5", gear_positions, gear_velocities, gear_previous, 0},
 };
 
+/* With partly held discs: the velocities the contact law read are zero in
+ * the held components (centred and verlet recover them by inverting the
+ * last update, which the hold overrode; gear5 stores them, zero).  A table
+ * of its own, so that the reports of other scenes test nothing. */
+static void centred_previous_held(const struct bal_sim *s, int i, double *vx, double *vy, double *w)
+{
+    centred_previous(s, i, vx, vy, w);
+    zero_held(s, i, vx, vy, w);
+}
+
+static void verlet_previous_held(const struct bal_sim *s, int i, double *vx, double *vy, double *w)
+{
+    verlet_previous(s, i, vx, vy, w);
+    zero_held(s, i, vx, vy, w);
+}
+
+static const struct bal_integrator_type integrators_held[] = {
+    [BAL_INTEGRATOR_CENTRED] = {"centred", centred_positions, centred_velocities,
+                                centred_previous_held, 1},
+    [BAL_INTEGRATOR_VERLET] = {"verlet", verlet_positions, verlet_velocities,
+                               verlet_previous_held, 0},
+    [BAL_INTEGRATOR_GEAR5] = {"gear5", gear_positions, gear_velocities, gear_previous, 0},
+};
+
 struct bal_moves bal_integrate_positions(struct bal_sim *s) { return s->integ->positions(s); }
 
 void bal_integrate_velocities(struct bal_sim *s) { s->integ->velocities(s); }
@@ -580,7 +602,9 @@ void bal_integrate_previous(const struct bal_sim *s, int i, double *vx, double *
 enum bal_status bal_integrate_setup(struct bal_sim *s, struct bal_error *err)
 {
     const int which = s->scene->settings.integrator;
-    s->integ = &integrators[which >= 0 && which <= BAL_INTEGRATOR_GEAR5 ? which : 0];
+    s->integ = &(s->hold ? integrators_held : integrators)[which >= 0 && which <= BAL_INTEGRATOR_GEAR5
+                                                                  ? which
+                                                                  : 0];
     s->par.block_sums = calloc(2 * (size_t)bal_disc_blocks(s->n), sizeof(double));
     if (!s->par.block_sums)
         return bal_error(err, BAL_ENOMEM, "%s: out of memory (%d discs)", s->scene->path, s->n);

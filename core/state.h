@@ -98,7 +98,8 @@ struct bal_wall {
     double fn_sum;         /* Σ F_n over its contacts */
     double fn_s_sum;       /* Σ F_n s, s = position of the contact along e from P */
     double dash_f[2], dash_m; /* the contact dashpots' share of f and of the moment about P
-                            * (only in scenes with damping) */
+                            * (only in damped scenes, and in stages with a controller
+                            * acting every cycle: contacts.c) */
     double disp;           /* largest displacement of any of its points since rebuild */
     double f_prev[2], moment_prev; /* f and moment of the cycle before (energy audit) */
 };

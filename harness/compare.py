@@ -137,18 +137,37 @@ def _unknown_name(name, is_call, names):
     return f"column '{name}' missing from series.tsv (columns: {columns})"
 
 
-def evaluate(expr, run, sibling=None):
-    """The expression's value in run's outputs, as one finite float."""
+def _value(expr, run, sibling=None):
+    """The expression's value in run's outputs, whatever it is."""
     names = namespace(run, sibling)
     code = _compile(expr, names, run.columns)
     try:
         with np.errstate(all="ignore"):
-            result = eval(code, {**names, "__builtins__": {}})  # noqa: S307 -- no builtins, vetted names
+            return eval(code, {**names, "__builtins__": {}})  # noqa: S307 -- no builtins, vetted names
     except EvalError:
         raise
     except Exception as exc:  # any failure of the expression is a FAIL with its reason
         raise EvalError(f"'{expr}' raised {type(exc).__name__}: {exc}") from None
-    return _finite_scalar(result, expr)
+
+
+def evaluate(expr, run, sibling=None):
+    """The expression's value in run's outputs, as one finite float."""
+    return _finite_scalar(_value(expr, run, sibling), expr)
+
+
+def evaluate_array(expr, run, sibling=None):
+    """The expression's value in run's outputs as a 1-d float array (a figure's curve, e.g.
+    100 * axial_strain()); a number is an array of one.  Non-finite elements are kept: the
+    caller says what it does with them."""
+    result = _value(expr, run, sibling)
+    try:
+        arr = np.atleast_1d(np.asarray(result, dtype=float))
+    except (TypeError, ValueError):
+        raise EvalError(f"'{expr}' is not a number or an array of numbers: {result!r}") from None
+    if arr.ndim != 1 or arr.size == 0:
+        raise EvalError(f"'{expr}' gives {'no values' if arr.size == 0 else f'an array of shape {arr.shape}'}, "
+                        "not a row of numbers")
+    return arr
 
 
 def _finite_scalar(result, expr):

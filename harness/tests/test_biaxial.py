@@ -4,13 +4,16 @@ mobilised, peak and residual friction angles, the envelope's slope and intercept
 clear EvalErrors of what cannot be evaluated."""
 import json
 import math
+import shutil
 
 import numpy as np
 import pytest
 
-from harness.compare import RunStore, evaluate, folder_locator
-from harness.errors import EvalError
+from harness import catalogue, report
+from harness.compare import RunStore, evaluate, evaluate_array, folder_locator
+from harness.errors import EvalError, IniError
 from harness.families import biaxial
+from harness.report import plots
 from harness.tests import biaxial_fakes as fake
 
 CASE = "biax"
@@ -324,3 +327,247 @@ def test_setting_reads_the_runs_overrides(tmp_path):
     with pytest.raises(EvalError, match="--set x=y is not a number"):
         evaluate("setting('x')", run)
     assert json.loads((tmp_path / CASE / "v" / "run.json").read_text())["sets"][0] == "material.grain.delta=0.4"
+
+
+# ---------------------------------------------------------------- figures: JYH Figs 11-13
+
+needs_gnuplot = pytest.mark.skipif(not shutil.which("gnuplot"), reason="gnuplot not installed")
+
+DELTAS, SEEDS, KPA = (0.0, 0.4, 1.6), (1, 2), (100, 200, 400)
+
+
+def peak_sine(delta, seed):
+    """The synthetic material's sin phi at the peak: 0.4 + 0.1 delta, seed 1 0.005 below, seed 2 above."""
+    return 0.4 + 0.1 * delta + (0.005 if seed == 2 else -0.005)
+
+
+def residual_sine(delta, seed):
+    return 0.3 + 0.1 * delta + (0.005 if seed == 2 else -0.005)
+
+
+def name(delta, kpa, seed):
+    return f"m1_d{delta}_s{kpa}_r{seed}"
+
+
+NAMES = [name(d, k, r) for d in DELTAS for r in SEEDS for k in KPA]
+FIGURE_CASE = "[case biax]\ntier = full\ntitle = t\nchecks = c\nruntime = 1\n" + "".join(
+    f"\n[variant {v}]\nscene = biaxial.scene\n" for v in NAMES + ["unrun_s100"])
+
+FIG11 = """
+[figure fig11a]
+kind = curves
+variants = m1_d0.0_s200_r1 m1_d1.6_s200_r1
+x = 100 * axial_strain()
+y = (sigma_v() - sigma_h()) / 2 / 1000
+xlabel = axial strain (%)
+ylabel = (sigma_v - sigma_h)/2 (kPa)
+paper = "deviatoric stress (sigma_v - sigma_h)/2 against axial strain" (JYH 2005, Fig. 11(a))
+"""
+
+FIG12 = """
+[figure fig12]
+kind = fit
+group = no rolling; m1_d0.0_s100_r1 m1_d0.0_s200_r1 m1_d0.0_s400_r1
+group = Model 1, delta 1.6; m1_d1.6_s100_r1 m1_d1.6_s200_r1 m1_d1.6_s400_r1
+x = peak; at_peak(mean_stress()) / 1000
+y = peak; at_peak(deviator()) / 1000
+x = residual; window_mean(mean_stress(), 0.1, 0.19) / 1000
+y = residual; window_mean(deviator(), 0.1, 0.19) / 1000
+slope = asin
+xlabel = (sigma_v + sigma_h)/2 (kPa)
+ylabel = (sigma_v - sigma_h)/2 (kPa)
+"""
+
+FIG13 = """
+[figure fig13]
+kind = errorbars
+variants = """ + " ".join(name(d, 100, r) for d in DELTAS for r in SEEDS) + """
+x = setting('material.grain.delta')
+y = ballast peak; phi_envelope('peak', '_s100', '_s200', '_s400')
+y = ballast residual; phi_envelope('residual', '_s100', '_s200', '_s400', lo=0.1, hi=0.19)
+paper_point = 0 24.4 JYH 2005
+paper_point = 0 19.3 JYH 2005
+paper_point = 1.6 42.3 JYH 2005
+paper_point = 1.6 35.8 JYH 2005
+paper_point = 0.4 26.5 JYH 2005, Model 2
+xlabel = delta
+ylabel = phi (degrees)
+"""
+
+
+@pytest.fixture
+def figure_store(tmp_path):
+    """Model 1 materials delta = 0, 0.4, 1.6 with seeds 1 and 2 at 100, 200 and 400 kPa: peaks on
+    t = peak_sine s, residuals on t = residual_sine s (no cohesion); setting() gives delta."""
+    for delta in DELTAS:
+        for seed in SEEDS:
+            for kpa in KPA:
+                sh = kpa * 1e3
+                fake.write_biaxial_run(tmp_path / "runs" / "biax" / name(delta, kpa, seed), sh,
+                                       fake.on_line(sh, peak_sine(delta, seed), 0),
+                                       fake.on_line(sh, residual_sine(delta, seed), 0),
+                                       info={"sets": [f"material.grain.delta={delta}"]})
+    return RunStore(folder_locator(tmp_path / "runs"))
+
+
+def load_case(tmp_path, figures):
+    folder = tmp_path / "cases" / "biaxial"
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "case.txt").write_text(FIGURE_CASE + figures)
+    return catalogue.load(tmp_path / "cases")[0]
+
+
+def script_data(tmp_path, store, figures, kind_script):
+    """Run a figure's script maker in a scratch folder: (script, notes, {data file: rows})."""
+    case = load_case(tmp_path, figures)
+    work = tmp_path / "work"
+    work.mkdir(exist_ok=True)
+    text, notes = kind_script(case, case.figures[0], store, work, work / "f.png", work / "f.svg")
+    data = {p.name: np.loadtxt(p, ndmin=2) for p in sorted(work.glob("*.dat"))}
+    return text, notes, data
+
+
+def test_a_curve_is_an_array_expression(store):
+    run = store.get(CASE, "m0_s100")
+    assert evaluate_array("100 * axial_strain()", run).shape == (201,)
+    assert evaluate_array("phi_peak()", run).shape == (1,)
+    with pytest.raises(EvalError, match="'sigma_v\\(\\)\\[:0\\]' gives no values, not a row of numbers"):
+        evaluate_array("sigma_v()[:0]", run)
+    with pytest.raises(EvalError, match="gives an array of shape \\(2, 201\\), not a row of numbers"):
+        evaluate_array("[phi(), phi()]", run)
+    with pytest.raises(EvalError, match="is not a number or an array of numbers: 'x'"):
+        evaluate_array("'x'", run)
+
+
+def test_the_new_figure_kinds_are_read(tmp_path):
+    case = load_case(tmp_path, FIG11 + FIG12 + FIG13)
+    curves, fit, bars = case.figures
+    assert (curves.kind, curves.x, curves.y, curves.labels) == (
+        "curves", "100 * axial_strain()", ["(sigma_v() - sigma_h()) / 2 / 1000"], ["(sigma_v() - sigma_h()) / 2 / 1000"])
+    assert (curves.xlabel, curves.ylabel) == ("axial strain (%)", "(sigma_v - sigma_h)/2 (kPa)")
+    assert fit.groups[1] == ("Model 1, delta 1.6", ["m1_d1.6_s100_r1", "m1_d1.6_s200_r1", "m1_d1.6_s400_r1"])
+    assert fit.labels == ["peak", "residual"] and fit.xs[1] == "window_mean(mean_stress(), 0.1, 0.19) / 1000"
+    assert fit.slope == "asin" and fit.variants == [name(d, k, 1) for d in (0.0, 1.6) for k in KPA]
+    assert bars.labels == ["ballast peak", "ballast residual"] and len(bars.variants) == 6
+    assert bars.paper_points[-1] == (0.4, 26.5, "JYH 2005, Model 2")
+
+
+@pytest.mark.parametrize("figure, words", [
+    ("[figure f]\nkind = fit\nvariants = m1_d0.0_s100_r1\ngroup = a; m1_d0.0_s100_r1 m1_d0.0_s200_r1\nx = 1\ny = 2\n",
+     "'variants' does not apply to a fit figure"),
+    ("[figure f]\nkind = fit\ngroup = a; m1_d0.0_s100_r1\nx = 1\ny = 2\n",
+     "'group' must be 'LABEL; VARIANT VARIANT ...' (two or more variants)"),
+    ("[figure f]\nkind = fit\ngroup = m1_d0.0_s100_r1 m1_d0.0_s200_r1\nx = 1\ny = 2\n", "'group' must be 'LABEL;"),
+    ("[figure f]\nkind = fit\nx = 1\ny = 2\n", "needs 'group = LABEL; VARIANT VARIANT ...'"),
+    ("[figure f]\nkind = fit\ngroup = a; m1_d0.0_s100_r1 nope\nx = 1\ny = 2\n", "names unknown variant 'nope'"),
+    ("[figure f]\nkind = fit\ngroup = a; m1_d0.0_s100_r1 m1_d0.0_s200_r1\nx = 1\ny = 2\ny = 3\n",
+     "a fit figure pairs each 'x' with a 'y': it has 1 x and 2 y"),
+    ("[figure f]\nkind = fit\ngroup = a; m1_d0.0_s100_r1 m1_d0.0_s200_r1\nx = 1\ny = 2\nslope = atan\n",
+     "'slope' must be one of number, asin, not 'atan'"),
+    ("[figure f]\nkind = curves\nx = axial_strain()\n", "needs 'y = [LABEL;] EXPR'"),
+    ("[figure f]\nkind = curves\nx = axial_strain()\ny = a; phi(\n", "'y' is not an expression"),
+    ("[figure f]\nkind = curves\nx = axial_strain()\ny = a;\n", "'y' is empty"),
+    ("[figure f]\nkind = curves\nx = axial_strain()\ny = phi()\nslope = asin\n", "'slope' does not apply to a curves"),
+    ("[figure f]\nkind = errorbars\nx = 1\ny = 2\npaper_point = 0 24.4\n", "'paper_point' must be 'X Y LABEL'"),
+    ("[figure f]\nkind = errorbars\nx = 1\ny = 2\npaper_point = zero 24.4 JYH\n", "'paper_point' must be 'X Y LABEL'"),
+    ("[figure f]\nkind = errorbars\ny = 2\n", "needs 'x = ...'"),
+])
+def test_bad_new_figures_are_refused(tmp_path, figure, words):
+    with pytest.raises(IniError) as caught:
+        load_case(tmp_path, "\n" + figure)
+    assert "case.txt:" in str(caught.value) and words in str(caught.value), str(caught.value)
+
+
+def test_fig11_curves_draw_the_deviator_against_the_axial_strain_in_kpa_and_percent(tmp_path, figure_store):
+    text, notes, data = script_data(tmp_path, figure_store, FIG11, plots._curves_script)
+    assert notes == [] and sorted(data) == ["m1_d0.0_s200_r1_0.dat", "m1_d1.6_s200_r1_0.dat"]
+    rows = data["m1_d1.6_s200_r1_0.dat"]
+    t_peak = fake.on_line(200e3, peak_sine(1.6, 1), 0)
+    assert rows[0] == pytest.approx([0, 0], abs=1e-9) and rows[-1, 0] == pytest.approx(20.0)
+    assert rows[:, 1].max() == pytest.approx(t_peak / 1000) and rows[30] == pytest.approx([3.0, t_peak / 1000])
+    assert "title 'm1_d1.6_s200_r1'" in text and "set xlabel 'axial strain (%)'" in text
+
+
+def test_fig11_curves_note_what_they_cannot_draw(tmp_path, figure_store):
+    figure = FIG11.replace("variants = m1_d0.0_s200_r1", "variants = unrun_s100 m1_d0.0_s200_r1").replace(
+        "y = (sigma_v()", "y = eps; 100 * volumetric_strain()\ny = bad; phi()[:3]\ny = (sigma_v()")
+    text, notes, data = script_data(tmp_path, figure_store, figure, plots._curves_script)
+    assert notes[0].startswith("unrun_s100: not drawn: run output missing")
+    assert notes[1:] == [f"{v}: bad: not drawn: 3 values against 201 of x" for v in ("m1_d0.0_s200_r1", "m1_d1.6_s200_r1")]
+    assert len(data) == 4 and text.count("with lines title") == 4
+
+
+def test_fig12_fit_draws_points_and_envelopes_with_their_angle(tmp_path, figure_store):
+    text, notes, data = script_data(tmp_path, figure_store, FIG12, plots._fit_script)
+    assert notes == []
+    points, line = data["fit_1_0.dat"], data["line_1_0.dat"]                 # Model 1, delta 1.6, peak
+    sine = peak_sine(1.6, 1)
+    s = [kpa + fake.on_line(kpa * 1e3, sine, 0) / 1e3 for kpa in KPA]
+    assert points[:, 0] == pytest.approx(s) and points[:, 1] == pytest.approx(sine * np.array(s))
+    assert line == pytest.approx(np.array([[0, 0], [s[-1], sine * s[-1]]]), abs=1e-9)
+    angle = math.degrees(math.asin(residual_sine(0.0, 1)))
+    assert f"title 'no rolling, residual: asin(slope) {angle:.1f} deg, intercept 0'" in text
+    assert "lt 2 dt 2" in text                                               # group 2's colour, pair 2's dashes
+
+
+def test_a_fit_line_and_its_legend():
+    assert plots.fitted_line([1, 2, 4], [2.5, 3, 4]) == pytest.approx((0.5, 2.0))
+    assert plots.fitted_line([1, 1], [2, 3]) is None and plots.fitted_line([1], [2]) is None
+    assert plots.fit_legend("g", "peak", (0.5, 2.0), "asin") == "g, peak: asin(slope) 30.0 deg, intercept 2"
+    assert plots.fit_legend("g", "peak", (1.5, 2.0), "asin") == "g, peak: slope 1.5, intercept 2"
+    assert plots.fit_legend("g", "peak", (0.5, 2.0), "number") == "g, peak: slope 0.5, intercept 2"
+    assert plots.fit_legend("g", "peak", (0.5, -4e-14), "number", 500.0) == "g, peak: slope 0.5, intercept 0"
+    assert plots.fit_legend("g", "peak", (0.5, -4e-6), "number", 500.0) == "g, peak: slope 0.5, intercept -4e-06"
+
+
+def test_fig12_fit_notes_a_missing_variant_and_a_degenerate_group(tmp_path, figure_store):
+    figure = FIG12.replace("group = no rolling; m1_d0.0_s100_r1 m1_d0.0_s200_r1 m1_d0.0_s400_r1",
+                           "group = lone; m1_d0.0_s100_r1 unrun_s100")
+    text, notes, data = script_data(tmp_path, figure_store, figure, plots._fit_script)
+    assert notes[0].startswith("lone, peak: unrun_s100: not drawn: run output missing")
+    assert "lone, peak: fewer than two different x: no line" in notes
+    assert "title 'lone, peak'" in text and "line_0_0.dat" not in data and "line_1_0.dat" in data
+
+
+def test_fig13_errorbars_give_the_mean_and_the_spread_between_seeds(tmp_path, figure_store):
+    text, notes, data = script_data(tmp_path, figure_store, FIG13, plots._errorbars_script)
+    assert notes == []
+    peak = data["series_0.dat"]
+    for row, delta in zip(peak, DELTAS):
+        angles = [math.degrees(math.asin(peak_sine(delta, seed))) for seed in SEEDS]
+        assert row == pytest.approx([delta, np.mean(angles), min(angles), max(angles), 2])
+    assert data["series_1.dat"][2, 1] == pytest.approx(np.mean(
+        [math.degrees(math.asin(residual_sine(1.6, seed))) for seed in SEEDS]))
+    assert data["paper_0.dat"].tolist() == [[0, 24.4], [0, 19.3], [1.6, 42.3], [1.6, 35.8]]
+    assert data["paper_1.dat"].tolist() == [[0.4, 26.5]]
+    assert "with yerrorlines lt 1" in text and "title 'JYH 2005'" in text and "title 'JYH 2005, Model 2'" in text
+
+
+def test_spread_points():
+    assert plots.spread_points({0.4: [1.0, 3.0, 2.0], 0.0: [5.0]}) == [(0.0, 5.0, 5.0, 5.0, 1), (0.4, 2.0, 1.0, 3.0, 3)]
+    assert plots.number_key(0.1 + 0.2) == plots.number_key(0.3)
+
+
+def test_fig13_errorbars_note_the_variants_they_cannot_draw(tmp_path, figure_store):
+    figure = FIG13.replace("variants = ", "variants = unrun_s100 ").replace(
+        "x = setting('material.grain.delta')", "x = setting('material.grain.delta') + 0 * phi_peak(rows=300)")
+    _, notes, data = script_data(tmp_path, figure_store, figure, plots._errorbars_script)
+    assert notes[0].startswith("unrun_s100: not drawn: run output missing") and notes[-1] == "nothing to plot"
+    assert len(notes) == 8 and all("phi_peak(): rows must be 1 to 201" in n for n in notes[1:-1])
+    assert data == {}
+    figure = FIG13.replace("y = ballast peak;", "y = ballast peak; 1 / 0 + ")
+    _, notes, data = script_data(tmp_path, figure_store, figure, plots._errorbars_script)
+    assert len(notes) == 6 and all(": ballast peak: not drawn: " in n and "ZeroDivisionError" in n for n in notes)
+    assert sorted(data) == ["paper_0.dat", "paper_1.dat", "series_1.dat"]
+
+
+@needs_gnuplot
+def test_the_biaxial_figures_render_into_the_report(tmp_path, figure_store):
+    """Figs 11-13 and a force network (the existing kind) of one specimen's final state."""
+    case = load_case(tmp_path, FIG11 + FIG12 + FIG13)
+    index = report.write_report([case], [], figure_store, tmp_path / "runs", tmp_path / "reports")
+    html = index.read_text()
+    for figure in ("fig11a", "fig12", "fig13"):
+        assert (tmp_path / "reports" / "figures" / f"biax_{figure}.png").stat().st_size > 1000
+    assert html.count("data:image/svg+xml;base64,") == 3
+    assert "(JYH 2005, Fig. 11(a))" in html

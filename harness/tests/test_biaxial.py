@@ -273,6 +273,22 @@ def test_the_envelope_of_this_variants_material(store):
     assert biaxial.resolve("_soft", "m1_s100") == "_soft"
 
 
+def test_the_spread_of_a_quantity_over_variants(store):
+    """Peak less residual envelope angle: m1 asin 0.5 - asin 0.35, m0 asin 0.4 - asin 0.3."""
+    soft = "phi_envelope('peak', '_s100', '_s200', '_s400') - phi_envelope('residual', '_s100', '_s200', '_s400', lo=0.1, hi=0.19)"
+    m1, m0 = (math.degrees(math.asin(a) - math.asin(b)) for a, b in ((0.5, 0.35), (0.4, 0.3)))
+    assert value(store, f'spread("{soft}", "m1_d0.4_s100", "m0_s400")', "m0_s100") == pytest.approx(abs(m1 - m0), abs=1e-9)
+    assert value(store, 'spread("phi_peak()", "m0_s100", "m0_s200", "m0_s400")') == pytest.approx(0, abs=1e-9)
+    # with cohesion, the angle of each test falls with the confining stress: 100 kPa above 400
+    angle = [math.degrees(math.asin(sin_phi(fake.on_line(sh, 0.5, 10e3), sh))) for sh in (100e3, 400e3)]
+    assert value(store, 'spread("phi_peak()", "m1_d0.4_s100", "m1_d0.4_s200", "m1_d0.4_s400")') == pytest.approx(
+        angle[0] - angle[1], abs=1e-9)
+    with pytest.raises(EvalError, match="spread\\(\\): needs at least two variants"):
+        value(store, 'spread("phi_peak()", "m0_s100")')
+    with pytest.raises(EvalError, match="of\\(\\): variant 'nope'"):
+        value(store, 'spread("phi_peak()", "m0_s100", "nope")')
+
+
 def test_the_envelope_fit_by_hand():
     """Three points off a line: the least-squares slope and intercept of numpy's own normal equations."""
     points = [(100.0, 52.0), (200.0, 98.0), (400.0, 201.0)]

@@ -20,8 +20,8 @@ NAMES_BEFORE = {"first", "last", "mean", "max", "min", "std", "amp", "abs", "sqr
                 "between", "period", "settle", "run", "energy", "series", "pile_X", "pile_S", "middle",
                 "horizontal_contacts", "contact_error", "contact_mismatch", "weight", "contact_start",
                 "contact_end", "sine_period", "sine_amplitude", "contact_duration", "restitution", "of", "order"}
-# The names the biaxial family (JYH 2005, issue 21) added after them.
-BIAXIAL = {"sigma_v", "sigma_h", "mean_stress", "deviator", "phi", "axial_strain", "lateral_strain",
+# The names issue 21 added after them: spread (variants) and the biaxial family (JYH 2005).
+BIAXIAL = {"spread", "sigma_v", "sigma_h", "mean_stress", "deviator", "phi", "axial_strain", "lateral_strain",
            "volumetric_strain", "shear_start", "phi_peak", "peak_cycle", "at_peak", "phi_residual",
            "window_mean", "residual_drift", "dilation", "phi_envelope", "cohesion_envelope", "setting"}
 

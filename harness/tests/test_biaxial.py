@@ -5,12 +5,13 @@ clear EvalErrors of what cannot be evaluated."""
 import json
 import math
 import shutil
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from harness import catalogue, report
-from harness.compare import RunStore, evaluate, evaluate_array, folder_locator
+from harness import catalogue, references, report
+from harness.compare import RunStore, evaluate, evaluate_all, evaluate_array, folder_locator
 from harness.errors import EvalError, IniError
 from harness.families import biaxial
 from harness.report import plots
@@ -587,3 +588,68 @@ def test_the_biaxial_figures_render_into_the_report(tmp_path, figure_store):
         assert (tmp_path / "reports" / "figures" / f"biax_{figure}.png").stat().st_size > 1000
     assert html.count("data:image/svg+xml;base64,") == 3
     assert "(JYH 2005, Fig. 11(a))" in html
+
+
+# ---------------------------------------------------------------- JYH's laws as checks
+
+LAWS = """
+[check phi_rises_with_delta]
+case = biax
+quantity = phi_envelope('peak', '_s100', '_s200', '_s400')
+tolerance = trend increasing
+variants = m1_d0.0_s100_r1 m1_d0.4_s100_r1 m1_d1.6_s100_r1
+kind = paper
+provenance = JYH 2005 Sec. 5.3: "the peak (residual) phi increases evidently with the increasing of delta"
+
+[check residual_below_peak]
+case = biax
+variant = m1_d0.4_s100_r1
+quantity = phi_envelope('peak', '_s100', '_s200', '_s400') - phi_envelope('residual', '_s100', '_s200', '_s400', lo=0.1, hi=0.19)
+tolerance = interval
+lo = 2
+kind = paper
+provenance = JYH 2005 Fig. 12
+
+[check softening_constant]
+case = biax
+variant = m1_d0.0_s100_r1
+quantity = spread("phi_envelope('peak', '_s100', '_s200', '_s400') - phi_envelope('residual', '_s100', '_s200', '_s400', lo=0.1, hi=0.19)", 'm1_d0.0_s100_r1', 'm1_d0.4_s100_r1', 'm1_d1.6_s100_r1')
+tolerance = interval
+hi = 1.5
+kind = paper
+provenance = JYH 2005 Sec. 5.3: "the difference between peak and residual strength is almost constant with delta"
+
+[check dilates]
+case = biax
+variant = m1_d1.6_s200_r2
+quantity = dilation()
+tolerance = interval
+lo = 0.01
+kind = paper
+provenance = JYH 2005 Fig. 11(b): "shear-dilant behaviour"
+
+[check no_cohesion]
+case = biax
+variant = m1_d0.0_s100_r1
+quantity = cohesion_envelope('peak', '_s100', '_s200', '_s400') / 1000
+tolerance = abs 1
+value = 0
+kind = paper
+provenance = JYH 2005 Sec. 5.2: "all strength envelopes of no rolling resistance materials nearly pass through the origin"
+"""
+
+
+def test_jyhs_laws_hold_as_checks_of_a_ref_file(tmp_path, figure_store):
+    """The laws written as the case will write them: a trend over materials through the relative
+    '_s100' names, intervals on the softening and on its spread over delta, the dilation, the
+    cohesionless envelope -- all pass on the synthetic materials, and fail when the data break them."""
+    ref = tmp_path / "biaxial.ref"
+    ref.write_text(LAWS)
+    checks = references.load_file(ref)
+    verdicts = evaluate_all(checks, figure_store)
+    assert [(v.check, v.passed) for v in verdicts] == [(c.name, True) for c in checks], [v.message for v in verdicts]
+    assert verdicts[0].value == pytest.approx([math.degrees(math.asin(peak_sine(d, 1))) for d in DELTAS])
+    # the same trend over the materials in the wrong order fails, naming the step
+    backwards = replace(checks[0], variants=checks[0].variants[::-1])
+    verdict = evaluate_all([backwards], figure_store)[0]
+    assert not verdict.passed and verdict.message.startswith("not increasing: m1_d1.6_s100_r1 = 33.71")

@@ -4,10 +4,11 @@ A quantity is a Python expression evaluated without builtins in a namespace hold
 series.tsv column (numpy array) and the functions that harness/expressions.py gives for the
 run: the expression language's own (at, first, last, after, upto, between, mean, max, min,
 std, abs, sqrt, amp, run, energy) and those every case family registered there (the
-modules of harness/families: signals, variants, piles, networks, collisions).  This module
-knows no family: it asks the registry.  evaluate_check() turns one Check into a Verdict;
+modules of harness/families: signals, variants, piles, networks, collisions, biaxial).  This
+module knows no family: it asks the registry.  evaluate_check() turns one Check into a Verdict;
 anything that goes wrong (missing output, failed run, missing column, an expression that
 raises, a NaN/inf value) is a FAIL whose message says which, never a pass and never a skip.
+evaluate_array() gives a figure (report/plots.py) an expression's whole row of numbers.
 """
 import ast
 import math

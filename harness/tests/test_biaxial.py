@@ -580,7 +580,7 @@ def test_fig13_errorbars_note_the_variants_they_cannot_draw(tmp_path, figure_sto
 
 @needs_gnuplot
 def test_the_biaxial_figures_render_into_the_report(tmp_path, figure_store):
-    """Figs 11-13 and a force network (the existing kind) of one specimen's final state."""
+    """Figs 11(a), 12 and 13 drawn by gnuplot into the report, with the figure's paper quote."""
     case = load_case(tmp_path, FIG11 + FIG12 + FIG13)
     index = report.write_report([case], [], figure_store, tmp_path / "runs", tmp_path / "reports")
     html = index.read_text()

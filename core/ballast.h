@@ -304,6 +304,7 @@ struct bal_stage_def {
                                * target stress (0: off) */
     double stop_unbalanced;   /* ... and ΔF/F (bal_measure_unbalanced) <= this (0: off) */
     long check_every;         /* cycles between checks of the stop rule (100) */
+    long output_at_end;       /* 1: a series row after the stage's last cycle (0) */
     int n_moves;              /* walls the stage drives; the others stay at rest */
     struct bal_move_def moves[BAL_MAX_MOVES];
     BAL_SECTION_TAIL;

@@ -239,6 +239,9 @@ const struct bal_key bal_scene_keys[] = {
      "... and the disc stresses change by <= this share of the largest between checks"},
     {BAL_SEC_STAGE, "check_every", BAL_KEY_LONG, G(check_every), "100", 0, 1, 1e15, NULL,
      "cycles between checks of the stop rule"},
+    {BAL_SEC_STAGE, "output_at_end", BAL_KEY_LONG, G(output_at_end), "0", 0, 0, 1, NULL,
+     "1: write a series row after the stage's last cycle (its count or its stop rule), so the "
+     "next stage's start is in series.tsv"},
     {BAL_SEC_STAGE, "stop_servo", BAL_KEY_DOUBLE, G(stop_servo), "0", 0, 0, BIG, NULL,
      "... and every servo wall of the stage is within this share of its target stress (0: off)"},
     {BAL_SEC_STAGE, "stop_unbalanced", BAL_KEY_DOUBLE, G(stop_unbalanced), "0", 0, 0, BIG, NULL,

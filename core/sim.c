@@ -313,7 +313,9 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
             if (stage->ramp)
                 s->gfac = (double)(c + 1) / (double)cycles;
             const int check = rule && (c + 1) % stage->check_every == 0;
-            const int last = g == sc->n_stages - 1 && c == cycles - 1;
+            /* A row after the last cycle of the run, and of a stage that asks
+             * for one (output_at_end: the state where the next stage starts). */
+            const int last = (g == sc->n_stages - 1 || stage->output_at_end) && c == cycles - 1;
             const int row = series && ((s->step + 1) % every == 0 || last);
             if ((status = cycle(s, err)) != BAL_OK)
                 break;
@@ -325,7 +327,7 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
                 (status = bal_energy_guard(s, err)) != BAL_OK)
                 break;
             const int done = check && stop_rule_met(s, stage, log);
-            if ((row || (done && series && g == sc->n_stages - 1)) &&
+            if ((row || (done && series && (g == sc->n_stages - 1 || stage->output_at_end))) &&
                 (status = bal_output_series_row(s, series, err)) != BAL_OK)
                 break;
             if (done) {

@@ -39,6 +39,8 @@ takes kind, title, variants and paper; variants default to all of the case's):
 
 A key that the figure's kind does not use is an error, as is an unknown kind.
 [sweep NAME] sections declare the case's error-against-cost sweeps (keys in sweep_spec.py).
+[ensemble NAME] sections declare many realisations of one scene, one variant per seed, named
+NAME_s<seed> (ensembles.py); a figure's `variants` may name an ensemble for all of them.
 """
 import ast
 import math
@@ -47,6 +49,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import TIERS, cases_root
+from . import ensembles
 from .errors import CatalogueError, IniError, shown
 from .families.piles import COMPONENTS
 from .ini import parse_file
@@ -85,6 +88,8 @@ class Variant:
     command: str = "run"     # run: the DEM; exact: the exact static solver (ballast exact);
                              # peer: the cross-check against LAMMPS (harness/peer/race.py);
                              # peer_rolling: JYH's rolling against LAMMPS (harness/peer/rolling.py)
+    ensemble: str = ""       # a realisation of [ensemble NAME]: NAME (and its seed); '' otherwise
+    seed: int = None
 
 
 @dataclass
@@ -127,6 +132,7 @@ class Case:
     variants: list = field(default_factory=list)
     figures: list = field(default_factory=list)
     sweeps: list = field(default_factory=list)     # [sweep NAME] sections as sweep_spec.Sweep (error against cost)
+    ensembles: list = field(default_factory=list)  # [ensemble NAME] sections as ensembles.Ensemble
 
     @property
     def source(self):
@@ -139,6 +145,25 @@ class Case:
 
     def variant_names(self):
         return [v.name for v in self.variants]
+
+    def ensemble(self, name):
+        """The [ensemble] called name, or None."""
+        return next((e for e in self.ensembles if e.name == name), None)
+
+    def ensemble_members(self):
+        """{ensemble name: its realisations' variant names, in seed order}."""
+        return {e.name: list(e.members) for e in self.ensembles}
+
+    def variant_summary(self):
+        """The variants in a few words: plain ones by name, an ensemble as NAME_s[seeds]."""
+        words, shown_ensembles = [], set()
+        for v in self.variants:
+            if not v.ensemble:
+                words.append(v.name)
+            elif v.ensemble not in shown_ensembles:
+                shown_ensembles.add(v.ensemble)
+                words.append(f"{v.ensemble}_s[{ensembles.seeds_text(self.ensemble(v.ensemble).seeds)}]")
+        return " ".join(words)
 
 
 def tier_rank(tier):
@@ -173,8 +198,11 @@ def load_file(path):
             _add_figure(cases[-1], section)
         elif section.kind == "sweep":
             cases[-1].sweeps.append(parse_sweep(section))
+        elif section.kind == "ensemble":
+            _add_ensemble(cases[-1], section)
         else:
-            raise section.error(f"unknown section kind '{section.kind}' (known: case, variant, figure, sweep)")
+            raise section.error(f"unknown section kind '{section.kind}' "
+                                "(known: case, variant, ensemble, figure, sweep)")
     for case in cases:
         _finish(case)
     return cases
@@ -200,6 +228,7 @@ def _case(section, path):
 
 def _add_variant(case, section):
     section.check_keys(VARIANT_KEYS)
+    _not_an_ensembles_name(case, section, section.name)
     if case.variant(section.name):
         raise section.error(f"variant '{section.name}' defined twice in case '{case.name}'")
     for entry in section.all("set"):
@@ -210,6 +239,31 @@ def _add_variant(case, section):
     if command not in COMMANDS:
         raise section.error(f"command must be one of {', '.join(COMMANDS)}, not '{command}'")
     case.variants.append(Variant(section.name, case.folder / section.require("scene"), sets, command))
+
+
+def _not_an_ensembles_name(case, section, name):
+    """A plain variant's or a new ensemble's name must not be an ensemble's, nor one it keeps
+    for its realisations (NAME_s<digits>)."""
+    for ens in case.ensembles:
+        where = f"ensemble '{ens.name}' ({shown(ens.path)}:{ens.line})"
+        if name == ens.name:
+            raise section.error(f"'{name}' is already the name of {where}")
+        if ensembles.claims(ens.name, name):
+            raise section.error(f"'{name}' is a name {where} keeps for its realisations ({ens.name}_s<seed>)")
+
+
+def _add_ensemble(case, section):
+    """[ensemble NAME]: one variant per seed, NAME_s<seed> (ensembles.py)."""
+    _not_an_ensembles_name(case, section, section.name)
+    for variant in case.variants:
+        if variant.name == section.name or ensembles.claims(section.name, variant.name):
+            raise section.error(f"ensemble '{section.name}' would name its realisations {section.name}_s<seed>, "
+                                f"but the case already has a variant '{variant.name}'")
+    ens = ensembles.parse(section)
+    case.ensembles.append(ens)
+    for seed in ens.seeds:
+        name, scene, sets = ens.realisation(seed)
+        case.variants.append(Variant(name, case.folder / scene, sets, ens.command, ens.name, seed))
 
 
 def _add_figure(case, section):
@@ -381,15 +435,27 @@ def _range(section, key):
 
 
 def _finish(case):
-    """Whole-case checks: at least one variant; figures name existing variants."""
+    """Whole-case checks: at least one variant; figures name existing variants (an ensemble's
+    name stands for its realisations)."""
     if not case.variants:
-        raise IniError(case.path, case.line, f"case '{case.name}' has no [variant]")
+        raise IniError(case.path, case.line, f"case '{case.name}' has no [variant] or [ensemble]")
+    members = case.ensemble_members()
     for figure in case.figures:
+        figure.variants = [v for name in figure.variants for v in members.get(name, [name])]
+        if figure.kind in ("network", "principal") and len(figure.variants) != 1:
+            raise IniError(case.path, figure.line, f"a {figure.kind} figure shows exactly one variant, "
+                           f"not the {len(figure.variants)} realisations of an ensemble")
         for name in figure.variants:
             if not case.variant(name):
                 raise IniError(case.path, figure.line,
                                f"figure '{figure.name}' names unknown variant '{name}'")
         figure.variants = figure.variants or case.variant_names()
+
+
+def ensembles_of(cases):
+    """{case name: {ensemble name: its realisations' variant names}} of the cases that declare
+    ensembles (for compare.RunStore: the expression functions over an ensemble)."""
+    return {c.name: c.ensemble_members() for c in cases if c.ensembles}
 
 
 def select(cases, names=(), tier="standard"):

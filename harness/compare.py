@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import EvalError, RunProblem, RunSkipped
-from .expressions import functions
+from .expressions import Siblings, functions
 from .tables import load_run
 
 
@@ -74,11 +74,18 @@ def _json_number(x):
 # ---------------------------------------------------------------- run outputs
 
 class RunStore:
-    """Loads each run folder once; locate(case, variant) gives the folder."""
+    """Loads each run folder once; locate(case, variant) gives the folder.  ensembles:
+    {case: {ensemble: its realisations' variant names}} (catalogue.ensembles_of), for the
+    expression functions over an ensemble; empty when not given."""
 
-    def __init__(self, locate):
+    def __init__(self, locate, ensembles=None):
         self.locate = locate
+        self.ensembles = dict(ensembles or {})
         self._cache = {}
+
+    def siblings(self, case):
+        """The other variants of case, for an expression evaluated in one of them."""
+        return Siblings(lambda other: self.get(case, other), self.ensembles.get(case))
 
     def get(self, case, variant):
         """The Run of case/variant, or raise its RunProblem."""
@@ -201,7 +208,7 @@ def quantity_in(store, case, variant, expr):
     """Evaluate expr in the outputs of case/variant; errors say which variant."""
     run = store.get(case, variant)
     try:
-        return evaluate(expr, run, lambda other: store.get(case, other))
+        return evaluate(expr, run, store.siblings(case))
     except EvalError as exc:
         raise EvalError(f"{variant}: {exc}") from None
 

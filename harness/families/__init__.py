@@ -9,6 +9,7 @@ harness/expressions.py: each module registers its own when it is imported.
     rolling      fit_slope: a straight line through a branch of a curve (the rolling law tester)
     biaxial      sigma_v, phi, axial_strain, phi_peak, phi_residual, phi_envelope, ...: a biaxial
                  compression test and its strength envelope (JYH 2005)
+    ensembles    members, seeds, realisations, over: the realisations of an [ensemble]
 
 A new family is one module here that calls expressions.register, and its name below.  The
 order of the imports is the order in which an unknown-function message lists the names.
@@ -20,3 +21,4 @@ from . import networks  # noqa: F401
 from . import collisions  # noqa: F401
 from . import rolling  # noqa: F401
 from . import biaxial  # noqa: F401
+from . import ensembles  # noqa: F401

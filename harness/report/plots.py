@@ -36,6 +36,7 @@ from .. import files
 from ..children import options as child_options
 from ..compare import evaluate, evaluate_array
 from ..errors import EvalError, RunProblem
+from ..expressions import Siblings
 from ..families import piles
 from ..final_state import state
 from . import network
@@ -178,7 +179,7 @@ def _profile_script(case, figure, store, workdir, png, svg):
 def _points_script(case, figure, store, workdir, png, svg):
     """One point (x, y) per variant, joined in the order listed, labelled with its name."""
     rows, notes = [], []
-    sibling = lambda other: store.get(case.name, other)
+    sibling = Siblings(lambda other: store.get(case.name, other), case.ensemble_members())
     for variant in figure.variants:
         try:
             run = store.get(case.name, variant)

@@ -26,7 +26,8 @@ NAMES_ADDED = {"fit_slope"}             # rolling: the law tester (cases/rolling
 BIAXIAL = {"spread", "sigma_v", "sigma_h", "mean_stress", "deviator", "phi", "axial_strain", "lateral_strain",
            "volumetric_strain", "shear_start", "phi_peak", "peak_cycle", "at_peak", "phi_residual",
            "window_mean", "residual_drift", "dilation", "phi_envelope", "cohesion_envelope", "setting"}
-NAMES = NAMES_BEFORE | NAMES_ADDED | BIAXIAL
+ENSEMBLES = {"members", "seeds", "realisations", "over"}   # issue 22: over an [ensemble]'s realisations
+NAMES = NAMES_BEFORE | NAMES_ADDED | BIAXIAL | ENSEMBLES
 
 
 def _run(**columns):
@@ -37,7 +38,7 @@ def _run(**columns):
 
 def test_every_family_registered_and_every_name_kept():
     assert list(expressions.registered()) == ["signals", "variants", "piles", "networks", "collisions",
-                                              "rolling", "biaxial"]
+                                              "rolling", "biaxial", "ensembles"]
     names = {n for n, f in namespace(_run()).items() if callable(f)}
     assert names == NAMES
 

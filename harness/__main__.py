@@ -57,8 +57,9 @@ def selected(args, cases):
     return catalogue.select(cases, getattr(args, "cases", []) or [], args.tier)
 
 
-def default_store():
-    return RunStore(folder_locator(runs_root()))
+def default_store(cases=()):
+    """The runs under reports/runs, with the ensembles of the cases (for over(), members())."""
+    return RunStore(folder_locator(runs_root()), catalogue.ensembles_of(cases))
 
 
 # ---------------------------------------------------------------- commands
@@ -66,7 +67,7 @@ def default_store():
 def cmd_list(args):
     cases = selected(args, load_cases())
     rows = [("CASE", "TIER", "VARIANTS", "RUNTIME", "CHECKS")]
-    rows += [(c.name, c.tier, " ".join(c.variant_names()), f"{c.runtime:g} s", c.checks) for c in cases]
+    rows += [(c.name, c.tier, c.variant_summary(), f"{c.runtime:g} s", c.checks) for c in cases]
     widths = [max(len(r[i]) for r in rows) for i in range(4)]
     for r in rows:
         print("  ".join(x.ljust(w) for x, w in zip(r, widths)) + "  " + r[4])
@@ -98,14 +99,15 @@ def cmd_check(args):
     all_cases = load_cases()
     checks = load_checks(all_cases)
     cases = selected(args, all_cases)
-    return gate(references.for_cases(checks, cases), default_store(), reports_root(), sys.stdout)
+    return gate(references.for_cases(checks, cases), default_store(all_cases), reports_root(), sys.stdout)
 
 
 def cmd_report(args):
     all_cases = load_cases()
     checks = load_checks(all_cases)
     cases = selected(args, all_cases)
-    write_report(cases, references.for_cases(checks, cases), default_store(), runs_root(), reports_root(), sys.stdout)
+    write_report(cases, references.for_cases(checks, cases), default_store(all_cases), runs_root(), reports_root(),
+                 sys.stdout)
     return 0
 
 
@@ -133,7 +135,7 @@ def cmd_validate(args):
 def cmd_rebaseline(args):
     cases = load_cases()
     case = catalogue.select(cases, [args.case])[0]
-    return rebaseline(case, load_checks(cases), default_store(), sys.stdout)
+    return rebaseline(case, load_checks(cases), default_store(cases), sys.stdout)
 
 
 def cmd_sweep(args):

@@ -23,9 +23,24 @@ takes kind, title, variants and paper; variants default to all of the case's):
                with the variant's name (error against cost): x = EXPR, y = EXPR (quantity
                expressions, as in reference/*.ref), logscale = xy | x | y | (empty: none),
                xlabel, ylabel, xrange, yrange
+    curves     per variant, a curve of array expressions (JYH Fig. 11): x = EXPR,
+               y = [LABEL;] EXPR (repeatable: one curve each), xlabel, ylabel, xrange, yrange
+    errorbars  per variant a point (x, y) of quantity expressions; the variants that share an x
+               make one point at the mean of their y with a bar from its least to its largest
+               (the spread between specimens, JYH Fig. 13): x = EXPR, y = [LABEL;] EXPR
+               (repeatable: one series each), paper_point = X Y LABEL (repeatable: a published
+               value drawn beside, one legend entry per LABEL), xlabel, ylabel, xrange, yrange
+    fit        per group of variants, the points (x, y) of its variants and their least-squares
+               line (strength envelopes, JYH Fig. 12): group = LABEL; VARIANT VARIANT ...
+               (repeatable, two or more variants each; no `variants` key), x = [LABEL;] EXPR
+               and y = [LABEL;] EXPR (repeatable, paired in order: one line per pair and group),
+               slope = number | asin (the legend gives the slope, or the angle whose sine it is),
+               xlabel, ylabel, xrange, yrange
 
 A key that the figure's kind does not use is an error, as is an unknown kind.
 [sweep NAME] sections declare the case's error-against-cost sweeps (keys in sweep_spec.py).
+[ensemble NAME] sections declare many realisations of one scene, one variant per seed, named
+NAME_s<seed> (ensembles.py); a figure's `variants` may name an ensemble for all of them.
 """
 import ast
 import math
@@ -34,6 +49,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import TIERS, cases_root
+from . import ensembles
 from .errors import CatalogueError, IniError, shown
 from .families.piles import COMPONENTS
 from .ini import parse_file
@@ -42,7 +58,7 @@ from .sweep_spec import parse as parse_sweep
 CASE_KEYS = {"tier", "title", "checks", "runtime", "stability"}
 VARIANT_KEYS = {"scene", "set", "command"}
 COMMANDS = ("run", "exact", "peer", "peer_rolling")
-FIGURE_KINDS = ("series", "network", "profile", "principal", "points")
+FIGURE_KINDS = ("series", "network", "profile", "principal", "points", "curves", "errorbars", "fit")
 _COMMON = {"kind", "title", "variants", "paper"}
 _AXES = {"xlabel", "ylabel", "xrange", "yrange"}
 FIGURE_KIND_KEYS = {
@@ -51,7 +67,11 @@ FIGURE_KIND_KEYS = {
     "profile": _COMMON | _AXES | {"y", "row"},
     "principal": _COMMON,
     "points": _COMMON | _AXES | {"x", "y", "logscale"},
+    "curves": _COMMON | _AXES | {"x", "y"},
+    "errorbars": _COMMON | _AXES | {"x", "y", "paper_point"},
+    "fit": (_COMMON - {"variants"}) | _AXES | {"group", "x", "y", "slope"},
 }
+SLOPES = ("number", "asin")
 FIGURE_KEYS = set().union(*FIGURE_KIND_KEYS.values())
 LOGSCALES = {"": "", "x": "x", "y": "y", "xy": "xy", "yx": "xy"}
 PROFILE_XLABEL = "X = (x - x0) / l"
@@ -68,6 +88,8 @@ class Variant:
     command: str = "run"     # run: the DEM; exact: the exact static solver (ballast exact);
                              # peer: the cross-check against LAMMPS (harness/peer/race.py);
                              # peer_rolling: JYH's rolling against LAMMPS (harness/peer/rolling.py)
+    ensemble: str = ""       # a realisation of [ensemble NAME]: NAME (and its seed); '' otherwise
+    seed: int = None
 
 
 @dataclass
@@ -87,6 +109,11 @@ class Figure:
     row: int = 1             # profile: the pile row M of S(M)
     logscale: str = ""       # points: '', 'x', 'y' or 'xy'
     lines: list = field(default_factory=list)   # series: (slope, intercept, title) reference lines
+    labels: list = field(default_factory=list)   # curves, errorbars, fit: the legend label of each y
+    xs: list = field(default_factory=list)       # fit: the x expression paired with each y
+    groups: list = field(default_factory=list)   # fit: (label, [variants]) per group
+    paper_points: list = field(default_factory=list)   # errorbars: (x, y, label) published values
+    slope: str = "number"    # fit: how the legend gives a line's slope (SLOPES)
 
 
 @dataclass
@@ -105,6 +132,7 @@ class Case:
     variants: list = field(default_factory=list)
     figures: list = field(default_factory=list)
     sweeps: list = field(default_factory=list)     # [sweep NAME] sections as sweep_spec.Sweep (error against cost)
+    ensembles: list = field(default_factory=list)  # [ensemble NAME] sections as ensembles.Ensemble
 
     @property
     def source(self):
@@ -117,6 +145,25 @@ class Case:
 
     def variant_names(self):
         return [v.name for v in self.variants]
+
+    def ensemble(self, name):
+        """The [ensemble] called name, or None."""
+        return next((e for e in self.ensembles if e.name == name), None)
+
+    def ensemble_members(self):
+        """{ensemble name: its realisations' variant names, in seed order}."""
+        return {e.name: list(e.members) for e in self.ensembles}
+
+    def variant_summary(self):
+        """The variants in a few words: plain ones by name, an ensemble as NAME_s[seeds]."""
+        words, shown_ensembles = [], set()
+        for v in self.variants:
+            if not v.ensemble:
+                words.append(v.name)
+            elif v.ensemble not in shown_ensembles:
+                shown_ensembles.add(v.ensemble)
+                words.append(f"{v.ensemble}_s[{ensembles.seeds_text(self.ensemble(v.ensemble).seeds)}]")
+        return " ".join(words)
 
 
 def tier_rank(tier):
@@ -151,8 +198,11 @@ def load_file(path):
             _add_figure(cases[-1], section)
         elif section.kind == "sweep":
             cases[-1].sweeps.append(parse_sweep(section))
+        elif section.kind == "ensemble":
+            _add_ensemble(cases[-1], section)
         else:
-            raise section.error(f"unknown section kind '{section.kind}' (known: case, variant, figure, sweep)")
+            raise section.error(f"unknown section kind '{section.kind}' "
+                                "(known: case, variant, ensemble, figure, sweep)")
     for case in cases:
         _finish(case)
     return cases
@@ -178,6 +228,7 @@ def _case(section, path):
 
 def _add_variant(case, section):
     section.check_keys(VARIANT_KEYS)
+    _not_an_ensembles_name(case, section, section.name)
     if case.variant(section.name):
         raise section.error(f"variant '{section.name}' defined twice in case '{case.name}'")
     for entry in section.all("set"):
@@ -188,6 +239,31 @@ def _add_variant(case, section):
     if command not in COMMANDS:
         raise section.error(f"command must be one of {', '.join(COMMANDS)}, not '{command}'")
     case.variants.append(Variant(section.name, case.folder / section.require("scene"), sets, command))
+
+
+def _not_an_ensembles_name(case, section, name):
+    """A plain variant's or a new ensemble's name must not be an ensemble's, nor one it keeps
+    for its realisations (NAME_s<digits>)."""
+    for ens in case.ensembles:
+        where = f"ensemble '{ens.name}' ({shown(ens.path)}:{ens.line})"
+        if name == ens.name:
+            raise section.error(f"'{name}' is already the name of {where}")
+        if ensembles.claims(ens.name, name):
+            raise section.error(f"'{name}' is a name {where} keeps for its realisations ({ens.name}_s<seed>)")
+
+
+def _add_ensemble(case, section):
+    """[ensemble NAME]: one variant per seed, NAME_s<seed> (ensembles.py)."""
+    _not_an_ensembles_name(case, section, section.name)
+    for variant in case.variants:
+        if variant.name == section.name or ensembles.claims(section.name, variant.name):
+            raise section.error(f"ensemble '{section.name}' would name its realisations {section.name}_s<seed>, "
+                                f"but the case already has a variant '{variant.name}'")
+    ens = ensembles.parse(section)
+    case.ensembles.append(ens)
+    for seed in ens.seeds:
+        name, scene, sets = ens.realisation(seed)
+        case.variants.append(Variant(name, case.folder / scene, sets, ens.command, ens.name, seed))
 
 
 def _add_figure(case, section):
@@ -271,8 +347,80 @@ def _points(section, common):
                   yrange=_range(section, "yrange"), logscale=LOGSCALES[logscale], **common)
 
 
+def _labelled(section, key):
+    """Every `key = [LABEL;] EXPR` of the section: (labels, expressions), the label defaulting to
+    the expression; at least one.  A quantity never holds ';', so the first one ends the label."""
+    entries = section.all(key)
+    if not entries:
+        raise section.error(f"[{section.kind} {section.name}] needs '{key} = [LABEL;] EXPR'")
+    labels, exprs = [], []
+    for e in entries:
+        label, sep, text = e.value.partition(";")
+        label, text = (label.strip(), text.strip()) if sep else ("", label.strip())
+        if not text:
+            raise section.error(f"'{key}' is empty", e.line)
+        try:
+            ast.parse(text, mode="eval")
+        except SyntaxError as exc:
+            raise section.error(f"'{key}' is not an expression: {exc.msg}", e.line) from None
+        labels.append(label or text)
+        exprs.append(text)
+    return labels, exprs
+
+
+def _axes(section, x, ylabel):
+    """The axis keys of the expression kinds."""
+    return dict(xlabel=section.get("xlabel", x), ylabel=section.get("ylabel", ylabel),
+                xrange=_range(section, "xrange"), yrange=_range(section, "yrange"))
+
+
+def _curves(section, common):
+    x = _expression(section, "x")
+    labels, ys = _labelled(section, "y")
+    return Figure(variants=section.get("variants", "").split(), x=x, y=ys, labels=labels,
+                  **_axes(section, x, ", ".join(labels)), **common)
+
+
+def _errorbars(section, common):
+    x = _expression(section, "x")
+    labels, ys = _labelled(section, "y")
+    published = []
+    for e in section.all("paper_point"):
+        words = e.value.split(None, 2)
+        try:
+            published.append((float(words[0]), float(words[1]), words[2]))
+        except (ValueError, IndexError):
+            raise section.error(f"'paper_point' must be 'X Y LABEL' (two numbers, then the legend), "
+                                f"not '{e.value}'", e.line) from None
+    return Figure(variants=section.get("variants", "").split(), x=x, y=ys, labels=labels,
+                  paper_points=published, **_axes(section, x, ", ".join(labels)), **common)
+
+
+def _fit(section, common):
+    groups = []
+    for e in section.all("group"):
+        label, sep, names = e.value.partition(";")
+        if not sep or not label.strip() or len(names.split()) < 2:
+            raise section.error(f"'group' must be 'LABEL; VARIANT VARIANT ...' (two or more variants), "
+                                f"not '{e.value}'", e.line)
+        groups.append((label.strip(), names.split()))
+    if not groups:
+        raise section.error(f"[figure {section.name}] needs 'group = LABEL; VARIANT VARIANT ...'")
+    _, xs = _labelled(section, "x")
+    labels, ys = _labelled(section, "y")
+    if len(xs) != len(ys):
+        raise section.error(f"a fit figure pairs each 'x' with a 'y': it has {len(xs)} x and {len(ys)} y")
+    slope = section.get("slope", "number")
+    if slope not in SLOPES:
+        raise section.error(f"'slope' must be one of {', '.join(SLOPES)}, not '{slope}'", section.entry("slope").line)
+    variants = list(dict.fromkeys(v for _, names in groups for v in names))
+    return Figure(variants=variants, x=xs[0], y=ys, labels=labels, xs=xs, groups=groups, slope=slope,
+                  **_axes(section, xs[0], ys[0]), **common)
+
+
 FIGURE_MAKERS = {"series": _series, "network": _one_variant, "profile": _profile,
-                 "principal": _one_variant, "points": _points}
+                 "principal": _one_variant, "points": _points, "curves": _curves,
+                 "errorbars": _errorbars, "fit": _fit}
 
 
 def _range(section, key):
@@ -287,15 +435,27 @@ def _range(section, key):
 
 
 def _finish(case):
-    """Whole-case checks: at least one variant; figures name existing variants."""
+    """Whole-case checks: at least one variant; figures name existing variants (an ensemble's
+    name stands for its realisations)."""
     if not case.variants:
-        raise IniError(case.path, case.line, f"case '{case.name}' has no [variant]")
+        raise IniError(case.path, case.line, f"case '{case.name}' has no [variant] or [ensemble]")
+    members = case.ensemble_members()
     for figure in case.figures:
+        figure.variants = [v for name in figure.variants for v in members.get(name, [name])]
+        if figure.kind in ("network", "principal") and len(figure.variants) != 1:
+            raise IniError(case.path, figure.line, f"a {figure.kind} figure shows exactly one variant, "
+                           f"not the {len(figure.variants)} realisations of an ensemble")
         for name in figure.variants:
             if not case.variant(name):
                 raise IniError(case.path, figure.line,
                                f"figure '{figure.name}' names unknown variant '{name}'")
         figure.variants = figure.variants or case.variant_names()
+
+
+def ensembles_of(cases):
+    """{case name: {ensemble name: its realisations' variant names}} of the cases that declare
+    ensembles (for compare.RunStore: the expression functions over an ensemble)."""
+    return {c.name: c.ensemble_members() for c in cases if c.ensembles}
 
 
 def select(cases, names=(), tier="standard"):

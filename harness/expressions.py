@@ -17,7 +17,8 @@ module, at import:
 
 bind(run, sibling) returns {name: function} for exactly those names, bound to one run;
 sibling(variant) gives the Run of another variant of the same case (None where there is
-none).  The harness/families package holds the families, and importing it registers them
+none).  Where the catalogue is known, sibling is a Siblings, whose `ensembles` lists the
+realisations of each [ensemble] of the case (ensemble_members() reads it).  The harness/families package holds the families, and importing it registers them
 all (the command line does, first thing).  So compare.py knows no family: the registry
 sits below both, and a family is one module that nothing else has to name.
 
@@ -145,6 +146,31 @@ def functions(run, sibling=None):
             raise ValueError(f"family '{family}' made {', '.join(made)}, not its registered {', '.join(declared)}")
         names.update(made)
     return names
+
+
+class Siblings:
+    """The other variants of a run's case, as the families' functions see them: calling it with
+    a variant's name gives that variant's Run (or raises its RunProblem); `ensembles` maps each
+    [ensemble] of the case to its realisations' variant names, in seed order."""
+
+    def __init__(self, get, ensembles=None):
+        self._get = get
+        self.ensembles = dict(ensembles or {})
+
+    def __call__(self, variant):
+        return self._get(variant)
+
+
+def ensemble_members(sibling, name, fname):
+    """The variant names of the realisations of ensemble name, for a family's function fname;
+    EvalError when the case has no such ensemble or its ensembles are not known here."""
+    known = getattr(sibling, "ensembles", None)
+    if not known:
+        raise EvalError(f"{fname}(): no ensembles are known here (the case declares none, "
+                        "or this evaluation has no catalogue)")
+    if name not in known:
+        raise EvalError(f"{fname}(): the case has no ensemble '{name}' (has: {', '.join(known)})")
+    return list(known[name])
 
 
 def sibling_run(sibling, variant, fname):

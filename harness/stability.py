@@ -81,12 +81,15 @@ class Target:
 
 def targets_for(cases, one_per_case=False):
     """Every DEM variant (command = run) of the cases; or only the first of each case.  A case
-    that says `stability = no` has none (its motion is prescribed: no limit to find)."""
+    that says `stability = no` has none (its motion is prescribed: no limit to find).  Of an
+    [ensemble] only the first realisation: the others differ from it by a seed alone."""
     out = []
     for c in cases:
         if not c.stability:
             continue
-        runs = [Target(c.name, v.name, v.scene, list(v.sets)) for v in c.variants if v.command == "run"]
+        firsts = {e.name: e.members[0] for e in c.ensembles}
+        runs = [Target(c.name, v.name, v.scene, list(v.sets)) for v in c.variants
+                if v.command == "run" and (not v.ensemble or firsts[v.ensemble] == v.name)]
         out += runs[:1] if one_per_case else runs
     return out
 

@@ -27,7 +27,10 @@ BIAXIAL = {"spread", "sigma_v", "sigma_h", "mean_stress", "deviator", "phi", "ax
            "volumetric_strain", "shear_start", "phi_peak", "peak_cycle", "at_peak", "phi_residual",
            "window_mean", "residual_drift", "dilation", "phi_envelope", "cohesion_envelope", "setting"}
 ENSEMBLES = {"members", "seeds", "realisations", "over"}   # issue 22: over an [ensemble]'s realisations
-NAMES = NAMES_BEFORE | NAMES_ADDED | BIAXIAL | ENSEMBLES
+# issue 22: the statistics of polydisperse piles over an ensemble (families/pile_stats.py)
+PILE_STATS = {"ens_X", "ens_S", "ens_S_se", "dip", "dip_se", "profile_dip", "coordination", "ens_forces",
+              "tail_rate", "tail_ks", "ens_fluct", "ens_rho", "log10"}
+NAMES = NAMES_BEFORE | NAMES_ADDED | BIAXIAL | ENSEMBLES | PILE_STATS
 
 
 def _run(**columns):
@@ -38,7 +41,7 @@ def _run(**columns):
 
 def test_every_family_registered_and_every_name_kept():
     assert list(expressions.registered()) == ["signals", "variants", "piles", "networks", "collisions",
-                                              "rolling", "biaxial", "ensembles"]
+                                              "rolling", "biaxial", "ensembles", "pile_stats"]
     names = {n for n, f in namespace(_run()).items() if callable(f)}
     assert names == NAMES
 

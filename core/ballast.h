@@ -143,8 +143,16 @@ struct bal_disc_def {
     double omega;         /* angular velocity, rad/time (0) */
     char material[BAL_NAME_MAX];
     long fixed;           /* 1: held in place (velocity stays zero) (0) */
+    int hold;             /* BAL_HOLD_* bits: components of the motion held at zero (none);
+                           * all three are fixed = 1 */
     BAL_SECTION_TAIL;
 };
+
+/* The components of a disc's motion `hold` can keep at zero. */
+#define BAL_HOLD_X 1u         /* v_x: x stays */
+#define BAL_HOLD_Y 2u         /* v_y: y stays */
+#define BAL_HOLD_ROTATION 4u  /* ω: θ stays */
+#define BAL_HOLD_ALL 7u
 
 struct bal_wall_def {
     char name[BAL_NAME_MAX];
@@ -195,20 +203,94 @@ struct bal_pile_def {
     BAL_SECTION_TAIL;
 };
 
+/* A generator: n discs placed at random without overlap (random sequential
+ * addition, the largest first) in the rectangle from `origin` of the given
+ * size, with diameters from a grading curve given by area ("percent finer"
+ * by area in 2D): the share of the discs' area in discs of diameter <= d is
+ * 0, 0.1, 0.5, 0.6, 1 at dmin, d10, d50, d60, dmax, linear in between
+ * (specimen.c); with box = 1, four walls NAME_bottom/_right/_top/_left on
+ * the rectangle's sides, each reaching `overhang` beyond the corners. */
+struct bal_grains_def {
+    char name[BAL_NAME_MAX];
+    int line;
+    long n;               /* number of discs (required) */
+    double origin[2];     /* lower-left corner of the region (0 0) */
+    double size[2];       /* width and height of the region (required) */
+    double dmin, d10, d50, d60, dmax; /* the grading curve (required) */
+    unsigned long seed;   /* seed of GSL's gsl_rng_mt19937 (1) */
+    long tries;           /* random places tried for one disc before refusing (100000) */
+    long box;             /* 1: enclose with four walls (0) */
+    double overhang;      /* how far the box walls reach beyond the corners; -1: dmax (-1) */
+    char material[BAL_NAME_MAX];
+    char wall_material[BAL_NAME_MAX];
+    BAL_SECTION_TAIL;
+};
+
+/* Longest path of a data file a scene names. */
+#define BAL_PATH_MAX 512
+
+/* Columns of an imported disc, in struct bal_import_def's disc_data. */
+enum { BAL_IMPORT_X, BAL_IMPORT_Y, BAL_IMPORT_R, BAL_IMPORT_THETA, BAL_IMPORT_VX, BAL_IMPORT_VY,
+       BAL_IMPORT_OMEGA, BAL_IMPORT_FIXED, BAL_IMPORT_COLUMNS };
+
+/* A wall of an imported walls.tsv: its name and end points A, B. */
+struct bal_import_wall {
+    char name[BAL_NAME_MAX];
+    double a[2], b[2];
+    int row;              /* line of the data file */
+};
+
+/* A prepared state: the discs of a discs.tsv and the walls of a walls.tsv a
+ * run wrote, loaded unchanged.  The files are read when their keys are
+ * parsed (scene.c, import.c), so the scene holds their data. */
+struct bal_import_def {
+    char name[BAL_NAME_MAX];
+    int line;
+    char discs[BAL_PATH_MAX]; /* discs.tsv, relative to the scene's directory (required) */
+    char walls[BAL_PATH_MAX]; /* walls.tsv, likewise ("": no walls) */
+    char material[BAL_NAME_MAX];
+    char wall_material[BAL_NAME_MAX];
+    long velocities;      /* 1: read vx vy omega; 0: the discs start at rest (0) */
+    /* read from the files (owned by the scene, freed by bal_scene_free): */
+    long n;               /* discs */
+    int velocity_columns; /* 1: the discs.tsv has vx, vy, omega */
+    double *disc_data;    /* n x BAL_IMPORT_COLUMNS */
+    int *disc_row;        /* the data file's line of each disc */
+    int n_walls;
+    struct bal_import_wall *wall_data;
+    BAL_SECTION_TAIL;
+};
+
 /* How a stage drives a wall: its controller (walls.c), named by the stage
  * key that gives the wall's line. */
 enum bal_wall_control {
-    BAL_CONTROL_PRESCRIBED = 0  /* `move`: P moves with v, the wall turns about P with omega */
+    BAL_CONTROL_PRESCRIBED = 0, /* `move`: P moves with v, the wall turns about P with omega */
+    BAL_CONTROL_SERVO = 1,      /* `servo`: the wall holds a target normal stress */
+    BAL_CONTROL_STRAIN_RATE = 2 /* `strain_rate`: the gap to another wall shrinks at a rate */
 };
 
+/* Most other walls a controller's line names (the servo's two span walls). */
+#define BAL_CONTROL_WALLS_MAX 2
+
 /* A stage's line for one wall: its controller and the controller's
- * parameters, in the order its key takes them after the wall's name. */
+ * parameters, in the order its key takes them after the wall's name: its
+ * numbers go to consecutive doubles from the key's offset, the other walls
+ * it names to `walls`, in order. */
 struct bal_move_def {
     char wall[BAL_NAME_MAX];  /* wall name */
     int line;
     int control;              /* enum bal_wall_control (prescribed) */
+    char walls[BAL_CONTROL_WALLS_MAX][BAL_NAME_MAX]; /* servo: the two walls whose
+                               * distance is the span; strain_rate: the wall it moves
+                               * towards (walls[0]) */
     double v[2];              /* prescribed: velocity of P */
     double omega;             /* prescribed: angular velocity about P, rad/time */
+    double sigma;             /* servo: target normal stress, force/length (per unit
+                               * thickness), compression positive */
+    double gain;              /* servo: share α of the stress error removed per cycle */
+    double vmax;              /* servo: speed cap, length/time; 0: BAL_SERVO_CAP_SHARE of the
+                               * smallest radius per time step (walls.c) */
+    double rate;              /* strain_rate: -d(gap)/dt / gap, 1/time (> 0 compresses) */
 };
 
 struct bal_stage_def {
@@ -218,7 +300,11 @@ struct bal_stage_def {
     long ramp;                /* 1: gravity rises linearly from 0 over the stage (0) */
     double stop_ke;           /* stop when E_k <= stop_ke E_el (0: off) */
     double stop_stress;       /* ... and the stresses change by <= this (0: off) */
+    double stop_servo;        /* ... and every servo wall is within this share of its
+                               * target stress (0: off) */
+    double stop_unbalanced;   /* ... and ΔF/F (bal_measure_unbalanced) <= this (0: off) */
     long check_every;         /* cycles between checks of the stop rule (100) */
+    long output_at_end;       /* 1: a series row after the stage's last cycle (0) */
     int n_moves;              /* walls the stage drives; the others stay at rest */
     struct bal_move_def moves[BAL_MAX_MOVES];
     BAL_SECTION_TAIL;
@@ -236,8 +322,16 @@ enum bal_probe_kind {
     BAL_PROBE_HELD_FX, BAL_PROBE_HELD_FY, BAL_PROBE_WEIGHT_X, BAL_PROBE_WEIGHT_Y,
     BAL_PROBE_CONTACT_MR, BAL_PROBE_CONTACT_THETA_R, BAL_PROBE_CONTACT_ROLLING,
     BAL_PROBE_DISSIPATED_ROLLING,
+    BAL_PROBE_WALL_PX, BAL_PROBE_WALL_PY, BAL_PROBE_WALL_GAP, BAL_PROBE_WALL_STRESS,
     BAL_PROBE_COUNT
 };
+
+/* Does a probe of this kind read one wall (body a; wall_gap also b)? */
+static inline int bal_probe_is_wall(int kind)
+{
+    return (kind >= BAL_PROBE_WALL_F1 && kind <= BAL_PROBE_WALL_ECC) ||
+           (kind >= BAL_PROBE_WALL_PX && kind <= BAL_PROBE_WALL_STRESS);
+}
 
 /* Does a probe of this kind read one contact (bodies a and b)? */
 static inline int bal_probe_is_contact(int kind)
@@ -258,13 +352,16 @@ struct bal_probe_def {
 struct bal_scene {
     char path[512];                 /* file the scene came from */
     struct bal_settings settings;
-    int n_materials, n_discs, n_walls, n_fills, n_piles, n_stages, n_probes;
-    int cap_materials, cap_discs, cap_walls, cap_fills, cap_piles, cap_stages, cap_probes;
+    int n_materials, n_discs, n_walls, n_fills, n_piles, n_grains, n_imports, n_stages, n_probes;
+    int cap_materials, cap_discs, cap_walls, cap_fills, cap_piles, cap_grains, cap_imports,
+        cap_stages, cap_probes;
     struct bal_material_def *materials;
     struct bal_disc_def *discs;
     struct bal_wall_def *walls;
     struct bal_fill_def *fills;
     struct bal_pile_def *piles;
+    struct bal_grains_def *grains;
+    struct bal_import_def *imports;
     struct bal_stage_def *stages;
     struct bal_probe_def *probes;
 };

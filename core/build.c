@@ -6,8 +6,9 @@
  *              beyond BAL_MAX_DISCS, naming the generator that passes it
  *   materials  the contact parameters of every pair of materials
  *              (C&S eqs 16–19, 28)
- *   walls      [wall] sections, then four walls per boxed [fill] and a floor
- *              per smooth [pile]
+ *   walls      [wall] sections, then four walls per boxed [fill], a floor
+ *              per smooth [pile], four walls per boxed [grains] and the walls
+ *              of each [import]
  *   discs      laid out in scene order (specimen.c), sorted into cell order
  *              when the grid is used; everything derived from them checked
  *              to be a finite number
@@ -84,6 +85,16 @@ enum bal_status bal_build_settings(struct bal_sim *s, const struct bal_scene *sc
                 snprintf(where, sizeof where, "%s:%d: L: [pile %s]", sc->path,
                          sc->piles[p].key_line[bal_scene_key_index(BAL_SEC_PILE, "L")],
                          sc->piles[p].name);
+        for (int g = 0; g < sc->n_grains && seen <= BAL_MAX_DISCS; g++)
+            if ((seen += sc->grains[g].n) > BAL_MAX_DISCS)
+                snprintf(where, sizeof where, "%s:%d: n: [grains %s]", sc->path,
+                         sc->grains[g].key_line[bal_scene_key_index(BAL_SEC_GRAINS, "n")],
+                         sc->grains[g].name);
+        for (int i = 0; i < sc->n_imports && seen <= BAL_MAX_DISCS; i++)
+            if ((seen += sc->imports[i].n) > BAL_MAX_DISCS)
+                snprintf(where, sizeof where, "%s:%d: discs: [import %s]", sc->path,
+                         sc->imports[i].key_line[bal_scene_key_index(BAL_SEC_IMPORT, "discs")],
+                         sc->imports[i].name);
         return bal_error(err, BAL_EINVAL, "%s: the scene has %ld discs; at most %ld", where,
                          n_total, BAL_MAX_DISCS);
     }
@@ -157,6 +168,10 @@ enum bal_status bal_build_walls(struct bal_sim *s, struct bal_error *err)
         n_walls += sc->fills[f].box ? 4 : 0;
     for (int p = 0; p < sc->n_piles; p++)
         n_walls += sc->piles[p].bottom == 0;
+    for (int g = 0; g < sc->n_grains; g++)
+        n_walls += sc->grains[g].box ? 4 : 0;
+    for (int i = 0; i < sc->n_imports; i++)
+        n_walls += sc->imports[i].n_walls;
     s->walls = calloc((size_t)(n_walls ? n_walls : 1), sizeof *s->walls);
     if (!s->walls)
         return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
@@ -193,6 +208,35 @@ enum bal_status bal_build_walls(struct bal_sim *s, struct bal_error *err)
         snprintf(nm, sizeof nm, "%s_floor", pd->name);
         add_wall(s, nm, pd->origin[0], pd->origin[1], 0, -pd->d, (double)(pd->L + 1) * pd->d,
                  bal_scene_find(sc, BAL_SEC_MATERIAL, pd->wall_material));
+    }
+    for (int g = 0; g < sc->n_grains; g++) {
+        const struct bal_grains_def *gd = &sc->grains[g];
+        if (!gd->box)
+            continue;
+        /* The region's sides, each reaching `overhang` beyond the corners, so
+         * that a side wall that moves out leaves no gap at a corner. */
+        const int m = bal_scene_find(sc, BAL_SEC_MATERIAL, gd->wall_material);
+        const double o = gd->overhang < 0 ? gd->dmax : gd->overhang;
+        const double ox = gd->origin[0], oy = gd->origin[1], wd = gd->size[0], ht = gd->size[1];
+        char nm[2 * BAL_NAME_MAX];
+        snprintf(nm, sizeof nm, "%s_bottom", gd->name);
+        add_wall(s, nm, ox, oy, 0, -o, wd + o, m);
+        snprintf(nm, sizeof nm, "%s_right", gd->name);
+        add_wall(s, nm, ox + wd, oy, BAL_PI / 2, -o, ht + o, m);
+        snprintf(nm, sizeof nm, "%s_top", gd->name);
+        add_wall(s, nm, ox, oy + ht, 0, -o, wd + o, m);
+        snprintf(nm, sizeof nm, "%s_left", gd->name);
+        add_wall(s, nm, ox, oy, BAL_PI / 2, -o, ht + o, m);
+    }
+    for (int i = 0; i < sc->n_imports; i++) {
+        const struct bal_import_def *im = &sc->imports[i];
+        const int m = bal_scene_find(sc, BAL_SEC_MATERIAL, im->wall_material);
+        for (int k = 0; k < im->n_walls; k++) {
+            /* From A to B: P = A, h1 = 0, h2 = |B - A| (import.c). */
+            const struct bal_import_wall *w = &im->wall_data[k];
+            const double dx = w->b[0] - w->a[0], dy = w->b[1] - w->a[1];
+            add_wall(s, w->name, w->a[0], w->a[1], atan2(dy, dx), 0, hypot(dx, dy), m);
+        }
     }
     return BAL_OK;
 }
@@ -262,6 +306,7 @@ enum bal_status bal_build_discs(struct bal_sim *s, struct bal_error *err)
     double r_min = INFINITY;
     for (int i = 0; i < n; i++)
         r_min = fmin(r_min, d.r[i]);
+    s->r_min = r_min;
     s->overlap_sieve = s->overlap_budget * r_min; /* INFINITY when the budget is off */
 
     int ok = 1;
@@ -282,6 +327,10 @@ enum bal_status bal_build_discs(struct bal_sim *s, struct bal_error *err)
     s->slot = calloc((size_t)(n ? n : 1), sizeof *s->slot);
     s->mat = calloc((size_t)(n ? n : 1), sizeof *s->mat);
     s->fixed = calloc((size_t)(n ? n : 1), sizeof *s->fixed);
+    int partly_held = 0;
+    for (int i = 0; i < n; i++)
+        partly_held |= d.hold[i] != 0;
+    s->hold = partly_held ? calloc((size_t)n, sizeof *s->hold) : NULL;
     s->grid.cell = calloc((size_t)(n ? n : 1), sizeof *s->grid.cell);
     s->grid.list = calloc((size_t)(n ? n : 1), sizeof *s->grid.list);
     s->row = sc->n_piles ? calloc((size_t)(n ? n : 1), sizeof *s->row) : NULL;
@@ -291,7 +340,8 @@ enum bal_status bal_build_discs(struct bal_sim *s, struct bal_error *err)
     s->moment = stress_rule ? calloc((size_t)(4 * n + 4), sizeof *s->moment) : NULL;
     s->moment_prev = stress_rule ? calloc((size_t)(4 * n + 4), sizeof *s->moment_prev) : NULL;
     s->new2old = calloc((size_t)(n ? n : 1), sizeof *s->new2old);
-    if (!ok || !s->id || !s->slot || !s->mat || !s->fixed || !s->grid.cell || !s->grid.list ||
+    if (!ok || !s->id || !s->slot || !s->mat || !s->fixed || (partly_held && !s->hold) ||
+        !s->grid.cell || !s->grid.list ||
         (sc->n_piles && !s->row) || (stress_rule && (!s->moment || !s->moment_prev)) || !s->new2old) {
         bal_specimen_free(&d);
         return bal_error(err, BAL_ENOMEM, "%s: out of memory for %d discs", sc->path, n);
@@ -320,6 +370,8 @@ enum bal_status bal_build_discs(struct bal_sim *s, struct bal_error *err)
         s->w[i] = d.w[k];
         s->mat[i] = d.mat[k];
         s->fixed[i] = d.fixed[k];
+        if (s->hold)
+            s->hold[i] = d.hold[k];
         if (s->row)
             s->row[i] = d.row[k];
         s->inv_m[i] = 1 / bal_mass(s, i);
@@ -352,7 +404,7 @@ static double start_energy(const struct bal_sim *s, const struct bal_scene *sc)
     double e = 0, px = 0, py = 0, m = 0;
     int held = 0;
     for (int i = 0; i < s->n; i++) {
-        held |= s->fixed[i];
+        held |= s->fixed[i] || (s->hold && s->hold[i]);
         if (s->fixed[i])
             continue;
         const double mi = bal_mass(s, i);
@@ -362,8 +414,9 @@ static double start_energy(const struct bal_sim *s, const struct bal_scene *sc)
         py += mi * s->vy[i];
         m += mi;
     }
-    /* Without walls or held discs the momentum is conserved: the motion of
-     * the centre of mass can never go into a contact. */
+    /* Without walls or held discs (partly held ones included) the momentum
+     * is conserved: the motion of the centre of mass can never go into a
+     * contact. */
     if (!held && s->n_walls == 0 && m > 0)
         e -= 0.5 * (px * px + py * py) / m;
     return e > 0 ? e : 0;
@@ -524,8 +577,20 @@ enum bal_status bal_build_stages(struct bal_sim *s, struct bal_error *err)
     s->log = calloc((size_t)(sc->n_stages ? sc->n_stages : 1), sizeof *s->log);
     if (!s->log)
         return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
-    for (int g = 0; g < sc->n_stages; g++)
-        s->log[g] = (struct bal_stage_log){0, 0, -1, -1};
+    for (int g = 0; g < sc->n_stages; g++) {
+        s->log[g] = (struct bal_stage_log){0, 0, -1, -1, -1, -1};
+        /* A strain rate whose step rate dt reaches 1 would carry the wall
+         * onto (or past) the other in one cycle (walls.c). */
+        for (int m = 0; m < sc->stages[g].n_moves; m++) {
+            const struct bal_move_def *mv = &sc->stages[g].moves[m];
+            if (mv->control == BAL_CONTROL_STRAIN_RATE && !(mv->rate * s->dt < 1))
+                return bal_error(err, BAL_EINVAL,
+                                 "%s:%d: strain_rate: rate %g with the time step %g gives rate "
+                                 "dt = %g; expected rate dt < 1 (the gap shrinks by 1 - rate dt "
+                                 "a cycle)", sc->path, mv->line > 0 ? mv->line : sc->stages[g].line,
+                                 mv->rate, s->dt, mv->rate * s->dt);
+        }
+    }
     s->stage = -1; /* none yet: bal_sim_run or bal_sim_step selects the first */
     s->gfac = 1;
     return BAL_OK;

@@ -512,9 +512,13 @@ void bal_contacts_walls(struct bal_sim *s)
     for (int k = 0; k < s->n_walls; k++) {
         struct bal_wall *W = &s->walls[k];
         W->f[0] = W->f[1] = W->moment = W->fn_sum = W->fn_s_sum = 0;
+        W->dash_f[0] = W->dash_f[1] = W->dash_m = 0;
     }
     double lost_fric = 0, lost_roll = 0, wall_dash = 0;
     const int roll = p->rolling;
+    /* the dashpots' resultant per wall, for walls whose controller sets
+     * their velocity every cycle (walls.c); not kept otherwise */
+    const int track_dash = s->walls_controlled != 0;
     for (long c = 0; c < p->n; c++) {
         const int i = p->i[c];
         struct bal_wall *W = &s->walls[p->j[c]];
@@ -588,6 +592,14 @@ void bal_contacts_walls(struct bal_sim *s)
             wall_dash += dn * (wvx * ex + wvy * ey) + ds * (wvx * tx + wvy * ty);
             if (roll)
                 wall_dash += md * W->omega;
+            /* ... and their resultant on the wall, for a controller that
+             * changes the wall's velocity (walls.c, bal_walls_control) */
+            if (track_dash) {
+                const double dfx = dn * ex + ds * tx, dfy = dn * ey + ds * ty;
+                W->dash_f[0] += dfx;
+                W->dash_f[1] += dfy;
+                W->dash_m += (cx - W->p[0]) * dfy - (cy - W->p[1]) * dfx + (roll ? md : 0);
+            }
         }
         p->fn[c] = fn;
         p->fs[c] = fs;

@@ -70,7 +70,12 @@ static double start_kinetic(const struct bal_sim *s)
     double e = 0;
     for (int i = 0; i < s->n; i++) {
         const double h = s->fixed[i] ? 0 : half;
-        const double vx = s->vx[i] - h * s->g[0], vy = s->vy[i] - h * s->g[1];
+        double vx = s->vx[i] - h * s->g[0], vy = s->vy[i] - h * s->g[1];
+        const unsigned held = s->hold ? s->hold[i] : 0; /* held components never move */
+        if (held & BAL_HOLD_X)
+            vx = 0;
+        if (held & BAL_HOLD_Y)
+            vy = 0;
         e += 0.5 * bal_mass(s, i) * (vx * vx + vy * vy) + 0.5 * bal_inertia(s, i) * s->w[i] * s->w[i];
     }
     return e;

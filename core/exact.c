@@ -754,6 +754,19 @@ enum bal_status bal_exact_solve(const struct bal_sim *s, struct bal_exact *out,
                          s->scene->settings.key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "nu")],
                          s->nu);
 
+    /* Its unknowns are the free discs' two displacements: a disc held along
+     * one axis only (`hold`) would need one; not built. */
+    for (int i = 0; s->hold && i < s->n; i++)
+        if (s->hold[i] & (BAL_HOLD_X | BAL_HOLD_Y)) {
+            const int id = s->id[i];
+            const struct bal_disc_def *d = &s->scene->discs[id]; /* only [disc]s hold */
+            return bal_error(err, BAL_EINVAL,
+                             "%s:%d: hold: exact solver: disc %s is held along one axis only; "
+                             "the exact solution takes free and fully held (fixed = 1) discs",
+                             scene_path(s),
+                             d->key_line[bal_scene_key_index(BAL_SEC_DISC, "hold")], d->name);
+        }
+
     struct work w;
     memset(&w, 0, sizeof w);
     enum bal_status st = build_network(s, &w, err);

@@ -552,6 +552,8 @@ enum bal_status bal_grid_reorder(struct bal_sim *s, struct bal_error *err)
         if (s->row)
             permute_int32(s, s->row);
         permute_uint8(s, s->fixed);
+        if (s->hold)
+            permute_uint8(s, s->hold);
         for (int i = 0; i < n; i++)
             s->slot[s->id[i]] = i;
         for (int k = 0; k < s->n_probes; k++) {

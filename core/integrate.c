@@ -172,6 +172,20 @@ static struct bal_moves centred_positions(struct bal_sim *s)
     return (struct bal_moves){m1, m2};
 }
 
+/* A partly held disc's held components were zero in the last cycle too
+ * (the force on them went into the hold, not into a velocity): the
+ * `previous` of a scene with partly held discs (integrators_held below). */
+static inline void zero_held(const struct bal_sim *s, int i, double *vx, double *vy, double *w)
+{
+    const unsigned h = s->hold[i];
+    if (h & BAL_HOLD_X)
+        *vx = 0;
+    if (h & BAL_HOLD_Y)
+        *vy = 0;
+    if (h & BAL_HOLD_ROTATION)
+        *w = 0;
+}
+
 static void centred_previous(const struct bal_sim *s, int i, double *vx, double *vy, double *w)
 {
     if (s->fixed[i]) {
@@ -193,6 +207,7 @@ static void centred_previous(const struct bal_sim *s, int i, double *vx, double 
     *w = (s->w[i] * (1 + half) - aw) / (1 - half);
 }
 
+
 /* The velocity update, and in the same pass the two sums the energy audit
  * needs at t_N, v_N = (v_{N-1/2} + v_{N+1/2})/2 (energy.c): with global
  * damping Σ (m v_N² + I ω_N²), with dashpots Σ (F^D·v_N + M^D ω_N) — both
@@ -200,7 +215,7 @@ static void centred_previous(const struct bal_sim *s, int i, double *vx, double 
  * the force sums again.  Compiled in four variants, as the pair loops; one
  * block at a time, its sums into block_sums[2b], [2b + 1]. */
 static inline __attribute__((always_inline)) void
-centred_block(struct bal_sim *s, int b, const int damped, const int dashpots)
+centred_block(struct bal_sim *s, int b, const int damped, const int dashpots, const int held)
 {
     const int from = b * BAL_DISC_BLOCK, to = bal_block_end(s->n, b);
     const double dt = s->dt;
@@ -212,6 +227,7 @@ centred_block(struct bal_sim *s, int b, const int damped, const int dashpots)
     const double *restrict im = s->inv_m, *restrict ii = s->inv_i;
     const float *restrict dsh = s->dash;
     const uint8_t *restrict fixed = s->fixed;
+    const uint8_t *restrict hold = s->hold;
     double glob = 0, dash = 0;
     for (int i = from; i < to; i++) {
         if (fixed[i])
@@ -226,6 +242,16 @@ centred_block(struct bal_sim *s, int b, const int damped, const int dashpots)
             vy[i] = oy + (f[3 * i + 1] * im[i] * dt + gydt);
             w[i] = ow + f[3 * i + 2] * ii[i] * dt;
         }
+        if (held && hold[i]) {
+            /* held components stay at zero (ox etc. are zero already): the
+             * position pass then adds nothing to the held coordinates */
+            if (hold[i] & BAL_HOLD_X)
+                vx[i] = 0;
+            if (hold[i] & BAL_HOLD_Y)
+                vy[i] = 0;
+            if (hold[i] & BAL_HOLD_ROTATION)
+                w[i] = 0;
+        }
         /* twice v_N */
         const double cx = ox + vx[i], cy = oy + vy[i], cw = ow + w[i];
         if (damped)
@@ -238,9 +264,9 @@ centred_block(struct bal_sim *s, int b, const int damped, const int dashpots)
 }
 
 static inline __attribute__((always_inline)) void
-centred_update(struct bal_sim *s, const int damped, const int dashpots)
+centred_update(struct bal_sim *s, const int damped, const int dashpots, const int held)
 {
-    FOR_BLOCKS(s, b, centred_block(s, b, damped, dashpots));
+    FOR_BLOCKS(s, b, centred_block(s, b, damped, dashpots, held));
     double glob = 0, dash = 0;
     for (int b = 0; b < blocks_of(s); b++) {
         glob += s->par.block_sums[2 * b];
@@ -250,25 +276,45 @@ centred_update(struct bal_sim *s, const int damped, const int dashpots)
     s->audit.dash_sum = 0.5 * dash;
 }
 
-static void centred_velocities(struct bal_sim *s)
+/* The variants with partly held discs, out of line: the usual four keep
+ * the code they had. */
+static __attribute__((noinline)) void centred_velocities_held(struct bal_sim *s)
 {
     const int damped = s->alpha != 0, dashpots = s->dash != NULL;
     if (damped && dashpots)
-        centred_update(s, 1, 1);
+        centred_update(s, 1, 1, 1);
     else if (damped)
-        centred_update(s, 1, 0);
+        centred_update(s, 1, 0, 1);
     else if (dashpots)
-        centred_update(s, 0, 1);
+        centred_update(s, 0, 1, 1);
     else
-        centred_update(s, 0, 0);
+        centred_update(s, 0, 0, 1);
+}
+
+static void centred_velocities(struct bal_sim *s)
+{
+    const int damped = s->alpha != 0, dashpots = s->dash != NULL;
+    if (s->hold)
+        centred_velocities_held(s);
+    else if (damped && dashpots)
+        centred_update(s, 1, 1, 0);
+    else if (damped)
+        centred_update(s, 1, 0, 0);
+    else if (dashpots)
+        centred_update(s, 0, 1, 0);
+    else
+        centred_update(s, 0, 0, 0);
 }
 
 /* ------------------------------------------------------------------ */
 /* verlet: velocity Verlet, damping at whole steps                     */
 /* ------------------------------------------------------------------ */
 
-/* First half kick with the force sums of the last cycle, then the drift. */
-static struct bal_moves verlet_positions(struct bal_sim *s)
+/* First half kick with the force sums of the last cycle, then the drift;
+ * `held`: the variant that keeps the held components of partly held discs
+ * at zero (their coordinates then stay). */
+static inline __attribute__((always_inline)) struct bal_moves
+verlet_positions_with(struct bal_sim *s, const int held)
 {
     const int n = s->n;
     const double dt = s->dt, hdt = dt / 2;
@@ -279,12 +325,21 @@ static struct bal_moves verlet_positions(struct bal_sim *s)
     const double *restrict f = s->f;
     const double *restrict im = s->inv_m, *restrict ii = s->inv_i;
     const uint8_t *restrict fixed = s->fixed;
+    const uint8_t *restrict hold = s->hold;
     for (int i = 0; i < n; i++) {
         if (fixed[i])
             continue;
         vx[i] = vx[i] * keep + (f[3 * i] * im[i] + gx) * hdt;
         vy[i] = vy[i] * keep + (f[3 * i + 1] * im[i] + gy) * hdt;
         w[i] = w[i] * keep + f[3 * i + 2] * ii[i] * hdt;
+        if (held && hold[i]) {
+            if (hold[i] & BAL_HOLD_X)
+                vx[i] = 0;
+            if (hold[i] & BAL_HOLD_Y)
+                vy[i] = 0;
+            if (hold[i] & BAL_HOLD_ROTATION)
+                w[i] = 0;
+        }
         x[i] += vx[i] * dt;
         y[i] += vy[i] * dt;
         th[i] += w[i] * dt;
@@ -292,8 +347,19 @@ static struct bal_moves verlet_positions(struct bal_sim *s)
     return moved_scan(s);
 }
 
+static __attribute__((noinline)) struct bal_moves verlet_positions_held(struct bal_sim *s)
+{
+    return verlet_positions_with(s, 1);
+}
+
+static struct bal_moves verlet_positions(struct bal_sim *s)
+{
+    return s->hold ? verlet_positions_held(s) : verlet_positions_with(s, 0);
+}
+
 /* Second half kick with the force sums of this cycle. */
-static void verlet_velocities(struct bal_sim *s)
+static inline __attribute__((always_inline)) void verlet_velocities_with(struct bal_sim *s,
+                                                                         const int held)
 {
     const int n = s->n;
     const double hdt = s->dt / 2;
@@ -303,13 +369,35 @@ static void verlet_velocities(struct bal_sim *s)
     const double *restrict f = s->f;
     const double *restrict im = s->inv_m, *restrict ii = s->inv_i;
     const uint8_t *restrict fixed = s->fixed;
+    const uint8_t *restrict hold = s->hold;
     for (int i = 0; i < n; i++) {
         if (fixed[i])
             continue;
         vx[i] = (vx[i] + (f[3 * i] * im[i] + gx) * hdt) * scale;
         vy[i] = (vy[i] + (f[3 * i + 1] * im[i] + gy) * hdt) * scale;
         w[i] = (w[i] + f[3 * i + 2] * ii[i] * hdt) * scale;
+        if (held && hold[i]) {
+            if (hold[i] & BAL_HOLD_X)
+                vx[i] = 0;
+            if (hold[i] & BAL_HOLD_Y)
+                vy[i] = 0;
+            if (hold[i] & BAL_HOLD_ROTATION)
+                w[i] = 0;
+        }
     }
+}
+
+static __attribute__((noinline)) void verlet_velocities_held(struct bal_sim *s)
+{
+    verlet_velocities_with(s, 1);
+}
+
+static void verlet_velocities(struct bal_sim *s)
+{
+    if (s->hold)
+        verlet_velocities_held(s);
+    else
+        verlet_velocities_with(s, 0);
 }
 
 /* v_{N-1/2}, by inverting the second half kick. */
@@ -382,6 +470,15 @@ static void gear_start(struct bal_sim *s)
         r2x[i] = (s->g[0] * s->gfac - s->alpha * s->vx[i]) * half_dt2;
         r2y[i] = (s->g[1] * s->gfac - s->alpha * s->vy[i]) * half_dt2;
         r2t[i] = -s->alpha * s->w[i] * half_dt2;
+        /* a held component keeps all its derivatives at zero: the predictor
+         * then leaves it, and the corrector skips it */
+        const unsigned h = s->hold ? s->hold[i] : 0;
+        if (h & BAL_HOLD_X)
+            r2x[i] = 0;
+        if (h & BAL_HOLD_Y)
+            r2y[i] = 0;
+        if (h & BAL_HOLD_ROTATION)
+            r2t[i] = 0;
     }
     s->gear_started = 1;
 }
@@ -409,7 +506,8 @@ static struct bal_moves gear_positions(struct bal_sim *s)
     return moved_scan(s);
 }
 
-static void gear_velocities(struct bal_sim *s)
+static inline __attribute__((always_inline)) void gear_velocities_with(struct bal_sim *s,
+                                                                       const int held)
 {
     const int n = s->n;
     const double half_dt2 = s->dt * s->dt / 2, inv_dt = 1 / s->dt, alpha = s->alpha;
@@ -422,14 +520,32 @@ static void gear_velocities(struct bal_sim *s)
         double *restrict r4 = gear_col(s, GEAR_R4 + k), *restrict r5 = gear_col(s, GEAR_R5 + k);
         const double *restrict fk = s->f + k, *restrict ik = inv[k];
         const uint8_t *restrict fixed = s->fixed;
+        const uint8_t *restrict hold = s->hold;
+        const unsigned bit = 1u << k; /* BAL_HOLD_X, _Y, _ROTATION (asserted below) */
         const double gk = g[k];
         for (int i = 0; i < n; i++) {
-            if (fixed[i])
+            if (fixed[i] || (held && (hold[i] & bit)))
                 continue;
             const double acc = fk[3 * i] * ik[i] + gk - alpha * vk[i];
             gear_correct(&qk[i], &vk[i], &r2[i], &r3[i], &r4[i], &r5[i], acc, half_dt2, inv_dt);
         }
     }
+}
+
+_Static_assert(BAL_HOLD_X == 1u << 0 && BAL_HOLD_Y == 1u << 1 && BAL_HOLD_ROTATION == 1u << 2,
+               "gear5 finds the hold bit of coordinate k (x, y, θ) as 1 << k");
+
+static __attribute__((noinline)) void gear_velocities_held(struct bal_sim *s)
+{
+    gear_velocities_with(s, 1);
+}
+
+static void gear_velocities(struct bal_sim *s)
+{
+    if (s->hold)
+        gear_velocities_held(s);
+    else
+        gear_velocities_with(s, 0);
 }
 
 static void gear_previous(const struct bal_sim *s, int i, double *vx, double *vy, double *w)
@@ -450,6 +566,30 @@ static const struct bal_integrator_type integrators[] = {
     [BAL_INTEGRATOR_GEAR5] = {"gear5", gear_positions, gear_velocities, gear_previous, 0},
 };
 
+/* With partly held discs: the velocities the contact law read are zero in
+ * the held components (centred and verlet recover them by inverting the
+ * last update, which the hold overrode; gear5 stores them, zero).  A table
+ * of its own, so that the reports of other scenes test nothing. */
+static void centred_previous_held(const struct bal_sim *s, int i, double *vx, double *vy, double *w)
+{
+    centred_previous(s, i, vx, vy, w);
+    zero_held(s, i, vx, vy, w);
+}
+
+static void verlet_previous_held(const struct bal_sim *s, int i, double *vx, double *vy, double *w)
+{
+    verlet_previous(s, i, vx, vy, w);
+    zero_held(s, i, vx, vy, w);
+}
+
+static const struct bal_integrator_type integrators_held[] = {
+    [BAL_INTEGRATOR_CENTRED] = {"centred", centred_positions, centred_velocities,
+                                centred_previous_held, 1},
+    [BAL_INTEGRATOR_VERLET] = {"verlet", verlet_positions, verlet_velocities,
+                               verlet_previous_held, 0},
+    [BAL_INTEGRATOR_GEAR5] = {"gear5", gear_positions, gear_velocities, gear_previous, 0},
+};
+
 struct bal_moves bal_integrate_positions(struct bal_sim *s) { return s->integ->positions(s); }
 
 void bal_integrate_velocities(struct bal_sim *s) { s->integ->velocities(s); }
@@ -462,7 +602,9 @@ void bal_integrate_previous(const struct bal_sim *s, int i, double *vx, double *
 enum bal_status bal_integrate_setup(struct bal_sim *s, struct bal_error *err)
 {
     const int which = s->scene->settings.integrator;
-    s->integ = &integrators[which >= 0 && which <= BAL_INTEGRATOR_GEAR5 ? which : 0];
+    s->integ = &(s->hold ? integrators_held : integrators)[which >= 0 && which <= BAL_INTEGRATOR_GEAR5
+                                                                  ? which
+                                                                  : 0];
     s->par.block_sums = calloc(2 * (size_t)bal_disc_blocks(s->n), sizeof(double));
     if (!s->par.block_sums)
         return bal_error(err, BAL_ENOMEM, "%s: out of memory (%d discs)", s->scene->path, s->n);

@@ -175,7 +175,13 @@ double bal_measure_unbalanced(const struct bal_sim *s)
         if (s->fixed[i])
             continue;
         const double m = bal_mass(s, i);
-        const double sx = s->f[3 * i] + m * s->g[0], sy = s->f[3 * i + 1] + m * s->g[1];
+        double sx = s->f[3 * i] + m * s->g[0], sy = s->f[3 * i + 1] + m * s->g[1];
+        /* a held component is balanced by its hold */
+        const unsigned held = s->hold ? s->hold[i] : 0;
+        if (held & BAL_HOLD_X)
+            sx = 0;
+        if (held & BAL_HOLD_Y)
+            sy = 0;
         smax = fmax(smax, hypot(sx, sy));
     }
     return smax / fbig;

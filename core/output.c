@@ -412,14 +412,26 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
         for (int g = 0; g < sc->n_stages; g++) {
             fprintf(f, "%s\n    {\"name\": ", g ? "," : "");
             json_string(f, sc->stages[g].name);
+            const struct bal_stage_def *st = &sc->stages[g];
             fprintf(f, ", \"cycles\": %ld, \"max_cycles\": %ld, \"stop_rule\": %s, \"stopped\": %s, "
                        "\"ke_over_ee\": ",
-                    s->log[g].cycles, sc->stages[g].cycles,
-                    (sc->stages[g].stop_ke > 0 || sc->stages[g].stop_stress > 0) ? "true" : "false",
+                    s->log[g].cycles, st->cycles,
+                    (st->stop_ke > 0 || st->stop_stress > 0 || st->stop_servo > 0 ||
+                     st->stop_unbalanced > 0) ? "true" : "false",
                     s->log[g].stopped ? "true" : "false");
             json_number(f, s->log[g].ke_over_ee);
             fputs(", \"stress_change\": ", f);
             json_number(f, s->log[g].stress_change);
+            /* The servo and unbalanced rules only where a stage has them: a
+             * scene without keeps the run.json it had. */
+            if (st->stop_servo > 0) {
+                fprintf(f, ", \"stop_servo\": %.17g, \"servo_error\": ", st->stop_servo);
+                json_number(f, s->log[g].servo_error);
+            }
+            if (st->stop_unbalanced > 0) {
+                fprintf(f, ", \"stop_unbalanced\": %.17g, \"unbalanced\": ", st->stop_unbalanced);
+                json_number(f, s->log[g].unbalanced);
+            }
             fputs("}", f);
         }
         fputs("\n  ],\n  \"piles\": [", f);

@@ -13,14 +13,22 @@
  * discs exert on the wall; the moment is about P, counter-clockwise; the
  * eccentricity e/(L/2) is the distance, along the wall, from the wall's
  * centre to the point where the resultant normal force acts, divided by
- * half the wall length (footnote 1 of Table 1).  held_fx, held_fy sum the
- * contact forces on held discs; weight_x, weight_y the gravity on the free
- * ones (with the current ramp).
+ * half the wall length (footnote 1 of Table 1).  wall_px, wall_py are the
+ * wall's point P; wall_gap the distance from wall a to the midpoint of wall
+ * b along a's normal (walls.c, bal_walls_gap: the distance between the
+ * parallel walls of a box, as the controllers measure it); wall_stress the
+ * normal stress a servo measured on the wall in the last cycle (the normal
+ * force of its contact springs over its span, compression positive: at rest
+ * the whole force; 0 when no servo drives the wall).  held_fx, held_fy sum the
+ * contact forces on the discs held along the axis (fixed = 1, or a `hold`
+ * with x or y); weight_x, weight_y the gravity on the discs free along it
+ * (with the current ramp).
  */
 #include <math.h>
 
 #include "measure.h"
 #include "pairs.h"
+#include "walls.h"
 
 /* Contacts whose flags include `flag` (touching, or sliding). */
 static long count_contacts(const struct bal_sim *s, uint8_t flag)
@@ -76,6 +84,18 @@ double bal_probes_value(const struct bal_sim *s, int probe)
         return s->walls[p->a].f[1];
     case BAL_PROBE_WALL_MOMENT:
         return s->walls[p->a].moment;
+    case BAL_PROBE_WALL_PX:
+        return s->walls[p->a].p[0];
+    case BAL_PROBE_WALL_PY:
+        return s->walls[p->a].p[1];
+    case BAL_PROBE_WALL_GAP:
+        return bal_walls_gap(&s->walls[p->a], &s->walls[p->b], NULL);
+    case BAL_PROBE_WALL_STRESS: {
+        /* What the wall's servo measured in the last cycle; 0 for a wall no
+         * servo drives in the current stage. */
+        const struct bal_wall *W = &s->walls[p->a];
+        return W->move && W->move->control == BAL_CONTROL_SERVO ? W->stress : 0;
+    }
     case BAL_PROBE_WALL_ECC: {
         const struct bal_wall *W = &s->walls[p->a];
         if (W->fn_sum == 0)
@@ -127,18 +147,23 @@ double bal_probes_value(const struct bal_sim *s, int probe)
         return (double)count_contacts(s, BAL_PAIR_SLIDING);
     case BAL_PROBE_HELD_FX:
     case BAL_PROBE_HELD_FY: {
+        /* the discs held along the axis: fixed ones, and partly held ones
+         * whose hold includes it */
         double f = 0;
         const int k = p->kind == BAL_PROBE_HELD_FX ? 0 : 1;
+        const unsigned axis = k == 0 ? BAL_HOLD_X : BAL_HOLD_Y;
         for (int i = 0; i < s->n; i++)
-            if (s->fixed[i])
+            if (s->fixed[i] || (s->hold && (s->hold[i] & axis)))
                 f += s->f[3 * i + k];
         return f;
     }
     case BAL_PROBE_WEIGHT_X:
     case BAL_PROBE_WEIGHT_Y: {
+        /* the discs free along the axis */
         double m = 0;
+        const unsigned axis = p->kind == BAL_PROBE_WEIGHT_X ? BAL_HOLD_X : BAL_HOLD_Y;
         for (int i = 0; i < s->n; i++)
-            if (!s->fixed[i])
+            if (!s->fixed[i] && !(s->hold && (s->hold[i] & axis)))
                 m += bal_mass(s, i);
         return m * s->g[p->kind == BAL_PROBE_WEIGHT_X ? 0 : 1] * s->gfac;
     }

@@ -27,6 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "import.h"
 #include "scene.h"
 
 /* Longest line a scene file may hold; longer lines are refused, not cut. */
@@ -61,6 +62,12 @@ static struct section_array section_array(struct bal_scene *s,
         break;
     case BAL_SEC_PILE:
         a = (struct section_array){(void **)&s->piles, &s->n_piles, &s->cap_piles};
+        break;
+    case BAL_SEC_GRAINS:
+        a = (struct section_array){(void **)&s->grains, &s->n_grains, &s->cap_grains};
+        break;
+    case BAL_SEC_IMPORT:
+        a = (struct section_array){(void **)&s->imports, &s->n_imports, &s->cap_imports};
         break;
     case BAL_SEC_STAGE:
         a = (struct section_array){(void **)&s->stages, &s->n_stages, &s->cap_stages};
@@ -241,15 +248,25 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
         return where_error(err, w, key->name, "%s", msg);
     }
     case BAL_KEY_CONTROL: {
-        /* A wall's name, then as many numbers as the key's form has words
-         * after "WALL" (key->choices: "WALL v1 v2 omega"). */
+        /* A wall's name, then what the key's form (key->choices, e.g.
+         * "WALL sigma gain vmax WALL_A WALL_B") has after "WALL": a word
+         * that starts with WALL is the name of another wall, any other
+         * word a finite number. */
         static const char *const counts[BAL_CONTROL_VALUES_MAX + 1] = {
             "no", "one", "two", "three", "four", "five", "six", "seven", "eight"};
         struct bal_stage_def *st = item;
-        int n_values = 0;
-        for (const char *c = key->choices; (c = strchr(c, ' ')) != NULL; c++)
-            n_values++;
+        int n_values = 0, n_walls = 0;
+        char is_wall[BAL_CONTROL_VALUES_MAX + BAL_CONTROL_WALLS_MAX];
+        int n_words = 0;
+        for (const char *c = key->choices; (c = strchr(c, ' ')) != NULL && n_words < (int)sizeof is_wall;) {
+            c++;
+            is_wall[n_words] = strncmp(c, "WALL", 4) == 0;
+            n_walls += is_wall[n_words];
+            n_values += !is_wall[n_words];
+            n_words++;
+        }
         double values[BAL_CONTROL_VALUES_MAX];
+        char walls[BAL_CONTROL_WALLS_MAX][BAL_NAME_MAX + 1];
         char wall[BAL_NAME_MAX + 1], msg[BAL_MSG_MAX];
         int n_read = 0;
         if (sscanf(value, "%48s%n", wall, &n_read) != 1 || !valid_name(wall)) {
@@ -257,22 +274,36 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
             return where_error(err, w, key->name, "%s", msg);
         }
         p = value + n_read;
-        int ok = 1;
-        for (int k = 0; k < n_values && ok; k++)
-            ok = parse_number(&p, &values[k]);
+        int ok = 1, nv = 0, nw = 0;
+        for (int k = 0; k < n_words && ok; k++) {
+            if (!is_wall[k]) {
+                ok = parse_number(&p, &values[nv++]);
+                continue;
+            }
+            int got = 0;
+            ok = sscanf(p, "%48s%n", walls[nw], &got) == 1 && valid_name(walls[nw]);
+            p += got;
+            nw++;
+        }
         if (!ok || !at_end(p)) {
-            snprintf(msg, sizeof msg, "expected '%s' with %s finite numbers, got '%s'",
-                     key->choices, counts[n_values], value);
+            char names[32] = "";
+            if (n_walls > 0)
+                snprintf(names, sizeof names, " and %s wall name%s", counts[n_walls],
+                         n_walls > 1 ? "s" : "");
+            snprintf(msg, sizeof msg, "expected '%s' with %s finite number%s%s, got '%s'",
+                     key->choices, counts[n_values], n_values == 1 ? "" : "s", names, value);
             return where_error(err, w, key->name, "%s", msg);
         }
-        /* In a file a wall is moved once per stage; --set (line 0) replaces
-         * the wall's motion, so a variant can change a loading speed. */
+        /* In a file a wall has one line per stage, whatever its controller;
+         * --set (line 0) replaces the wall's line, so a variant can change a
+         * loading speed (or the controller). */
         struct bal_move_def *m = NULL;
         for (int i = 0; i < st->n_moves; i++) {
             if (strcmp(st->moves[i].wall, wall) != 0)
                 continue;
             if (w.line > 0)
-                return where_error(err, w, key->name, "wall '%s' is moved twice in this stage", wall);
+                return where_error(err, w, key->name,
+                                   "wall '%s' is driven twice in this stage", wall);
             m = &st->moves[i];
         }
         if (!m) {
@@ -280,10 +311,68 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
                 return where_error(err, w, key->name, "more than %s moves in one stage", "16");
             m = &st->moves[st->n_moves++];
         }
+        memset(m, 0, sizeof *m);
         strcpy(m->wall, wall);
         m->line = w.line;
         m->control = bal_scene_key_control(key->name);
         memcpy((char *)m + key->offset, values, (size_t)n_values * sizeof(double));
+        for (int k = 0; k < n_walls; k++)
+            strcpy(m->walls[k], walls[k]);
+        return BAL_OK;
+    }
+    case BAL_KEY_FILE: {
+        /* The path as written; the file, relative to the scene's directory,
+         * is read now into the section (import.c), and only a file read
+         * whole replaces what the section held. */
+        if (!*value) { /* the default: no file */
+            *field = '\0';
+            return BAL_OK;
+        }
+        if (strlen(value) >= BAL_PATH_MAX)
+            return where_error(err, w, key->name, "%s", "expected a path of at most 511 characters");
+        char path[2 * BAL_PATH_MAX + 1];
+        const char *slash = strrchr(w.file, '/');
+        if (value[0] == '/' || !slash)
+            snprintf(path, sizeof path, "%s", value);
+        else
+            snprintf(path, sizeof path, "%.*s/%s", (int)(slash - w.file), w.file, value);
+        char msg[BAL_MSG_MAX];
+        const enum bal_status st = bal_import_read(item, key->choices, path, msg, sizeof msg);
+        if (st != BAL_OK) {
+            where_error(err, w, key->name, "%s", msg);
+            err->code = st;
+            return st;
+        }
+        strcpy(field, value);
+        return BAL_OK;
+    }
+    case BAL_KEY_FLAGS: {
+        /* "none", or words of key->choices separated by spaces: bit k for
+         * the k-th word. */
+        int bits = 0;
+        char words[LINE_MAX_CHARS];
+        snprintf(words, sizeof words, "%s", value);
+        for (char *save = NULL, *word = strtok_r(words, " \t", &save); word;
+             word = strtok_r(NULL, " \t", &save)) {
+            if (strcmp(word, "none") == 0)
+                continue;
+            int idx = 0, found = -1;
+            for (const char *c = key->choices; *c; idx++) {
+                const char *e = strchr(c, ' ');
+                const size_t len = e ? (size_t)(e - c) : strlen(c);
+                if (len == strlen(word) && strncmp(c, word, len) == 0)
+                    found = idx;
+                c += len + (e ? 1 : 0);
+            }
+            if (found < 0) {
+                char msg[BAL_MSG_MAX];
+                snprintf(msg, sizeof msg, "expected 'none' or words of {%s}, got '%s'",
+                         key->choices, word);
+                return where_error(err, w, key->name, "%s", msg);
+            }
+            bits |= 1 << found;
+        }
+        memcpy(field, &bits, sizeof bits);
         return BAL_OK;
     }
     }
@@ -321,6 +410,10 @@ void bal_scene_free(struct bal_scene *s)
     free(s->walls);
     free(s->fills);
     free(s->piles);
+    free(s->grains);
+    for (int i = 0; i < s->n_imports; i++)
+        bal_import_free(&s->imports[i]);
+    free(s->imports);
     free(s->stages);
     free(s->probes);
     memset(s, 0, sizeof *s);
@@ -466,7 +559,7 @@ enum bal_status bal_scene_parse(struct bal_scene *s, const char *text,
             if (k < 0)
                 return bal_error(err, BAL_EINVAL,
                                  "%s:%d: [%s]: unknown section; expected one of settings, "
-                                 "material, disc, wall, fill, pile, stage, probe",
+                                 "material, disc, wall, fill, pile, grains, import, stage, probe",
                                  w.file, w.line, inner);
             if (bal_scene_sections[k].named && !*sec_name)
                 return bal_error(err, BAL_EINVAL, "%s:%d: [%s]: a name is required: [%s NAME]",

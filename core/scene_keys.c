@@ -35,12 +35,18 @@
 #define F(field) offsetof(struct bal_fill_def, field)
 #define G(field) offsetof(struct bal_stage_def, field)
 #define Q(field) offsetof(struct bal_pile_def, field)
+#define R(field) offsetof(struct bal_grains_def, field)
+#define I(field) offsetof(struct bal_import_def, field)
 #define P(field) offsetof(struct bal_probe_def, field)
 #define MV(field) offsetof(struct bal_move_def, field)
 
-/* `move` stores its three numbers from v on: v[0], v[1], omega. */
+/* A controller's numbers are consecutive doubles of struct bal_move_def from
+ * its key's offset on: `move` v[0], v[1], omega; `servo` sigma, gain, vmax;
+ * `strain_rate` rate. */
 _Static_assert(offsetof(struct bal_move_def, omega) == MV(v) + 2 * sizeof(double),
                "the numbers of `move` are consecutive doubles of struct bal_move_def");
+_Static_assert(MV(gain) == MV(sigma) + sizeof(double) && MV(vmax) == MV(sigma) + 2 * sizeof(double),
+               "the numbers of `servo` are consecutive doubles of struct bal_move_def");
 
 const struct bal_key bal_scene_keys[] = {
     /* [settings] */
@@ -122,6 +128,9 @@ const struct bal_key bal_scene_keys[] = {
      "initial angular velocity, rad/time, counter-clockwise"},
     {BAL_SEC_DISC, "fixed", BAL_KEY_LONG, D(fixed), "0", 0, 0, 1, NULL,
      "1: the disc is held (its velocity stays zero; it still feels forces)"},
+    {BAL_SEC_DISC, "hold", BAL_KEY_FLAGS, D(hold), NULL, 0, 0, 0, "x y rotation",
+     "components of the disc's motion held at zero, e.g. 'x rotation' (all three: fixed = 1); "
+     "the held coordinates stay, the others move (docs/physics.md)"},
 
     /* [wall NAME] */
     {BAL_SEC_WALL, "p", BAL_KEY_VEC2, W(p), NULL, 1, -BIG, BIG, NULL,
@@ -175,6 +184,50 @@ const struct bal_key bal_scene_keys[] = {
     {BAL_SEC_PILE, "wall_material", BAL_KEY_NAME, Q(wall_material), "", 0, 0, 0, NULL,
      "material of the floor (required with bottom = smooth)"},
 
+    /* [grains NAME] */
+    {BAL_SEC_GRAINS, "n", BAL_KEY_LONG, R(n), NULL, 1, 1, 100000000.0, NULL, "number of discs"},
+    {BAL_SEC_GRAINS, "origin", BAL_KEY_VEC2, R(origin), "0 0", 0, -BIG, BIG, NULL,
+     "lower-left corner of the region"},
+    {BAL_SEC_GRAINS, "size", BAL_KEY_VEC2, R(size), NULL, 1, 1e-300, BIG, NULL,
+     "width and height of the region (every disc lies inside it)"},
+    {BAL_SEC_GRAINS, "dmin", BAL_KEY_DOUBLE, R(dmin), NULL, 1, 1e-300, BIG, NULL,
+     "smallest diameter: 0 % of the discs' area is finer"},
+    {BAL_SEC_GRAINS, "d10", BAL_KEY_DOUBLE, R(d10), NULL, 1, 1e-300, BIG, NULL,
+     "diameter than which 10 % of the discs' area is finer (grading by area, linear between "
+     "the given points)"},
+    {BAL_SEC_GRAINS, "d50", BAL_KEY_DOUBLE, R(d50), NULL, 1, 1e-300, BIG, NULL,
+     "... 50 % (the median by area)"},
+    {BAL_SEC_GRAINS, "d60", BAL_KEY_DOUBLE, R(d60), NULL, 1, 1e-300, BIG, NULL,
+     "... 60 % (C_u = d60/d10)"},
+    {BAL_SEC_GRAINS, "dmax", BAL_KEY_DOUBLE, R(dmax), NULL, 1, 1e-300, BIG, NULL,
+     "largest diameter: 100 % of the area is finer"},
+    {BAL_SEC_GRAINS, "seed", BAL_KEY_LONG, R(seed), "1", 0, 0, 4294967295.0, NULL,
+     "seed of GSL's gsl_rng_mt19937 (same seed, same discs on every machine; 0 is GSL's 4357)"},
+    {BAL_SEC_GRAINS, "tries", BAL_KEY_LONG, R(tries), "100000", 0, 1, 1e7, NULL,
+     "random places tried for one disc before the generator gives up (a larger region helps)"},
+    {BAL_SEC_GRAINS, "box", BAL_KEY_LONG, R(box), "0", 0, 0, 1, NULL,
+     "1: add four walls on the region's sides (named NAME_bottom/_right/_top/_left)"},
+    {BAL_SEC_GRAINS, "overhang", BAL_KEY_DOUBLE, R(overhang), "-1", 0, -1, BIG, NULL,
+     "how far each box wall reaches beyond the corners (so the side walls can move out); "
+     "-1 = dmax"},
+    {BAL_SEC_GRAINS, "material", BAL_KEY_NAME, R(material), NULL, 1, 0, 0, NULL,
+     "material of the discs"},
+    {BAL_SEC_GRAINS, "wall_material", BAL_KEY_NAME, R(wall_material), "", 0, 0, 0, NULL,
+     "material of the box walls (required with box = 1)"},
+
+    /* [import NAME] */
+    {BAL_SEC_IMPORT, "discs", BAL_KEY_FILE, I(discs), NULL, 1, 0, 0, "discs",
+     "a discs.tsv a run wrote (columns x y r theta, and vx vy omega fixed if present), relative "
+     "to the scene's directory: its discs, in its order, named NAME.k"},
+    {BAL_SEC_IMPORT, "walls", BAL_KEY_FILE, I(walls), "", 0, 0, 0, "walls",
+     "a walls.tsv a run wrote (columns name ax ay bx by): its walls, from A to B, with their names"},
+    {BAL_SEC_IMPORT, "material", BAL_KEY_NAME, I(material), NULL, 1, 0, 0, NULL,
+     "material of the discs"},
+    {BAL_SEC_IMPORT, "wall_material", BAL_KEY_NAME, I(wall_material), "", 0, 0, 0, NULL,
+     "material of the walls (required with walls)"},
+    {BAL_SEC_IMPORT, "velocities", BAL_KEY_LONG, I(velocities), "0", 0, 0, 1, NULL,
+     "1: the discs start with the file's vx vy omega; 0: at rest"},
+
     /* [stage NAME] */
     {BAL_SEC_STAGE, "cycles", BAL_KEY_LONG, G(cycles), NULL, 1, 0, 1e15, NULL,
      "number of calculation cycles in this stage (0: the stage is skipped)"},
@@ -186,12 +239,30 @@ const struct bal_key bal_scene_keys[] = {
      "... and the disc stresses change by <= this share of the largest between checks"},
     {BAL_SEC_STAGE, "check_every", BAL_KEY_LONG, G(check_every), "100", 0, 1, 1e15, NULL,
      "cycles between checks of the stop rule"},
+    {BAL_SEC_STAGE, "output_at_end", BAL_KEY_LONG, G(output_at_end), "0", 0, 0, 1, NULL,
+     "1: write a series row after the stage's last cycle (its count or its stop rule), so the "
+     "next stage's start is in series.tsv"},
+    {BAL_SEC_STAGE, "stop_servo", BAL_KEY_DOUBLE, G(stop_servo), "0", 0, 0, BIG, NULL,
+     "... and every servo wall of the stage is within this share of its target stress (0: off)"},
+    {BAL_SEC_STAGE, "stop_unbalanced", BAL_KEY_DOUBLE, G(stop_unbalanced), "0", 0, 0, BIG, NULL,
+     "... and the unbalanced-force ratio (probe unbalanced, C&S dF/F) is <= this (0: off)"},
     /* A wall controller's key (walls.c; bal_scene_controls says which): its
      * numbers go, in order, to consecutive doubles of struct bal_move_def
-     * from `offset` on. */
+     * from `offset` on; the words of its form that start with WALL after
+     * the first are the names of other walls (struct bal_move_def, walls). */
     {BAL_SEC_STAGE, "move", BAL_KEY_CONTROL, MV(v), NULL, 0, -BIG, BIG, "WALL v1 v2 omega",
      "repeatable: WALL v1 v2 omega; velocity of P and angular velocity about P (C&S p. 53); "
      "walls not named are at rest; --set replaces the named wall's motion"},
+    {BAL_SEC_STAGE, "servo", BAL_KEY_CONTROL, MV(sigma), NULL, 0, -BIG, BIG,
+     "WALL sigma gain vmax WALL_A WALL_B",
+     "repeatable: the wall holds the normal stress sigma (the normal force of its contact springs "
+     "over the distance between WALL_A and WALL_B), removing the share gain (0 < gain < 2; <= 1 "
+     "monotone) of the error per cycle, at most vmax fast (0: 1e-3 of the smallest radius per "
+     "step)"},
+    {BAL_SEC_STAGE, "strain_rate", BAL_KEY_CONTROL, MV(rate), NULL, 0, -BIG, BIG,
+     "WALL rate WALL_TO",
+     "repeatable: the wall moves along its normal towards WALL_TO at rate x their distance "
+     "(a logarithmic strain rate, 1/time; < 0 moves away)"},
 
     /* [probe NAME] */
     {BAL_SEC_PROBE, "quantity", BAL_KEY_ENUM, P(kind), NULL, 1, 0, 0,
@@ -200,12 +271,12 @@ const struct bal_key bal_scene_keys[] = {
      "energy_kinetic energy_elastic work_walls work_gravity dissipated_dashpot "
      "dissipated_friction dissipated_global energy_imbalance unbalanced n_contacts n_sliding "
      "held_fx held_fy weight_x weight_y contact_mr contact_theta_r contact_rolling "
-     "dissipated_rolling",
+     "dissipated_rolling wall_px wall_py wall_gap wall_stress",
      "what the series column holds"},
     {BAL_SEC_PROBE, "a", BAL_KEY_NAME, P(a), "", 0, 0, 0, NULL,
      "body: the disc (disc_*), the wall (wall_*), or the first body of a contact"},
     {BAL_SEC_PROBE, "b", BAL_KEY_NAME, P(b), "", 0, 0, 0, NULL,
-     "second body of a contact (contact_*)"},
+     "second body of a contact (contact_*), or the second wall of wall_gap"},
 };
 
 const size_t bal_scene_n_keys = sizeof bal_scene_keys / sizeof bal_scene_keys[0];
@@ -213,6 +284,8 @@ const size_t bal_scene_n_keys = sizeof bal_scene_keys / sizeof bal_scene_keys[0]
 /* Each wall controller's stage key (a BAL_KEY_CONTROL row above). */
 const struct bal_control_key bal_scene_controls[] = {
     {"move", BAL_CONTROL_PRESCRIBED},
+    {"servo", BAL_CONTROL_SERVO},
+    {"strain_rate", BAL_CONTROL_STRAIN_RATE},
 };
 
 const size_t bal_scene_n_controls = sizeof bal_scene_controls / sizeof bal_scene_controls[0];
@@ -227,6 +300,10 @@ const struct bal_section_info bal_scene_sections[BAL_SEC_COUNT] = {
     {"wall", 1, SEC(bal_wall_def), "a straight rigid wall (C&S Fig. 4)"},
     {"fill", 1, SEC(bal_fill_def), "a generator of many discs on a lattice"},
     {"pile", 1, SEC(bal_pile_def), "a generator of a pile on a triangular lattice (MLH Fig. 2)"},
+    {"grains", 1, SEC(bal_grains_def),
+     "a generator of discs from a grading curve, placed at random without overlap"},
+    {"import", 1, SEC(bal_import_def),
+     "a prepared state: the discs and walls of the files a run wrote"},
     {"stage", 1, SEC(bal_stage_def), "a stage of the loading protocol, run in file order"},
     {"probe", 1, SEC(bal_probe_def), "a column of series.tsv, in file order"},
 };
@@ -276,7 +353,7 @@ const struct bal_key *bal_scene_key_at(enum bal_section_kind sec, int k)
 void bal_scene_print_keys(FILE *out)
 {
     static const char *const type_names[] = {"number", "integer", "two numbers", "name",
-                                             "word", NULL};
+                                             "word", NULL, "file", "words"};
     for (int k = 0; k < BAL_SEC_COUNT; k++) {
         const struct bal_section_info *sec = &bal_scene_sections[k];
         fprintf(out, "\n`[%s%s]` — %s\n\n", sec->name, sec->named ? " NAME" : "", sec->doc);
@@ -291,6 +368,8 @@ void bal_scene_print_keys(FILE *out)
             const char *shown = range;
             if (key->type == BAL_KEY_ENUM)
                 shown = key->choices;
+            else if (key->type == BAL_KEY_FLAGS)
+                snprintf(range, sizeof range, "none, or any of: %s", key->choices);
             else if (key->type == BAL_KEY_DOUBLE || key->type == BAL_KEY_LONG) {
                 char lo[32] = "", hi[32] = "";
                 if (key->min > -1e300)

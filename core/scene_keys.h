@@ -23,13 +23,19 @@ enum bal_key_type {
     BAL_KEY_VEC2,     /* two finite numbers */
     BAL_KEY_NAME,     /* a name of another section (resolved in validate) */
     BAL_KEY_ENUM,     /* one word of `choices` (space separated), stored as int */
-    BAL_KEY_CONTROL   /* repeatable: a wall controller's line of a stage, "WALL" and its
+    BAL_KEY_CONTROL,  /* repeatable: a wall controller's line of a stage, "WALL" and its
                        * numbers (struct bal_move_def; see struct bal_key) */
+    BAL_KEY_FILE,     /* a data file's path, relative to the scene's directory, read when
+                       * the key is parsed: `choices` says what it holds ("discs", "walls";
+                       * import.c), the section struct its data */
+    BAL_KEY_FLAGS     /* any of the words of `choices`, or "none", stored as an int with
+                       * bit k for the k-th word */
 };
 
 enum bal_section_kind {
     BAL_SEC_SETTINGS, BAL_SEC_MATERIAL, BAL_SEC_DISC, BAL_SEC_WALL,
-    BAL_SEC_FILL, BAL_SEC_PILE, BAL_SEC_STAGE, BAL_SEC_PROBE, BAL_SEC_COUNT
+    BAL_SEC_FILL, BAL_SEC_PILE, BAL_SEC_GRAINS, BAL_SEC_IMPORT, BAL_SEC_STAGE, BAL_SEC_PROBE,
+    BAL_SEC_COUNT
 };
 
 struct bal_key {

@@ -13,7 +13,9 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "import.h"
 #include "scene.h"
+#include "walls.h"
 
 static int line_of(void *item, enum bal_section_kind k, const char *key)
 {
@@ -65,65 +67,113 @@ static enum bal_status check_material_ref(const struct bal_scene *s, void *item,
     return BAL_OK;
 }
 
-/* Is `name` a disc, a wall, or a wall made by a fill's box? */
+static const char *const box_sides[] = {"_bottom", "_right", "_top", "_left"};
+
+/* Is `name` a wall a generator makes: a boxed [fill]'s or [grains]'s, a
+ * smooth [pile]'s floor, an [import]'s?  Its header line into *line. */
+static int generated_wall(const struct bal_scene *s, const char *name, int *line)
+{
+    for (int k = 0; k < s->n_fills + s->n_grains; k++) {
+        const int fill = k < s->n_fills;
+        const char *sec = fill ? s->fills[k].name : s->grains[k - s->n_fills].name;
+        if (!(fill ? s->fills[k].box : s->grains[k - s->n_fills].box))
+            continue;
+        for (int side = 0; side < 4; side++) {
+            char nm[2 * BAL_NAME_MAX];
+            snprintf(nm, sizeof nm, "%s%s", sec, box_sides[side]);
+            if (strcmp(nm, name) == 0) {
+                *line = fill ? s->fills[k].line : s->grains[k - s->n_fills].line;
+                return 1;
+            }
+        }
+    }
+    for (int p = 0; p < s->n_piles; p++) {
+        char nm[2 * BAL_NAME_MAX];
+        snprintf(nm, sizeof nm, "%s_floor", s->piles[p].name);
+        if (s->piles[p].bottom == 0 && strcmp(nm, name) == 0) {
+            *line = s->piles[p].line;
+            return 1;
+        }
+    }
+    for (int i = 0; i < s->n_imports; i++)
+        for (int k = 0; k < s->imports[i].n_walls; k++)
+            if (strcmp(s->imports[i].wall_data[k].name, name) == 0) {
+                *line = s->imports[i].line;
+                return 1;
+            }
+    return 0;
+}
+
+/* Is `name` a disc, a wall, or a wall a generator makes? */
 static int body_exists(const struct bal_scene *s, const char *name, int *is_wall)
 {
     if (bal_scene_find(s, BAL_SEC_DISC, name) >= 0) {
         *is_wall = 0;
         return 1;
     }
-    if (bal_scene_find(s, BAL_SEC_WALL, name) >= 0) {
+    int line;
+    if (bal_scene_find(s, BAL_SEC_WALL, name) >= 0 || generated_wall(s, name, &line)) {
         *is_wall = 1;
         return 1;
-    }
-    for (int p = 0; p < s->n_piles; p++) {
-        char nm[2 * BAL_NAME_MAX];
-        snprintf(nm, sizeof nm, "%s_floor", s->piles[p].name);
-        if (s->piles[p].bottom == 0 && strcmp(nm, name) == 0) {
-            *is_wall = 1;
-            return 1;
-        }
-    }
-    static const char *const sides[] = {"_bottom", "_right", "_top", "_left"};
-    for (int f = 0; f < s->n_fills; f++) {
-        if (!s->fills[f].box)
-            continue;
-        for (int k = 0; k < 4; k++) {
-            char nm[2 * BAL_NAME_MAX];
-            snprintf(nm, sizeof nm, "%s%s", s->fills[f].name, sides[k]);
-            if (strcmp(nm, name) == 0) {
-                *is_wall = 1;
-                return 1;
-            }
-        }
     }
     return 0;
 }
 
 /* Probes and moves find bodies by name, so a disc, a wall and the walls a
- * fill box or a smooth pile makes must not share one (else the first found
- * wins silently; seen by reading, while fuzzing). */
+ * generator makes (fill and grains boxes, smooth pile floors, imports) must
+ * not share one (else the first found wins silently; seen by reading, while
+ * fuzzing). */
 static enum bal_status check_body_names(const struct bal_scene *s, struct bal_error *err)
 {
-    static const char *const sides[] = {"_bottom", "_right", "_top", "_left"};
     for (int i = 0; i < s->n_walls; i++)
         if (bal_scene_find(s, BAL_SEC_DISC, s->walls[i].name) >= 0)
             return bal_error(err, BAL_EINVAL, "%s:%d: [wall %s]: a disc has this name too; "
                              "probes and moves need one body per name",
                              s->path, s->walls[i].line, s->walls[i].name);
-    for (int k = 0; k < s->n_fills + s->n_piles; k++) {
-        const int fill = k < s->n_fills;
-        const char *name = fill ? s->fills[k].name : s->piles[k - s->n_fills].name;
-        const int line = fill ? s->fills[k].line : s->piles[k - s->n_fills].line;
-        if (fill ? !s->fills[k].box : s->piles[k - s->n_fills].bottom != 0)
-            continue;
-        for (int side = 0; side < (fill ? 4 : 1); side++) {
-            char nm[2 * BAL_NAME_MAX];
-            snprintf(nm, sizeof nm, "%s%s", name, fill ? sides[side] : "_floor");
-            if (bal_scene_find(s, BAL_SEC_DISC, nm) >= 0 || bal_scene_find(s, BAL_SEC_WALL, nm) >= 0)
-                return bal_error(err, BAL_EINVAL, "%s:%d: [%s %s]: makes a wall '%s', but a disc "
-                                 "or wall has that name already",
-                                 s->path, line, fill ? "fill" : "pile", name, nm);
+    /* Each generated wall against the named bodies and the generated walls
+     * before it: the sections in file order of their kinds, as the builder
+     * makes them. */
+    char seen_name[2 * BAL_NAME_MAX];
+    for (int pass = 0; pass < 4; pass++) {
+        const int count = pass == 0 ? s->n_fills : pass == 1 ? s->n_piles
+                        : pass == 2 ? s->n_grains : s->n_imports;
+        for (int k = 0; k < count; k++) {
+            const char *kind = pass == 0 ? "fill" : pass == 1 ? "pile" : pass == 2 ? "grains" : "import";
+            const char *name = pass == 0 ? s->fills[k].name : pass == 1 ? s->piles[k].name
+                             : pass == 2 ? s->grains[k].name : s->imports[k].name;
+            const int line = pass == 0 ? s->fills[k].line : pass == 1 ? s->piles[k].line
+                           : pass == 2 ? s->grains[k].line : s->imports[k].line;
+            int n_made = 0;
+            if (pass == 0 || pass == 2)
+                n_made = (pass == 0 ? s->fills[k].box : s->grains[k].box) ? 4 : 0;
+            else if (pass == 1)
+                n_made = s->piles[k].bottom == 0;
+            else
+                n_made = s->imports[k].n_walls;
+            for (int w = 0; w < n_made; w++) {
+                if (pass == 3)
+                    snprintf(seen_name, sizeof seen_name, "%s", s->imports[k].wall_data[w].name);
+                else
+                    snprintf(seen_name, sizeof seen_name, "%s%s", name,
+                             pass == 1 ? "_floor" : box_sides[w]);
+                int clash = bal_scene_find(s, BAL_SEC_DISC, seen_name) >= 0 ||
+                            bal_scene_find(s, BAL_SEC_WALL, seen_name) >= 0;
+                /* ... or a generated wall made before it */
+                int first_line = 0;
+                struct bal_scene before = *s;
+                before.n_fills = pass == 0 ? k : s->n_fills;
+                before.n_piles = pass < 1 ? 0 : pass == 1 ? k : s->n_piles;
+                before.n_grains = pass < 2 ? 0 : pass == 2 ? k : s->n_grains;
+                before.n_imports = pass < 3 ? 0 : k;
+                clash |= generated_wall(&before, seen_name, &first_line);
+                if (!clash && pass == 3)
+                    for (int q = 0; q < w; q++)
+                        clash |= strcmp(s->imports[k].wall_data[q].name, seen_name) == 0;
+                if (clash)
+                    return bal_error(err, BAL_EINVAL, "%s:%d: [%s %s]: makes a wall '%s', but a "
+                                     "disc or wall has that name already",
+                                     s->path, line, kind, name, seen_name);
+            }
         }
     }
     return BAL_OK;
@@ -155,6 +205,11 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
         if (d->fixed && (d->v[0] != 0 || d->v[1] != 0 || d->omega != 0))
             return FAIL_AT(d, BAL_SEC_DISC, "fixed", "%s",
                            "a held disc cannot have a velocity (v and omega must be 0)");
+        if (((d->hold & BAL_HOLD_X) && d->v[0] != 0) || ((d->hold & BAL_HOLD_Y) && d->v[1] != 0) ||
+            ((d->hold & BAL_HOLD_ROTATION) && d->omega != 0))
+            return FAIL_AT(d, BAL_SEC_DISC, "hold", "%s",
+                           "a held component cannot have a velocity (v1 with x, v2 with y, omega "
+                           "with rotation must be 0)");
     }
     for (int i = 0; i < s->n_walls; i++) {
         struct bal_wall_def *w = &s->walls[i];
@@ -193,6 +248,45 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
                                "a smooth bottom needs L >= 3 (two corner stones and a free disc)");
         }
     }
+    for (int i = 0; i < s->n_grains; i++) {
+        struct bal_grains_def *g = &s->grains[i];
+        /* The grading curve rises: dmin <= d10 <= d50 <= d60 <= dmax. */
+        const double d[5] = {g->dmin, g->d10, g->d50, g->d60, g->dmax};
+        static const char *const names[5] = {"dmin", "d10", "d50", "d60", "dmax"};
+        for (int k = 1; k < 5; k++)
+            if (!(d[k] >= d[k - 1]))
+                return FAIL_AT(g, BAL_SEC_GRAINS, names[k],
+                               "expected dmin <= d10 <= d50 <= d60 <= dmax (the share finer "
+                               "by area rises with d), got %s = %g < %s = %g",
+                               names[k], d[k], names[k - 1], d[k - 1]);
+        if (!(g->size[0] >= g->dmax && g->size[1] >= g->dmax))
+            return FAIL_AT(g, BAL_SEC_GRAINS, "size",
+                           "the region %g x %g must be at least dmax = %g wide and high",
+                           g->size[0], g->size[1], g->dmax);
+        if (check_material_ref(s, g, BAL_SEC_GRAINS, "material", g->material, 1, err))
+            return err->code;
+        if (g->box) {
+            if (!*g->wall_material)
+                return FAIL_AT(g, BAL_SEC_GRAINS, "wall_material", "%s", "required with box = 1");
+            if (check_material_ref(s, g, BAL_SEC_GRAINS, "wall_material", g->wall_material, 0, err))
+                return err->code;
+        }
+    }
+    for (int i = 0; i < s->n_imports; i++) {
+        struct bal_import_def *m = &s->imports[i];
+        if (check_material_ref(s, m, BAL_SEC_IMPORT, "material", m->material, 1, err))
+            return err->code;
+        if (*m->walls) {
+            if (!*m->wall_material)
+                return FAIL_AT(m, BAL_SEC_IMPORT, "wall_material", "%s",
+                               "required with walls (the imported walls' material)");
+            if (check_material_ref(s, m, BAL_SEC_IMPORT, "wall_material", m->wall_material, 0, err))
+                return err->code;
+        }
+        if (m->velocities && !bal_import_has_velocities(m))
+            return FAIL_AT(m, BAL_SEC_IMPORT, "velocities",
+                           "the discs file %s has no columns vx, vy, omega to start from", m->discs);
+    }
     for (int i = 0; i < s->n_materials; i++) {
         struct bal_material_def *m = &s->materials[i];
         if (!(m->ks >= 1e-150 || m->ks == -1))
@@ -206,19 +300,34 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
                                           "add e.g. [stage run] with cycles = N", s->path);
     for (int i = 0; i < s->n_stages; i++) {
         struct bal_stage_def *g = &s->stages[i];
+        int servos = 0;
         for (int m = 0; m < g->n_moves; m++) {
             const struct bal_move_def *mv = &g->moves[m];
+            const char *key = bal_scene_key_for_control(mv->control);
+            /* A line from --set has no line of its own: the stage's header. */
+            const int line = mv->line > 0 ? mv->line : g->line;
             int is_wall = 0;
             if (!body_exists(s, mv->wall, &is_wall) || !is_wall)
                 return bal_error(err, BAL_EINVAL, "%s:%d: %s: no wall named '%s'", s->path,
-                                 mv->line, bal_scene_key_for_control(mv->control), mv->wall);
+                                 line, key, mv->wall);
+            for (int q = 0; q < BAL_CONTROL_WALLS_MAX; q++)
+                if (*mv->walls[q] && (!body_exists(s, mv->walls[q], &is_wall) || !is_wall))
+                    return bal_error(err, BAL_EINVAL, "%s:%d: %s: no wall named '%s'", s->path,
+                                     line, key, mv->walls[q]);
+            char why[BAL_MSG_MAX / 2];
+            if (bal_walls_check(mv, why, sizeof why))
+                return bal_error(err, BAL_EINVAL, "%s:%d: %s: %s", s->path, line, key, why);
+            servos += mv->control == BAL_CONTROL_SERVO;
         }
+        if (g->stop_servo > 0 && servos == 0)
+            return FAIL_AT(g, BAL_SEC_STAGE, "stop_servo", "%s",
+                           "no wall of this stage has a servo to be within the tolerance");
     }
     for (int i = 0; i < s->n_probes; i++) {
         struct bal_probe_def *p = &s->probes[i];
         int k = p->kind, wa = 0, wb = 0;
         int contact = bal_probe_is_contact(k);
-        int wall = k >= BAL_PROBE_WALL_F1 && k <= BAL_PROBE_WALL_ECC;
+        int wall = bal_probe_is_wall(k);
         int disc = k >= BAL_PROBE_DISC_X && k <= BAL_PROBE_DISC_OMEGA;
         if (contact || wall || disc) {
             if (!*p->a)
@@ -241,13 +350,23 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
                 return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "two walls never make a contact");
             if (strcmp(p->a, p->b) == 0)
                 return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "a body cannot touch itself");
+        } else if (k == BAL_PROBE_WALL_GAP) {
+            if (!*p->b)
+                return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "wall_gap needs a second wall in 'b'");
+            if (!body_exists(s, p->b, &wb) || !wb)
+                return FAIL_AT(p, BAL_SEC_PROBE, "b", "no wall named '%s'", p->b);
+            if (strcmp(p->a, p->b) == 0)
+                return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "the gap of a wall to itself is 0");
         } else if (*p->b) {
-            return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "only contact probes take a second body");
+            return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s",
+                           "only contact probes and wall_gap take a second body");
         }
     }
-    if (s->n_discs == 0 && s->n_fills == 0 && s->n_piles == 0)
+    if (s->n_discs == 0 && s->n_fills == 0 && s->n_piles == 0 && s->n_grains == 0 &&
+        s->n_imports == 0)
         return bal_error(err, BAL_EINVAL,
-                         "%s: no discs: add [disc NAME], [fill NAME] or [pile NAME] sections", s->path);
+                         "%s: no discs: add [disc NAME], [fill NAME], [pile NAME], [grains NAME] "
+                         "or [import NAME] sections", s->path);
     return BAL_OK;
 }
 

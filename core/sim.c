@@ -102,6 +102,7 @@ void bal_sim_free(struct bal_sim *s)
     free(s->slot);
     free(s->mat);
     free(s->fixed);
+    free(s->hold);
     free(s->walls);
     free(s->law);
     free(s->probes);
@@ -244,9 +245,18 @@ static enum bal_status check_finite(const struct bal_sim *s, struct bal_error *e
     return BAL_OK;
 }
 
-/* The stop rule of a stage (MLH Sec. 3: "the kinetic energy has to be orders
- * of magnitude smaller than the elastic energy ... and the stresses no longer
- * vary with time"): record both measures and say whether the rule is met. */
+/* Does stage g have a stop rule? */
+static int has_stop_rule(const struct bal_stage_def *g)
+{
+    return g->stop_ke > 0 || g->stop_stress > 0 || g->stop_servo > 0 || g->stop_unbalanced > 0;
+}
+
+/* The stop rule of a stage: every rule it gives must hold.  MLH Sec. 3: "the
+ * kinetic energy has to be orders of magnitude smaller than the elastic
+ * energy ... and the stresses no longer vary with time" (stop_ke,
+ * stop_stress); a servo-controlled consolidation (JYH Sec. 5.1): every servo
+ * wall within stop_servo of its target stress, and ΔF/F within
+ * stop_unbalanced.  Record the measures and say whether the rule is met. */
 static int stop_rule_met(struct bal_sim *s, const struct bal_stage_def *g, struct bal_stage_log *log)
 {
     const double ee = bal_measure_elastic(s);
@@ -264,6 +274,19 @@ static int stop_rule_met(struct bal_sim *s, const struct bal_stage_def *g, struc
         log->stress_change = log->stress_change < 0 ? INFINITY : (size > 0 ? change / size : 0);
         met = met && log->stress_change <= g->stop_stress;
     }
+    if (g->stop_servo > 0) {
+        /* The stresses the servos measured in this cycle (bal_walls_control). */
+        double worst = 0;
+        for (int k = 0; k < s->n_walls; k++)
+            if (s->walls[k].move && s->walls[k].move->control == BAL_CONTROL_SERVO)
+                worst = fmax(worst, s->walls[k].stress_error);
+        log->servo_error = worst;
+        met = met && worst <= g->stop_servo;
+    }
+    if (g->stop_unbalanced > 0) {
+        log->unbalanced = bal_measure_unbalanced(s);
+        met = met && log->unbalanced <= g->stop_unbalanced;
+    }
     return met;
 }
 
@@ -278,7 +301,7 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
     for (int g = 0; g < sc->n_stages && status == BAL_OK; g++) {
         const struct bal_stage_def *stage = &sc->stages[g];
         struct bal_stage_log *log = &s->log[g];
-        const int rule = stage->stop_ke > 0 || stage->stop_stress > 0;
+        const int rule = has_stop_rule(stage);
         bal_sim_set_stage(s, g);
         const long cycles = stage->cycles;
         for (long c = 0; c < cycles; c++) {
@@ -290,7 +313,9 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
             if (stage->ramp)
                 s->gfac = (double)(c + 1) / (double)cycles;
             const int check = rule && (c + 1) % stage->check_every == 0;
-            const int last = g == sc->n_stages - 1 && c == cycles - 1;
+            /* A row after the last cycle of the run, and of a stage that asks
+             * for one (output_at_end: the state where the next stage starts). */
+            const int last = (g == sc->n_stages - 1 || stage->output_at_end) && c == cycles - 1;
             const int row = series && ((s->step + 1) % every == 0 || last);
             if ((status = cycle(s, err)) != BAL_OK)
                 break;
@@ -302,7 +327,7 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
                 (status = bal_energy_guard(s, err)) != BAL_OK)
                 break;
             const int done = check && stop_rule_met(s, stage, log);
-            if ((row || (done && series && g == sc->n_stages - 1)) &&
+            if ((row || (done && series && (g == sc->n_stages - 1 || stage->output_at_end))) &&
                 (status = bal_output_series_row(s, series, err)) != BAL_OK)
                 break;
             if (done) {
@@ -390,6 +415,8 @@ void bal_sim_memory(const struct bal_sim *s, double *disc_bytes, double *pair_by
     const double n = s->n;
     /* 14 double columns, id, slot, mat, fixed, grid cell and list, new2old */
     double d = n * (14 * sizeof(double) + 3 * sizeof(int32_t) + 1 + 3 * sizeof(int32_t));
+    if (s->hold)
+        d += n * sizeof *s->hold;
     if (s->row)
         d += n * sizeof *s->row;
     if (s->moment)

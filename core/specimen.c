@@ -12,20 +12,49 @@
  *           platform; no global state);
  *   [pile]  equal discs on a triangular lattice (MLH Sec. 4, Fig. 2): row M
  *           holds L − 3M (30°) or L − M (60°) discs, each row at the lowest
- *           height where it touches the row below (struct bal_pile_def).
+ *           height where it touches the row below (struct bal_pile_def);
+ *   [grains] n discs from a grading curve, placed at random without
+ *           overlap in a rectangle (below);
+ *   [import] the discs of a discs.tsv a run wrote, unchanged (read when the
+ *           scene was parsed: import.c).
  *
- * Scene order — [disc] sections first, then each [fill], then each [pile],
- * each in file order — is the disc's stable id: outputs are written in it,
- * and messages name a disc by it.  The functions at the end turn an id back
- * into a name (FILL.k) and into the scene line that placed the disc.
+ * The grading curve of [grains] is "percent finer" by area (in 2D, the
+ * discs' area stands for the sieve's mass): F(d), the share of the discs'
+ * area in discs of diameter <= d, is 0, 0.1, 0.5, 0.6, 1 at dmin, d10, d50,
+ * d60, dmax and linear in between.  Diameters are drawn by number: a disc
+ * of diameter d has area ∝ d², so the number density is n(d) ∝ F'(d)/d².
+ * On a piece [a, b] of the curve with rise ΔF, F' = ΔF/(b − a) and the
+ * piece holds the share ∝ ΔF/(b − a) ∫_a^b d⁻² dd = ΔF/(a b) of the
+ * discs (also for a = b: a step of F, ΔF/a² discs of diameter a); within
+ * it the number CDF is (1/a − 1/d)/(1/a − 1/b), inverted in closed form:
+ *   d = 1 / (1/a − u (1/a − 1/b)),  u uniform in [0, 1).
+ * One uniform picks the piece, one the diameter within it.  The numbers
+ * come from GSL's gsl_rng_mt19937 seeded with the section's seed (the same
+ * discs on every machine): first two per disc for the diameters, then two
+ * per try for the places.  The discs are placed largest first (random
+ * sequential addition: each at a uniform random place inside the region,
+ * kept if it overlaps no disc placed before, tried up to `tries` times; a
+ * cell grid of side dmax finds the neighbours), and numbered in that order.
+ * Random sequential addition jams near an area fraction of 0.55 (equal
+ * discs), so a dense specimen is placed loose in a tall region and then
+ * compressed by its walls (the servo of walls.c).
  *
- * A new generator (the polydisperse specimen, say) is a section in the key
- * table, a count in bal_specimen_count, a lay_* function called from
- * bal_specimen_generate, and its branch in the name and origin functions.
+ * Scene order — [disc] sections first, then each [fill], [pile], [grains]
+ * and [import], each kind in file order — is the disc's stable id: outputs
+ * are written in it, and messages name a disc by it.  The functions at the
+ * end turn an id back into a name (FILL.k) and into the scene line that
+ * placed the disc.
+ *
+ * A new generator is a section in the key table, a count in
+ * bal_specimen_count, a lay_* function called from bal_specimen_generate,
+ * and its branch in the name and origin functions.
  */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_rng.h>
 
 #include "scene.h"
 #include "specimen.h"
@@ -65,6 +94,10 @@ long bal_specimen_count(const struct bal_scene *sc)
         n += sc->fills[f].n;
     for (int p = 0; p < sc->n_piles; p++)
         n += bal_specimen_pile_count(&sc->piles[p]);
+    for (int g = 0; g < sc->n_grains; g++)
+        n += sc->grains[g].n;
+    for (int i = 0; i < sc->n_imports; i++)
+        n += sc->imports[i].n;
     return n;
 }
 
@@ -101,7 +134,11 @@ static int lay_discs(const struct bal_scene *sc, struct bal_specimen *d, int k)
         d->th[k] = dd->theta * (BAL_PI / 180);
         d->w[k] = dd->omega;
         d->mat[k] = bal_scene_find(sc, BAL_SEC_MATERIAL, dd->material);
-        d->fixed[k] = (uint8_t)(dd->fixed != 0);
+        /* Holding every component is holding the disc: fixed = 1, with
+         * everything that goes with it (no pair of held discs, no weight). */
+        const unsigned hold = (unsigned)dd->hold & BAL_HOLD_ALL;
+        d->fixed[k] = (uint8_t)(dd->fixed != 0 || hold == BAL_HOLD_ALL);
+        d->hold[k] = (uint8_t)(d->fixed[k] ? 0 : hold);
     }
     return k;
 }
@@ -171,6 +208,182 @@ static int lay_pile(const struct bal_pile_def *p, int mat, struct bal_specimen *
     return k;
 }
 
+/* The grading curve's points: diameters and shares finer by area. */
+static void grading_points(const struct bal_grains_def *g, double d[5], double F[5])
+{
+    const double dd[5] = {g->dmin, g->d10, g->d50, g->d60, g->dmax};
+    const double FF[5] = {0, 0.1, 0.5, 0.6, 1};
+    memcpy(d, dd, sizeof dd);
+    memcpy(F, FF, sizeof FF);
+}
+
+double bal_specimen_grading_diameter(const struct bal_grains_def *g, double u1, double u2)
+{
+    double d[5], F[5], w[4], total = 0;
+    grading_points(g, d, F);
+    for (int k = 0; k < 4; k++) {
+        w[k] = (F[k + 1] - F[k]) / (d[k] * d[k + 1]); /* its share of the discs, by number */
+        total += w[k];
+    }
+    /* the piece: the first whose cumulative share passes u1 (the last, for
+     * a u1 that rounding carries past them all) */
+    int k = 0;
+    for (double acc = w[0] / total; k < 3 && !(u1 < acc); acc += w[++k] / total)
+        ;
+    const double a = d[k], b = d[k + 1];
+    if (!(b > a))
+        return a;
+    const double dia = 1 / (1 / a - u2 * (1 / a - 1 / b));
+    return dia < a ? a : dia > b ? b : dia; /* rounding at the ends */
+}
+
+double bal_specimen_grading_finer(const struct bal_grains_def *g, double dia)
+{
+    double d[5], F[5];
+    grading_points(g, d, F);
+    if (dia < d[0])
+        return 0;
+    for (int k = 0; k < 4; k++)
+        if (dia < d[k + 1])
+            return F[k] + (F[k + 1] - F[k]) * (dia - d[k]) / (d[k + 1] - d[k]);
+    return 1;
+}
+
+static int descending(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? 1 : x > y ? -1 : 0;
+}
+
+/* A [grains] specimen (the file's header) from index k on; returns the index
+ * after the last disc, or -1 with err filled. */
+static int lay_grains(const struct bal_scene *sc, const struct bal_grains_def *g, int mat,
+                      struct bal_specimen *d, int k, struct bal_error *err)
+{
+    const long n = g->n;
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    double *dia = malloc((size_t)n * sizeof *dia);
+    /* a cell grid of side dmax over the region: head of each cell's list,
+     * next disc of each disc's */
+    const double cell = g->dmax;
+    const long nx = (long)fmin(ceil(g->size[0] / cell), 1e6) + 1;
+    const long ny = (long)fmin(ceil(g->size[1] / cell), 1e6) + 1;
+    const int too_many = (double)nx * (double)ny > 4.0 * (double)n + 1e6;
+    long *head = too_many ? NULL : malloc((size_t)(nx * ny) * sizeof *head);
+    long *next = malloc((size_t)n * sizeof *next);
+    if (!rng || !dia || !next || (!too_many && !head)) {
+        gsl_rng_free(rng);
+        free(dia);
+        free(head);
+        free(next);
+        bal_error(err, BAL_ENOMEM, "%s:%d: [grains %s]: out of memory for %ld discs", sc->path,
+                  g->line, g->name, n);
+        return -1;
+    }
+    if (too_many) {
+        free(dia);
+        free(next);
+        gsl_rng_free(rng);
+        const int ki = bal_scene_key_index(BAL_SEC_GRAINS, "size");
+        bal_error(err, BAL_EINVAL, "%s:%d: size: [grains %s]: the region %g x %g holds %g cells "
+                  "of side dmax = %g, more than 4 per disc: expected a region near the size the "
+                  "discs need", sc->path, g->key_line[ki] > 0 ? g->key_line[ki] : g->line, g->name,
+                  g->size[0], g->size[1], (double)nx * (double)ny, g->dmax);
+        return -1;
+    }
+    gsl_rng_set(rng, g->seed);
+    for (long q = 0; q < n; q++) {
+        const double u1 = gsl_rng_uniform(rng);
+        const double u2 = gsl_rng_uniform(rng);
+        dia[q] = bal_specimen_grading_diameter(g, u1, u2);
+    }
+    qsort(dia, (size_t)n, sizeof *dia, descending);
+    for (long c = 0; c < nx * ny; c++)
+        head[c] = -1;
+    const double x0 = g->origin[0], y0 = g->origin[1];
+    double area = 0;
+    const int first = k;
+    for (long q = 0; q < n; q++) {
+        const double r = 0.5 * dia[q];
+        const double wx = g->size[0] - 2 * r, wy = g->size[1] - 2 * r;
+        int placed = 0;
+        double x = 0, y = 0;
+        for (long t = 0; t < g->tries && !placed; t++) {
+            x = x0 + r + gsl_rng_uniform(rng) * wx;
+            y = y0 + r + gsl_rng_uniform(rng) * wy;
+            const long cx = (long)((x - x0) / cell), cy = (long)((y - y0) / cell);
+            placed = 1;
+            /* a disc that overlaps this one has its centre within r + dmax/2
+             * <= dmax: in this cell or a neighbour */
+            for (long jy = cy - 1; jy <= cy + 1 && placed; jy++) {
+                if (jy < 0 || jy >= ny)
+                    continue;
+                for (long jx = cx - 1; jx <= cx + 1 && placed; jx++) {
+                    if (jx < 0 || jx >= nx)
+                        continue;
+                    for (long o = head[jy * nx + jx]; o >= 0 && placed; o = next[o]) {
+                        const double dx = x - d->x[first + o], dy = y - d->y[first + o];
+                        const double rs = r + d->r[first + o];
+                        placed = dx * dx + dy * dy >= rs * rs;
+                    }
+                }
+            }
+        }
+        if (!placed) {
+            const int ki = bal_scene_key_index(BAL_SEC_GRAINS, "n");
+            bal_error(err, BAL_EINVAL,
+                      "%s:%d: n: [grains %s]: placed %ld of %ld discs (area fraction %.3g of the "
+                      "region), then found no place for one of diameter %g in %ld tries; expected "
+                      "a larger region (size), fewer discs (n) or more tries (random sequential "
+                      "addition jams near an area fraction of 0.55)",
+                      sc->path, g->key_line[ki] > 0 ? g->key_line[ki] : g->line, g->name, q, n,
+                      area / (g->size[0] * g->size[1]), dia[q], g->tries);
+            gsl_rng_free(rng);
+            free(dia);
+            free(head);
+            free(next);
+            return -1;
+        }
+        const long c = (long)((x - x0) / cell) + nx * (long)((y - y0) / cell);
+        next[q] = head[c];
+        head[c] = q;
+        d->x[k] = x;
+        d->y[k] = y;
+        d->r[k] = r;
+        d->mat[k] = mat;
+        area += BAL_PI * r * r;
+        k++;
+    }
+    gsl_rng_free(rng);
+    free(dia);
+    free(head);
+    free(next);
+    return k;
+}
+
+/* The discs of an [import] from index k on; returns the index after the
+ * last. */
+static int lay_import(const struct bal_import_def *m, int mat, struct bal_specimen *d, int k)
+{
+    for (long q = 0; q < m->n; q++, k++) {
+        const double *row = m->disc_data + q * BAL_IMPORT_COLUMNS;
+        d->x[k] = row[BAL_IMPORT_X];
+        d->y[k] = row[BAL_IMPORT_Y];
+        d->r[k] = row[BAL_IMPORT_R];
+        d->th[k] = row[BAL_IMPORT_THETA] * (BAL_PI / 180);
+        if (m->velocities) {
+            d->vx[k] = row[BAL_IMPORT_VX];
+            d->vy[k] = row[BAL_IMPORT_VY];
+            d->w[k] = row[BAL_IMPORT_OMEGA];
+        }
+        d->fixed[k] = row[BAL_IMPORT_FIXED] != 0;
+        if (d->fixed[k]) /* held: at rest, as a [disc] with fixed = 1 must be */
+            d->vx[k] = d->vy[k] = d->w[k] = 0;
+        d->mat[k] = mat;
+    }
+    return k;
+}
+
 static double *alloc_doubles(size_t n, int *ok)
 {
     double *p = calloc(n ? n : 1, sizeof *p);
@@ -192,8 +405,9 @@ enum bal_status bal_specimen_generate(const struct bal_scene *sc, int n, struct 
     d->w = alloc_doubles((size_t)n, &ok);
     d->mat = calloc((size_t)(n ? n : 1), sizeof *d->mat);
     d->fixed = calloc((size_t)(n ? n : 1), sizeof *d->fixed);
+    d->hold = calloc((size_t)(n ? n : 1), sizeof *d->hold);
     d->row = malloc((size_t)(n ? n : 1) * sizeof *d->row);
-    if (!ok || !d->mat || !d->fixed || !d->row)
+    if (!ok || !d->mat || !d->fixed || !d->hold || !d->row)
         return bal_error(err, BAL_ENOMEM, "%s: out of memory for %d discs", sc->path, n);
     for (int i = 0; i < n; i++)
         d->row[i] = -1;
@@ -204,6 +418,15 @@ enum bal_status bal_specimen_generate(const struct bal_scene *sc, int n, struct 
     for (int p = 0; p < sc->n_piles; p++)
         k = lay_pile(&sc->piles[p], bal_scene_find(sc, BAL_SEC_MATERIAL, sc->piles[p].material),
                      d, k);
+    for (int g = 0; g < sc->n_grains; g++) {
+        k = lay_grains(sc, &sc->grains[g],
+                       bal_scene_find(sc, BAL_SEC_MATERIAL, sc->grains[g].material), d, k, err);
+        if (k < 0)
+            return err->code;
+    }
+    for (int i = 0; i < sc->n_imports; i++)
+        k = lay_import(&sc->imports[i],
+                       bal_scene_find(sc, BAL_SEC_MATERIAL, sc->imports[i].material), d, k);
     return BAL_OK;
 }
 
@@ -218,6 +441,7 @@ void bal_specimen_free(struct bal_specimen *d)
     free(d->w);
     free(d->mat);
     free(d->fixed);
+    free(d->hold);
     free(d->row);
 }
 
@@ -246,6 +470,20 @@ void bal_specimen_disc_name(const struct bal_scene *sc, int id, char *buf, size_
             return;
         }
         k -= n;
+    }
+    for (int g = 0; g < sc->n_grains; g++) {
+        if (k < sc->grains[g].n) {
+            snprintf(buf, size, "%s.%ld", sc->grains[g].name, k);
+            return;
+        }
+        k -= sc->grains[g].n;
+    }
+    for (int i = 0; i < sc->n_imports; i++) {
+        if (k < sc->imports[i].n) {
+            snprintf(buf, size, "%s.%ld", sc->imports[i].name, k);
+            return;
+        }
+        k -= sc->imports[i].n;
     }
     snprintf(buf, size, "?%d", id);
 }
@@ -292,6 +530,32 @@ void bal_specimen_disc_origin(const struct bal_scene *sc, int id, enum bal_disc_
         const int line = ki >= 0 && pd->key_line[ki] > 0 ? pd->key_line[ki] : pd->line;
         snprintf(buf, size, "%s:%d: %s: disc %s.%ld of [pile %s]", sc->path, line, key, pd->name,
                  k, pd->name);
+        return;
+    }
+    for (int g = 0; g < sc->n_grains; g++) {
+        const struct bal_grains_def *gd = &sc->grains[g];
+        if (k >= gd->n) {
+            k -= gd->n;
+            continue;
+        }
+        const char *key = prop == BAL_DISC_SIZE ? "dmin" : prop == BAL_DISC_PLACE ? "origin" : "n";
+        const int ki = bal_scene_key_index(BAL_SEC_GRAINS, key);
+        const int line = ki >= 0 && gd->key_line[ki] > 0 ? gd->key_line[ki] : gd->line;
+        snprintf(buf, size, "%s:%d: %s: disc %s.%ld of [grains %s]", sc->path, line, key, gd->name,
+                 k, gd->name);
+        return;
+    }
+    for (int i = 0; i < sc->n_imports; i++) {
+        const struct bal_import_def *m = &sc->imports[i];
+        if (k >= m->n) {
+            k -= m->n;
+            continue;
+        }
+        /* the scene's line of the file, and the file's line of the disc */
+        const int ki = bal_scene_key_index(BAL_SEC_IMPORT, "discs");
+        const int line = ki >= 0 && m->key_line[ki] > 0 ? m->key_line[ki] : m->line;
+        snprintf(buf, size, "%s:%d: discs: disc %s.%ld of [import %s] (line %d of %s)", sc->path,
+                 line, m->name, k, m->name, m->disc_row[k], m->discs);
         return;
     }
     snprintf(buf, size, "%s: disc %d", sc->path, id);

@@ -14,12 +14,13 @@
 #define BAL_MAX_DISCS 100000000L
 
 /* The discs of a scene in scene order ([disc] sections, then each [fill],
- * then each [pile]), before the builder sorts them into cell order: one
+ * [pile], [grains], [import]), before the builder sorts them into cell order: one
  * column per property, n entries each. */
 struct bal_specimen {
     double *x, *y, *r, *vx, *vy, *th, *w;
     int32_t *mat;                /* material index in the scene */
     uint8_t *fixed;              /* 1: held */
+    uint8_t *hold;               /* BAL_HOLD_* bits of a partly held disc, else 0 */
     int32_t *row;                /* row M of a pile disc, -1 otherwise */
 };
 
@@ -34,6 +35,13 @@ long bal_specimen_pile_count(const struct bal_pile_def *p);
 enum bal_status bal_specimen_generate(const struct bal_scene *sc, int n, struct bal_specimen *d,
                                       struct bal_error *err);
 void bal_specimen_free(struct bal_specimen *d);
+
+/* The diameter of a [grains] grading curve for the uniforms u1 (which piece
+ * of the curve) and u2 (where in it), u1, u2 in [0, 1): the inverse of the
+ * number distribution whose area distribution is the curve (specimen.c). */
+double bal_specimen_grading_diameter(const struct bal_grains_def *g, double u1, double u2);
+/* The curve itself: the share of the area in discs of diameter <= d. */
+double bal_specimen_grading_finer(const struct bal_grains_def *g, double d);
 
 /* The name of the disc with scene-order index id: its [disc] name, or
  * FILL.k / PILE.k for the k-th disc a generator made. */

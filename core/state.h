@@ -82,12 +82,24 @@ struct bal_wall {
                             * the stage leaves the wall at rest (walls.c) */
     const struct bal_move_def *move; /* the stage's line for the wall: the controller's
                             * parameters (scene data), or NULL */
+    /* What a controller keeps between cycles (walls.c), set when its stage
+     * begins. */
+    int other[BAL_CONTROL_WALLS_MAX]; /* indices of the walls its line names */
+    double toward[2];      /* unit normal of the wall along which it moves: towards the
+                            * discs (servo) or the other wall (strain_rate) */
+    double vcap;           /* servo: the speed cap */
+    double stress;         /* servo: the normal stress measured in the last cycle */
+    double stress_error;   /* servo: |stress − target| / target of the last cycle
+                            * (INFINITY before the first) */
     /* Resultant of the contact forces exerted by the discs on the wall,
      * accumulated in the last cycle. */
     double f[2];           /* F1, F2 */
     double moment;         /* about P, counter-clockwise */
     double fn_sum;         /* Σ F_n over its contacts */
     double fn_s_sum;       /* Σ F_n s, s = position of the contact along e from P */
+    double dash_f[2], dash_m; /* the contact dashpots' share of f and of the moment about P
+                            * (only in damped scenes, and in stages with a controller
+                            * acting every cycle: contacts.c) */
     double disp;           /* largest displacement of any of its points since rebuild */
     double f_prev[2], moment_prev; /* f and moment of the cycle before (energy audit) */
 };
@@ -129,6 +141,9 @@ struct bal_stage_log {
     double ke_over_ee;     /* E_k / E_el at the last check (-1: never checked) */
     double stress_change;  /* largest change of a disc's stress moment between the
                             * last two checks, over the largest (-1: never) */
+    double servo_error;    /* the largest |stress − target|/target of the stage's servo
+                            * walls at the last check (-1: never) */
+    double unbalanced;     /* ΔF/F at the last check (-1: never) */
 };
 
 /* Running sums of the energy audit (energy.c), from the first cycle. */
@@ -232,8 +247,11 @@ struct bal_sim {
                                   * pair loop of a large packing reads fewer streams) */
     double *x_ref, *y_ref;       /* positions at the last rebuild */
     int32_t *mat;
-    uint8_t *fixed;
-    double r_max;
+    uint8_t *fixed;              /* 1: held (every component of its motion) */
+    uint8_t *hold;               /* BAL_HOLD_* bits of the components held at zero of a partly
+                                  * held disc (0 for the others); NULL when no disc is partly
+                                  * held, so the passes of other scenes test nothing */
+    double r_max, r_min;         /* largest and smallest radius */
 
     /* walls */
     int n_walls;

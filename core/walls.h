@@ -5,6 +5,8 @@
 #ifndef BAL_WALLS_H
 #define BAL_WALLS_H
 
+#include <stddef.h>
+
 #include "state.h"
 
 /* Closest point of wall w to (x, y); returns squared distance. */
@@ -19,14 +21,26 @@ void bal_walls_move(struct bal_sim *s);
 
 /* A wall's controller: how a stage drives the wall, chosen by the stage key
  * that names it (the table in walls.c, indexed by enum bal_wall_control).
- * `start` takes the parameters of the stage's line when the stage begins;
- * `control`, unless NULL, runs in every cycle once the cycle's wall forces
- * are known, and sets the velocity of the wall's next move. */
+ * `check` (may be NULL) refuses parameters it cannot work with, writing why
+ * into msg (bal_scene_validate names the line and key); `start` takes the
+ * parameters of the stage's line (w->move) when the stage begins, the other
+ * walls the line names resolved in w->other; `control`, unless NULL, runs in
+ * every cycle once the cycle's wall forces are known, and sets the velocity
+ * of the wall's next move. */
 struct bal_wall_controller_type {
     const char *name;
-    void (*start)(struct bal_wall *w, const struct bal_move_def *mv);
+    int (*check)(const struct bal_move_def *mv, char *msg, size_t size);
+    void (*start)(struct bal_sim *s, struct bal_wall *w);
     void (*control)(struct bal_sim *s, struct bal_wall *w);
 };
+
+/* Does the controller of line mv refuse its parameters?  1 with the reason
+ * in msg, else 0 (bal_scene_validate). */
+int bal_walls_check(const struct bal_move_def *mv, char *msg, size_t size);
+/* The distance from wall a to the midpoint of wall b, along a's normal (for
+ * the parallel walls of a box, the distance between them); toward (may be
+ * NULL) receives a's unit normal on b's side. */
+double bal_walls_gap(const struct bal_wall *a, const struct bal_wall *b, double toward[2]);
 
 /* Stage g begins: each wall it names gets its controller and parameters;
  * the others are at rest, with none. */

@@ -23,6 +23,19 @@ takes kind, title, variants and paper; variants default to all of the case's):
                with the variant's name (error against cost): x = EXPR, y = EXPR (quantity
                expressions, as in reference/*.ref), logscale = xy | x | y | (empty: none),
                xlabel, ylabel, xrange, yrange
+    curves     per variant, a curve of array expressions (JYH Fig. 11): x = EXPR,
+               y = [LABEL;] EXPR (repeatable: one curve each), xlabel, ylabel, xrange, yrange
+    errorbars  per variant a point (x, y) of quantity expressions; the variants that share an x
+               make one point at the mean of their y with a bar from its least to its largest
+               (the spread between specimens, JYH Fig. 13): x = EXPR, y = [LABEL;] EXPR
+               (repeatable: one series each), paper_point = X Y LABEL (repeatable: a published
+               value drawn beside, one legend entry per LABEL), xlabel, ylabel, xrange, yrange
+    fit        per group of variants, the points (x, y) of its variants and their least-squares
+               line (strength envelopes, JYH Fig. 12): group = LABEL; VARIANT VARIANT ...
+               (repeatable, two or more variants each; no `variants` key), x = [LABEL;] EXPR
+               and y = [LABEL;] EXPR (repeatable, paired in order: one line per pair and group),
+               slope = number | asin (the legend gives the slope, or the angle whose sine it is),
+               xlabel, ylabel, xrange, yrange
 
 A key that the figure's kind does not use is an error, as is an unknown kind.
 [sweep NAME] sections declare the case's error-against-cost sweeps (keys in sweep_spec.py).
@@ -45,7 +58,7 @@ from .sweep_spec import parse as parse_sweep
 CASE_KEYS = {"tier", "title", "checks", "runtime", "stability"}
 VARIANT_KEYS = {"scene", "set", "command"}
 COMMANDS = ("run", "exact", "peer", "peer_rolling")
-FIGURE_KINDS = ("series", "network", "profile", "principal", "points")
+FIGURE_KINDS = ("series", "network", "profile", "principal", "points", "curves", "errorbars", "fit")
 _COMMON = {"kind", "title", "variants", "paper"}
 _AXES = {"xlabel", "ylabel", "xrange", "yrange"}
 FIGURE_KIND_KEYS = {
@@ -54,7 +67,11 @@ FIGURE_KIND_KEYS = {
     "profile": _COMMON | _AXES | {"y", "row"},
     "principal": _COMMON,
     "points": _COMMON | _AXES | {"x", "y", "logscale"},
+    "curves": _COMMON | _AXES | {"x", "y"},
+    "errorbars": _COMMON | _AXES | {"x", "y", "paper_point"},
+    "fit": (_COMMON - {"variants"}) | _AXES | {"group", "x", "y", "slope"},
 }
+SLOPES = ("number", "asin")
 FIGURE_KEYS = set().union(*FIGURE_KIND_KEYS.values())
 LOGSCALES = {"": "", "x": "x", "y": "y", "xy": "xy", "yx": "xy"}
 PROFILE_XLABEL = "X = (x - x0) / l"
@@ -92,6 +109,11 @@ class Figure:
     row: int = 1             # profile: the pile row M of S(M)
     logscale: str = ""       # points: '', 'x', 'y' or 'xy'
     lines: list = field(default_factory=list)   # series: (slope, intercept, title) reference lines
+    labels: list = field(default_factory=list)   # curves, errorbars, fit: the legend label of each y
+    xs: list = field(default_factory=list)       # fit: the x expression paired with each y
+    groups: list = field(default_factory=list)   # fit: (label, [variants]) per group
+    paper_points: list = field(default_factory=list)   # errorbars: (x, y, label) published values
+    slope: str = "number"    # fit: how the legend gives a line's slope (SLOPES)
 
 
 @dataclass
@@ -325,8 +347,80 @@ def _points(section, common):
                   yrange=_range(section, "yrange"), logscale=LOGSCALES[logscale], **common)
 
 
+def _labelled(section, key):
+    """Every `key = [LABEL;] EXPR` of the section: (labels, expressions), the label defaulting to
+    the expression; at least one.  A quantity never holds ';', so the first one ends the label."""
+    entries = section.all(key)
+    if not entries:
+        raise section.error(f"[{section.kind} {section.name}] needs '{key} = [LABEL;] EXPR'")
+    labels, exprs = [], []
+    for e in entries:
+        label, sep, text = e.value.partition(";")
+        label, text = (label.strip(), text.strip()) if sep else ("", label.strip())
+        if not text:
+            raise section.error(f"'{key}' is empty", e.line)
+        try:
+            ast.parse(text, mode="eval")
+        except SyntaxError as exc:
+            raise section.error(f"'{key}' is not an expression: {exc.msg}", e.line) from None
+        labels.append(label or text)
+        exprs.append(text)
+    return labels, exprs
+
+
+def _axes(section, x, ylabel):
+    """The axis keys of the expression kinds."""
+    return dict(xlabel=section.get("xlabel", x), ylabel=section.get("ylabel", ylabel),
+                xrange=_range(section, "xrange"), yrange=_range(section, "yrange"))
+
+
+def _curves(section, common):
+    x = _expression(section, "x")
+    labels, ys = _labelled(section, "y")
+    return Figure(variants=section.get("variants", "").split(), x=x, y=ys, labels=labels,
+                  **_axes(section, x, ", ".join(labels)), **common)
+
+
+def _errorbars(section, common):
+    x = _expression(section, "x")
+    labels, ys = _labelled(section, "y")
+    published = []
+    for e in section.all("paper_point"):
+        words = e.value.split(None, 2)
+        try:
+            published.append((float(words[0]), float(words[1]), words[2]))
+        except (ValueError, IndexError):
+            raise section.error(f"'paper_point' must be 'X Y LABEL' (two numbers, then the legend), "
+                                f"not '{e.value}'", e.line) from None
+    return Figure(variants=section.get("variants", "").split(), x=x, y=ys, labels=labels,
+                  paper_points=published, **_axes(section, x, ", ".join(labels)), **common)
+
+
+def _fit(section, common):
+    groups = []
+    for e in section.all("group"):
+        label, sep, names = e.value.partition(";")
+        if not sep or not label.strip() or len(names.split()) < 2:
+            raise section.error(f"'group' must be 'LABEL; VARIANT VARIANT ...' (two or more variants), "
+                                f"not '{e.value}'", e.line)
+        groups.append((label.strip(), names.split()))
+    if not groups:
+        raise section.error(f"[figure {section.name}] needs 'group = LABEL; VARIANT VARIANT ...'")
+    _, xs = _labelled(section, "x")
+    labels, ys = _labelled(section, "y")
+    if len(xs) != len(ys):
+        raise section.error(f"a fit figure pairs each 'x' with a 'y': it has {len(xs)} x and {len(ys)} y")
+    slope = section.get("slope", "number")
+    if slope not in SLOPES:
+        raise section.error(f"'slope' must be one of {', '.join(SLOPES)}, not '{slope}'", section.entry("slope").line)
+    variants = list(dict.fromkeys(v for _, names in groups for v in names))
+    return Figure(variants=variants, x=xs[0], y=ys, labels=labels, xs=xs, groups=groups, slope=slope,
+                  **_axes(section, xs[0], ys[0]), **common)
+
+
 FIGURE_MAKERS = {"series": _series, "network": _one_variant, "profile": _profile,
-                 "principal": _one_variant, "points": _points}
+                 "principal": _one_variant, "points": _points, "curves": _curves,
+                 "errorbars": _errorbars, "fit": _fit}
 
 
 def _range(section, key):

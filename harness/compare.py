@@ -4,12 +4,13 @@ A quantity is a Python expression evaluated without builtins in a namespace hold
 series.tsv column (numpy array) and the functions that harness/expressions.py gives for the
 run: the expression language's own (at, first, last, after, upto, between, mean, max, min,
 std, abs, sqrt, amp, run, energy) and those every case family registered there (the
-modules of harness/families: signals, variants, piles, networks, collisions).  This module
-knows no family: it asks the registry.  evaluate_check() turns one Check into a Verdict;
+modules of harness/families: signals, variants, piles, networks, collisions, biaxial).  This
+module knows no family: it asks the registry.  evaluate_check() turns one Check into a Verdict;
 anything that goes wrong (missing output, failed run, missing column, an expression that
 raises, a NaN/inf value) is a FAIL whose message says which, never a pass and never a skip.
 The one SKIP: a run that could not be made and says why (RunSkipped: a cross-check against
 LAMMPS where LAMMPS is absent and cannot be installed).
+evaluate_array() gives a figure (report/plots.py) an expression's whole row of numbers.
 """
 import ast
 import math
@@ -157,18 +158,37 @@ def _unknown_name(name, is_call, names):
     return f"column '{name}' missing from series.tsv (columns: {columns})"
 
 
-def evaluate(expr, run, sibling=None):
-    """The expression's value in run's outputs, as one finite float."""
+def _value(expr, run, sibling=None):
+    """The expression's value in run's outputs, whatever it is."""
     names = namespace(run, sibling)
     code = _compile(expr, names, run.columns)
     try:
         with np.errstate(all="ignore"):
-            result = eval(code, {**names, "__builtins__": {}})  # noqa: S307 -- no builtins, vetted names
+            return eval(code, {**names, "__builtins__": {}})  # noqa: S307 -- no builtins, vetted names
     except EvalError:
         raise
     except Exception as exc:  # any failure of the expression is a FAIL with its reason
         raise EvalError(f"'{expr}' raised {type(exc).__name__}: {exc}") from None
-    return _finite_scalar(result, expr)
+
+
+def evaluate(expr, run, sibling=None):
+    """The expression's value in run's outputs, as one finite float."""
+    return _finite_scalar(_value(expr, run, sibling), expr)
+
+
+def evaluate_array(expr, run, sibling=None):
+    """The expression's value in run's outputs as a 1-d float array (a figure's curve, e.g.
+    100 * axial_strain()); a number is an array of one.  Non-finite elements are kept: the
+    caller says what it does with them."""
+    result = _value(expr, run, sibling)
+    try:
+        arr = np.atleast_1d(np.asarray(result, dtype=float))
+    except (TypeError, ValueError):
+        raise EvalError(f"'{expr}' is not a number or an array of numbers: {result!r}") from None
+    if arr.ndim != 1 or arr.size == 0:
+        raise EvalError(f"'{expr}' gives {'no values' if arr.size == 0 else f'an array of shape {arr.shape}'}, "
+                        "not a row of numbers")
+    return arr
 
 
 def _finite_scalar(result, expr):

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "check_main.h"
+#include "exact.h"
 
 /* Closed forms evaluated here and the core's arithmetic differ by the
  * rounding of a few dozen O(1) operations: 1e-12 relative bounds that
@@ -825,6 +826,145 @@ START_TEST(integrators_fixed_disc)
 }
 END_TEST
 
+/* Per-axis holds (`hold`), in every integrator.  Free flight under gravity
+ * and global damping: a disc held along x keeps x (bitwise) and v_x = 0, also
+ * as measured (v_N) and as the contact law read it (v_{N-1/2}); its y moves
+ * exactly as that of a free disc beside it (each component's update reads
+ * only its own force, velocity and gravity).  Held along y, the same with
+ * the axes swapped. */
+START_TEST(integrators_hold_axes)
+{
+    for (int k = 0; k < 3; k++) {
+        struct tfx *f = tfx_newf("hold",
+                                 "[settings]\ndt = 1e-3\nalpha = 0.7\ngravity = 0.3 -2\n"
+                                 "integrator = %s\n[material m]\nkn = 1e4\ndensity = 2.385\n"
+                                 "[disc hx]\nx = 0.25 0.5\nr = 0.4\nv = 0 0.6\nomega = 1.3\n"
+                                 "hold = x\nmaterial = m\n"
+                                 "[disc hy]\nx = 5.25 0.75\nr = 0.4\nv = -0.4 0\nhold = y\n"
+                                 "material = m\n"
+                                 "[disc free]\nx = 10.25 0.5\nr = 0.4\nv = -0.4 0.6\nomega = 1.3\n"
+                                 "material = m\n[stage s]\ncycles = 1\n",
+                                 integrator_names[k]);
+        t_steps(f, 50);
+        const struct bal_sim *s = f->sim;
+        ck_assert_ptr_nonnull(s->hold);
+        const int hx = t_slot(f, "hx"), hy = t_slot(f, "hy"), fr = t_slot(f, "free");
+        double vx, vy, w, px, py, pw, fvx, fvy, fw;
+        bal_measure_velocity(s, hx, &vx, &vy, &w);
+        bal_integrate_previous(s, hx, &px, &py, &pw);
+        bal_measure_velocity(s, fr, &fvx, &fvy, &fw);
+        ck_assert_msg(s->x[hx] == 0.25 && s->vx[hx] == 0 && vx == 0 && px == 0,
+                      "%s: x %.17g, v_x %g, measured %g, read %g", integrator_names[k], s->x[hx],
+                      s->vx[hx], vx, px);
+        ck_assert(s->y[hx] == s->y[fr] && s->vy[hx] == s->vy[fr] && vy == fvy);
+        ck_assert(s->th[hx] == s->th[fr] && w == fw);
+        ck_assert(s->y[fr] != 0.5 && s->x[fr] != 10.25);
+        bal_measure_velocity(s, hy, &vx, &vy, &w);
+        bal_integrate_previous(s, hy, &px, &py, &pw);
+        ck_assert(s->y[hy] == 0.75 && s->vy[hy] == 0 && vy == 0 && py == 0);
+        ck_assert(s->vx[hy] == s->vx[fr] && vx == fvx);
+        ck_assert_double_eq_tol(s->x[hy] - 5.25, s->x[fr] - 10.25, 1e-14);
+        tfx_release(f);
+    }
+}
+END_TEST
+
+/* A rotation held: two discs rest on a floor that slides to the right under
+ * them with friction; the free one is turned by the friction's moment, the
+ * one with hold = rotation keeps θ = 0 and ω = 0 (and slides), and one with
+ * hold = x rotation keeps both x and θ. */
+START_TEST(integrators_hold_rotation)
+{
+    for (int k = 0; k < 3; k++) {
+        struct tfx *f = tfx_newf("hold_rotation",
+                                 "[settings]\ndt = 2e-4\ngravity = 0 -9.81\nnormal_law = power\n"
+                                 "integrator = %s\n[material m]\nkn = 1e5\nfriction = 0.6\n"
+                                 "density = 1\n"
+                                 "[wall floor]\np = -2 0\nangle = 0\nh1 = 0\nh2 = 12\nmaterial = m\n"
+                                 "[disc free]\nx = 0 0.49995\nr = 0.5\nmaterial = m\n"
+                                 "[disc spin]\nx = 3 0.49995\nr = 0.5\nhold = rotation\n"
+                                 "material = m\n"
+                                 "[disc both]\nx = 6 0.49995\nr = 0.5\nhold = x rotation\n"
+                                 "material = m\n"
+                                 "[stage s]\ncycles = 1\nmove = floor 0.2 0 0\n",
+                                 integrator_names[k]);
+        t_steps(f, 400);
+        const struct bal_sim *s = f->sim;
+        const int fr = t_slot(f, "free"), sp = t_slot(f, "spin"), bo = t_slot(f, "both");
+        double vx, vy, w;
+        bal_measure_velocity(s, sp, &vx, &vy, &w);
+        /* the floor drags the disc's bottom to the right: counter-clockwise */
+        ck_assert_msg(s->th[fr] > 1e-3, "%s: the free disc turned by %g", integrator_names[k],
+                      s->th[fr]);
+        ck_assert(s->th[sp] == 0 && s->w[sp] == 0 && w == 0);
+        ck_assert(s->x[sp] > 3 + 1e-4); /* dragged along */
+        ck_assert(s->th[bo] == 0 && s->x[bo] == 6 && s->vx[bo] == 0);
+        ck_assert(s->y[bo] != 0.49995); /* free along y */
+        tfx_release(f);
+    }
+}
+END_TEST
+
+/* What "held" means for a partly held disc, against a closed form: a disc
+ * held along x on a frictionless 30-degree incline (through the origin), under gravity
+ * g = (0.5, -9.81) and global damping, settles where the normal force N
+ * carries its weight along y: N cos 30° = m 9.81.  The hold takes the rest,
+ * held_fx = -N sin 30° = -m 9.81 tan 30° (the force on the axis it holds);
+ * weight_x counts the discs free along x (the other, held along y: it slides
+ * off along x forever), weight_y those free along y; the unbalanced force
+ * of the held disc is its free component (0 at rest: ΔF/F is q's weight
+ * over N; 0.5 if the held component were counted); the energy audit balances (the hold
+ * does no work); the time-step estimate treats the disc as free (holding a
+ * degree of freedom removes a row and a column of M^-1 K, whose largest
+ * eigenvalue can then only fall: Cauchy interlacing); the exact solver
+ * refuses it. */
+START_TEST(integrators_hold_incline)
+{
+    const double g = 9.81, m = 2.385 * BAL_PI * 0.16, mq = 2.385 * BAL_PI * 0.09;
+    for (int k = 0; k < 3; k++) {
+        const char *text =
+            "[settings]\ndt = 5e-4\nalpha = 40\ngravity = 0.5 -9.81\nnormal_law = power\n"
+            "integrator = %s\n[material m]\nkn = 1e5\ndensity = 2.385\n"
+            "[wall slope]\np = -2 -1.1547005383792515\nangle = 30\nh1 = 0\nh2 = 6\nmaterial = m\n"
+            "[disc p]\nx = 0 0.46188021535170065\nr = 0.4\nhold = %s\nmaterial = m\n"
+            "[disc q]\nx = 20 5\nr = 0.3\nhold = y\nmaterial = m\n"
+            "[stage s]\ncycles = 6000\n"
+            "[probe hfx]\nquantity = held_fx\n[probe hfy]\nquantity = held_fy\n"
+            "[probe wx]\nquantity = weight_x\n[probe wy]\nquantity = weight_y\n"
+            "[probe ub]\nquantity = unbalanced\n";
+        struct tfx *f = tfx_newf("incline", text, integrator_names[k], "x");
+        ck_assert_int_eq(bal_sim_run(f->sim, NULL, NULL, &f->err), BAL_OK);
+        const struct bal_sim *s = f->sim;
+        const int p = t_slot(f, "p");
+        ck_assert(s->x[p] == 0);
+        /* settled: α = 40 over 3 s damps the bounce by e^-60 (p starts
+         * touching the slope, 0.4 / cos 30° above it) */
+        ck_assert_double_eq_tol(s->f[3 * p + 1], m * g, 1e-7 * m * g);
+        ck_assert_double_eq_tol(t_probe_value(f, "hfx"), -m * g * tan(BAL_PI / 6), 1e-7 * m * g);
+        ck_assert_double_eq(t_probe_value(f, "hfy"), 0.0); /* q, held along y, touches nothing */
+        ck_assert_double_eq_tol(t_probe_value(f, "wx"), mq * 0.5, 1e-15);
+        ck_assert_double_eq_tol(t_probe_value(f, "wy"), -m * g, 1e-14);
+        /* ΔF/F: q's unbalanced weight along x over the contact force N */
+        const double n_slope = m * g / cos(BAL_PI / 6);
+        ck_assert_msg(fabs(t_probe_value(f, "ub") - mq * 0.5 / n_slope) < 1e-6,
+                      "%s: unbalanced %g", integrator_names[k], t_probe_value(f, "ub"));
+        struct bal_energy e;
+        bal_energy_report(s, &e);
+        ck_assert_msg(e.relative < 1e-3, "%s: imbalance %g of %g", integrator_names[k],
+                      e.imbalance, e.throughput);
+        /* the estimate of the same scene with p free */
+        struct tfx *free_p = tfx_newf("incline_free", text, integrator_names[k], "none");
+        ck_assert_double_eq(s->dt_estimate, free_p->sim->dt_estimate);
+        struct bal_exact ex;
+        ck_assert_int_eq(bal_exact_solve(s, &ex, &f->err), BAL_EINVAL);
+        ck_assert_msg(t_contains(f->err.msg, "incline:19: hold: exact solver: disc p is held along "
+                                             "one axis only"), "%s", f->err.msg);
+        tfx_release(free_p);
+        tfx_release(f);
+    }
+}
+END_TEST
+
 /* Gravity ramp, global damping, a wall and two stages with each
  * integrator: a disc dropped onto a floor settles where the floor carries
  * its weight, m g = k_n δ (power law, ν = 1) — statics, whatever the law of
@@ -1198,6 +1338,9 @@ Suite *suite_integrate(void)
     tcase_add_test(tc, integrators_centred_bitwise);
     tcase_add_test(tc, integrators_free_fall_exact);
     tcase_add_test(tc, integrators_fixed_disc);
+    tcase_add_test(tc, integrators_hold_axes);
+    tcase_add_test(tc, integrators_hold_rotation);
+    tcase_add_test(tc, integrators_hold_incline);
     tcase_add_test(tc, integrators_ramp_damping_wall);
     tcase_add_test(tc, integrators_verlet_is_centred);
     tcase_add_test(tc, integrators_gear_reorder);

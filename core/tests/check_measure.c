@@ -609,6 +609,38 @@ START_TEST(measure_weight_follows_ramp)
 }
 END_TEST
 
+/* output_at_end = 1 on a stage adds a row after its last cycle: 11 cycles,
+ * output_every = 4, the first stage of 6 asking for it: rows at 4, 6, 8, 11;
+ * and after a stage that its stop rule ends early. */
+START_TEST(measure_series_row_at_stage_end)
+{
+    struct tfx *f = tfx_new("[settings]\ndt = 2.7e-3\noutput_every = 4\n"
+                            "[material m]\nkn = 1e4\ndensity = 2.385\n"
+                            "[disc d]\nx = 0.5 1.25\nr = 0.3\nv = 0.37 -0.21\nmaterial = m\n"
+                            "[stage a]\ncycles = 6\noutput_at_end = 1\n[stage b]\ncycles = 5\n"
+                            "[probe x]\nquantity = disc_x\na = d\n",
+                            "ends");
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *out = open_memstream(&buf, &len);
+    ck_assert_ptr_nonnull(out);
+    ck_assert_int_eq(bal_sim_run(f->sim, out, NULL, &f->err), BAL_OK);
+    fclose(out);
+    long cycles[8] = {0};
+    int rows = 0;
+    /* bal_sim_run writes rows only (the header is bal_output_series_header's) */
+    for (char *line = buf; line && *line && rows < 8; line = strchr(line, '\n'), line = line ? line + 1 : NULL)
+        if (sscanf(line, "%ld", &cycles[rows]) == 1)
+            rows++;
+    free(buf);
+    ck_assert_int_eq(rows, 4);
+    ck_assert_int_eq(cycles[0], 4);
+    ck_assert_int_eq(cycles[1], 6);
+    ck_assert_int_eq(cycles[2], 8);
+    ck_assert_int_eq(cycles[3], 11);
+}
+END_TEST
+
 /* Issue 18: a series row is written only when every probe value is a
  * number; otherwise nothing of it is written and the probe is named by its
  * file, line and key. */
@@ -667,6 +699,7 @@ Suite *suite_measure(void)
     tcase_add_test(tc, measure_held_and_weight_probes);
     tcase_add_test(tc, measure_weight_follows_ramp);
     tcase_add_test(tc, measure_series_row_not_finite);
+    tcase_add_test(tc, measure_series_row_at_stage_end);
     suite_add_tcase(s, tc);
     return s;
 }

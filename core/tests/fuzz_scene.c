@@ -42,20 +42,21 @@
 /* A failed bal_scene_set must leave the scene as it was. */
 struct snapshot {
     struct bal_scene head;
-    void *arrays[7];
+    void *arrays[9];
 };
 
 static void snapshot_take(struct snapshot *sn, const struct bal_scene *s)
 {
     sn->head = *s;
-    const void *src[7] = {s->materials, s->discs, s->walls, s->fills, s->piles, s->stages,
-                          s->probes};
-    const size_t bytes[7] = {
+    const void *src[9] = {s->materials, s->discs, s->walls,   s->fills,  s->piles,
+                          s->grains,    s->imports, s->stages, s->probes};
+    const size_t bytes[9] = {
         (size_t)s->n_materials * sizeof *s->materials, (size_t)s->n_discs * sizeof *s->discs,
         (size_t)s->n_walls * sizeof *s->walls,         (size_t)s->n_fills * sizeof *s->fills,
-        (size_t)s->n_piles * sizeof *s->piles,         (size_t)s->n_stages * sizeof *s->stages,
+        (size_t)s->n_piles * sizeof *s->piles,         (size_t)s->n_grains * sizeof *s->grains,
+        (size_t)s->n_imports * sizeof *s->imports,     (size_t)s->n_stages * sizeof *s->stages,
         (size_t)s->n_probes * sizeof *s->probes};
-    for (int k = 0; k < 7; k++) {
+    for (int k = 0; k < 9; k++) {
         sn->arrays[k] = malloc(bytes[k] + 1);
         if (sn->arrays[k] && bytes[k])
             memcpy(sn->arrays[k], src[k], bytes[k]);
@@ -64,16 +65,17 @@ static void snapshot_take(struct snapshot *sn, const struct bal_scene *s)
 
 static void snapshot_check_free(struct snapshot *sn, const struct bal_scene *s)
 {
-    const void *now[7] = {s->materials, s->discs, s->walls, s->fills, s->piles, s->stages,
-                          s->probes};
-    const size_t bytes[7] = {
+    const void *now[9] = {s->materials, s->discs, s->walls,   s->fills,  s->piles,
+                          s->grains,    s->imports, s->stages, s->probes};
+    const size_t bytes[9] = {
         (size_t)s->n_materials * sizeof *s->materials, (size_t)s->n_discs * sizeof *s->discs,
         (size_t)s->n_walls * sizeof *s->walls,         (size_t)s->n_fills * sizeof *s->fills,
-        (size_t)s->n_piles * sizeof *s->piles,         (size_t)s->n_stages * sizeof *s->stages,
+        (size_t)s->n_piles * sizeof *s->piles,         (size_t)s->n_grains * sizeof *s->grains,
+        (size_t)s->n_imports * sizeof *s->imports,     (size_t)s->n_stages * sizeof *s->stages,
         (size_t)s->n_probes * sizeof *s->probes};
     if (memcmp(&sn->head, s, sizeof *s) != 0)
         abort(); /* a failed --set changed the settings or the section counts */
-    for (int k = 0; k < 7; k++) {
+    for (int k = 0; k < 9; k++) {
         if (sn->arrays[k] && bytes[k] && memcmp(sn->arrays[k], now[k], bytes[k]) != 0)
             abort(); /* a failed --set changed a section */
         free(sn->arrays[k]);
@@ -110,7 +112,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     bal_scene_default(&sc);
     fuzz_count(FUZZ_N_INPUTS);
     enum bal_status st = bal_scene_parse(&sc, text, "fuzz.scene", &err);
-    if (st != BAL_OK && (st != BAL_EINVAL || !err.msg[0]) && st != BAL_ENOMEM)
+    /* BAL_EIO: a data file an [import] names could not be read */
+    if (st != BAL_OK && ((st != BAL_EINVAL && st != BAL_EIO) || !err.msg[0]) && st != BAL_ENOMEM)
         fuzz_fail("bal_scene_parse failed (%d) without a message", st);
     if (st != BAL_OK)
         fuzz_check_origin(&err, st, "bal_scene_parse", "fuzz.scene", text);
@@ -130,7 +133,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (ss != BAL_OK)
                 snapshot_check_free(&sn, &sc);
             else
-                for (int k = 0; k < 7; k++)
+                for (int k = 0; k < 9; k++)
                     free(sn.arrays[k]);
             line = nl ? nl + 1 : NULL;
         }

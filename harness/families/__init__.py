@@ -7,6 +7,8 @@ harness/expressions.py: each module registers its own when it is imported.
     networks     contact_error, contact_mismatch: contact forces against another variant's
     collisions   contact_start, contact_end, contact_duration, restitution: a binary collision
     rolling      fit_slope: a straight line through a branch of a curve (the rolling law tester)
+    biaxial      sigma_v, phi, axial_strain, phi_peak, phi_residual, phi_envelope, ...: a biaxial
+                 compression test and its strength envelope (JYH 2005)
     ensembles    members, seeds, realisations, over: the realisations of an [ensemble]
 
 A new family is one module here that calls expressions.register, and its name below.  The
@@ -18,4 +20,5 @@ from . import piles  # noqa: F401
 from . import networks  # noqa: F401
 from . import collisions  # noqa: F401
 from . import rolling  # noqa: F401
+from . import biaxial  # noqa: F401
 from . import ensembles  # noqa: F401

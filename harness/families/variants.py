@@ -9,6 +9,10 @@ collisions.ref).
                              p = log(|q_1 - exact| / |q_2 - exact|) / log(dt_1 / dt_2), q = expr
                              in each variant, dt from each run.json; for more, the least-squares
                              slope of log|q - exact| on log dt
+    spread(expr, v1, v2, ...)
+                             the largest less the least value of expr over the variants: how
+                             far a quantity that should not change between them does (JYH's
+                             peak less residual angle over delta, the seeds of one material)
 """
 import numpy as np
 
@@ -16,7 +20,7 @@ from ..compare import evaluate
 from ..errors import EvalError
 from ..expressions import register, sibling_run
 
-NAMES = ("series", "of", "order")
+NAMES = ("series", "of", "order", "spread")
 
 
 def bind(run, sibling=None):
@@ -51,7 +55,13 @@ def bind(run, sibling=None):
         # Two variants: the pairwise order; more: the least-squares slope of log e on log dt.
         return float(np.polyfit(np.log(steps), np.log(errors), 1)[0])
 
-    return {"series": series, "of": of, "order": order}
+    def spread(expr, *variants):
+        if len(variants) < 2:
+            raise EvalError("spread(): needs at least two variants")
+        values = [of(variant, expr) for variant in variants]
+        return float(max(values) - min(values))
+
+    return {"series": series, "of": of, "order": order, "spread": spread}
 
 
 register("variants", NAMES, bind)

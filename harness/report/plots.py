@@ -11,9 +11,15 @@ principal axis of length proportional to S_max and one across it proportional to
 compression positive, tensile values in red, the largest |S| drawn PRINCIPAL_SHARE of the
 largest diameter; `set arrow ... nohead` per line, square aspect); points (one point per
 variant at (x, y) = two quantity expressions, joined in the order listed and labelled
-with the variant name, optional log axes).  Whatever a figure cannot show -- a variant
-without data, an expression that fails, a non-positive value on a log axis, non-finite
-values -- is listed in its notes, never silently dropped.
+with the variant name, optional log axes); curves (per variant, one line per y of array
+expressions against the array expression x, JYH Fig. 11); errorbars (per variant a point of
+quantity expressions; the variants sharing an x drawn as one point at the mean of their y with
+a bar from the least to the largest, joined per series, and the paper's published points beside,
+JYH Fig. 13); fit (per group of variants and per (x, y) pair, the points and their least-squares
+line drawn from x = 0 or the least x, whichever is smaller, to the largest x, its slope and
+intercept in the legend, JYH Fig. 12).  Whatever a figure cannot show -- a variant without
+data, an expression that fails, a non-positive value on a log axis, non-finite values -- is
+listed in its notes, never silently dropped.
 
 gnuplot draws in a scratch folder; each figure reaches reports/figures through files.py
 (a temporary file, then rename), so a killed report leaves it old or new, never cut.
@@ -28,7 +34,7 @@ import numpy as np
 
 from .. import files
 from ..children import options as child_options
-from ..compare import evaluate
+from ..compare import evaluate, evaluate_array
 from ..errors import EvalError, RunProblem
 from ..expressions import Siblings
 from ..families import piles
@@ -197,6 +203,160 @@ def _points_script(case, figure, store, workdir, png, svg):
     return gnuplot_script(figure, clauses, png, svg, settings), notes
 
 
+def _sibling_of(store, case):
+    return lambda other: store.get(case.name, other)
+
+
+def _curves_script(case, figure, store, workdir, png, svg):
+    """Per variant, each y array expression against the x array expression: one line each."""
+    clauses, notes = [], []
+    for variant in figure.variants:
+        try:
+            run = store.get(case.name, variant)
+            x = evaluate_array(figure.x, run, _sibling_of(store, case))
+        except (RunProblem, EvalError) as problem:
+            notes.append(f"{variant}: not drawn: {problem}")
+            continue
+        for k, (label, expr) in enumerate(zip(figure.labels, figure.y)):
+            try:
+                y = evaluate_array(expr, run, _sibling_of(store, case))
+            except EvalError as problem:
+                notes.append(f"{variant}: {label}: not drawn: {problem}")
+                continue
+            if y.shape != x.shape:
+                notes.append(f"{variant}: {label}: not drawn: {y.size} values against {x.size} of x")
+                continue
+            kept = np.isfinite(x) & np.isfinite(y)
+            if not kept.all():
+                notes.append(f"{variant}: {label}: {int((~kept).sum())} non-finite point(s) not drawn")
+            path = Path(workdir) / f"{variant}_{k}.dat"
+            _write_columns(path, [x[kept], y[kept]])
+            clauses.append(f"{gp_string(path)} using 1:2 with lines title "
+                           f"{gp_string(curve_title(variant, label, figure))}")
+    if not clauses:
+        return None, notes + ["nothing to plot"]
+    return gnuplot_script(figure, clauses, png, svg), notes
+
+
+def number_key(x):
+    """x rounded to 12 significant digits: the variants whose x agree to that share a point."""
+    return float(f"{x:.12g}")
+
+
+def spread_points(samples):
+    """{x: [y, ...]} -> rows (x, mean, least, largest, count), sorted by x."""
+    return [(x, float(np.mean(ys)), float(np.min(ys)), float(np.max(ys)), len(ys))
+            for x, ys in sorted(samples.items())]
+
+
+PAPER_POINT_TYPES = (6, 4, 8, 12, 10)    # open circle, square, triangle, diamond, pentagon
+
+
+def _errorbars_script(case, figure, store, workdir, png, svg):
+    """A point per distinct x and series: the mean of the variants' y, a bar from least to largest."""
+    samples, notes = [{} for _ in figure.y], []
+    for variant in figure.variants:
+        try:
+            run = store.get(case.name, variant)
+            x = evaluate(figure.x, run, _sibling_of(store, case))
+        except (RunProblem, EvalError) as problem:
+            notes.append(f"{variant}: not drawn: {problem}")
+            continue
+        for k, (label, expr) in enumerate(zip(figure.labels, figure.y)):
+            try:
+                y = evaluate(expr, run, _sibling_of(store, case))
+            except EvalError as problem:
+                notes.append(f"{variant}: {label}: not drawn: {problem}")
+                continue
+            samples[k].setdefault(number_key(x), []).append(y)
+    clauses = []
+    for k, label in enumerate(figure.labels):
+        if not samples[k]:
+            continue
+        path = Path(workdir) / f"series_{k}.dat"
+        _write_columns(path, list(zip(*spread_points(samples[k]))))
+        clauses.append(f"{gp_string(path)} using 1:2:3:4 with yerrorlines lt {k + 1} pt 7 ps 0.8 "
+                       f"title {gp_string(label)}")
+    if not clauses:
+        return None, notes + ["nothing to plot"]
+    published = list(dict.fromkeys(label for _, _, label in figure.paper_points))
+    for j, label in enumerate(published):
+        path = Path(workdir) / f"paper_{j}.dat"
+        _write_columns(path, list(zip(*[(x, y) for x, y, name in figure.paper_points if name == label])))
+        clauses.append(f"{gp_string(path)} using 1:2 with points pt {PAPER_POINT_TYPES[j % len(PAPER_POINT_TYPES)]} "
+                       f"ps 1.6 lw 2 lc rgb '#000000' title {gp_string(label)}")
+    return gnuplot_script(figure, clauses, png, svg, ERRORBAR_SETTINGS), notes
+
+
+ERRORBAR_SETTINGS = ("set offsets graph 0.04, graph 0.04, graph 0.05, graph 0.05",)   # bars clear of the frame
+
+
+def fitted_line(x, y):
+    """(slope, intercept) of the least-squares line through the points; None for fewer than two
+    different x."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if x.size < 2 or not np.ptp(x) > 0:
+        return None
+    slope, intercept = np.polyfit(x, y, 1)
+    return float(slope), float(intercept)
+
+
+def fit_legend(group, label, line, slope_as, scale=0.0):
+    """The legend of one fitted line: its slope (or, slope_as 'asin', the angle whose sine it is)
+    and its intercept (0 when below 1e-9 of scale, the largest |y|: round-off of a line through
+    the origin)."""
+    slope, intercept = line
+    if slope_as == "asin" and -1 < slope < 1:
+        shown = f"asin(slope) {np.degrees(np.arcsin(slope)):.1f} deg"
+    else:
+        shown = f"slope {slope:.4g}"
+    intercept = 0.0 if abs(intercept) < 1e-9 * scale else intercept
+    return f"{group}, {label}: {shown}, intercept {intercept:.4g}"
+
+
+FIT_POINT_TYPES = (7, 5, 9, 11, 13)     # filled circle, square, triangle, diamond, pentagon
+
+
+def _fit_script(case, figure, store, workdir, png, svg):
+    """Per group and (x, y) pair: the variants' points and their least-squares line."""
+    clauses, notes = [], []
+    for g, (group, variants) in enumerate(figure.groups):
+        for k, (xexpr, yexpr, label) in enumerate(zip(figure.xs, figure.y, figure.labels)):
+            points = []
+            for variant in variants:
+                try:
+                    run = store.get(case.name, variant)
+                    points.append([evaluate(e, run, _sibling_of(store, case)) for e in (xexpr, yexpr)])
+                except (RunProblem, EvalError) as problem:
+                    notes.append(f"{group}, {label}: {variant}: not drawn: {problem}")
+            if not points:
+                continue
+            x, y = np.array(points).T
+            path = Path(workdir) / f"fit_{g}_{k}.dat"
+            _write_columns(path, [x, y])
+            style = f"lt {g + 1} pt {FIT_POINT_TYPES[k % len(FIT_POINT_TYPES)]} ps 1.2"
+            line = fitted_line(x, y)
+            if line is None:
+                notes.append(f"{group}, {label}: fewer than two different x: no line")
+                clauses.append(f"{gp_string(path)} using 1:2 with points {style} "
+                               f"title {gp_string(f'{group}, {label}')}")
+                continue
+            if figure.slope == "asin" and not -1 < line[0] < 1:
+                notes.append(f"{group}, {label}: the slope {line[0]:.4g} is no sine of an angle")
+            ends = np.array([min(0.0, x.min()), x.max()])
+            line_path = Path(workdir) / f"line_{g}_{k}.dat"
+            _write_columns(line_path, [ends, line[0] * ends + line[1]])
+            clauses += [f"{gp_string(path)} using 1:2 with points {style} notitle",
+                        f"{gp_string(line_path)} using 1:2 with lines lt {g + 1} dt {k + 1} "
+                        f"title {gp_string(fit_legend(group, label, line, figure.slope, np.abs(y).max()))}"]
+    if not clauses:
+        return None, notes + ["nothing to plot"]
+    return gnuplot_script(figure, clauses, png, svg, FIT_SETTINGS), notes
+
+
+FIT_SETTINGS = ("set key below left vertical maxrows 4",)   # the legends are long: under the plot
+
+
 PRINCIPAL_SHARE = 0.9         # the largest principal value is drawn this share of the largest diameter
 PRINCIPAL_COLOURS = {"compressive": "#1f3a93", "tensile": "#d62728"}
 
@@ -272,7 +432,8 @@ def _walls(folder):
 
 
 SCRIPTS = {"series": _series_script, "network": _network_script, "profile": _profile_script,
-           "principal": _principal_script, "points": _points_script}
+           "principal": _principal_script, "points": _points_script, "curves": _curves_script,
+           "errorbars": _errorbars_script, "fit": _fit_script}
 
 
 def render_figure(case, figure, store, figures_dir):

@@ -69,7 +69,8 @@ QUANTITIES = ("contact_fn contact_fs contact_sliding wall_f1 wall_f2 wall_moment
               "disc_y disc_vx disc_vy disc_theta disc_omega energy_kinetic energy_elastic "
               "work_walls work_gravity dissipated_dashpot dissipated_friction dissipated_global "
               "energy_imbalance unbalanced n_contacts n_sliding held_fx held_fy weight_x "
-              "weight_y contact_mr contact_theta_r contact_rolling dissipated_rolling").split()
+              "weight_y contact_mr contact_theta_r contact_rolling dissipated_rolling wall_px "
+              "wall_py wall_gap wall_stress").split()
 
 
 @needs_ballast

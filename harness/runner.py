@@ -13,7 +13,9 @@ directory, so runs share no state and their results cannot depend on -j or on or
 After the run the folder holds the core's outputs plus ballast.stdout, ballast.stderr and,
 written last (tmp file + rename), harness.json: the command, exit code, wall time, on
 failure the cause, the run's identity (what made it: command, scene path and content hash,
---set overrides, the executable's hash) and the SHA-256 of every file the run left.
+--set overrides, the executable's hash), the SHA-256 of every file the run left, and for a
+realisation of an [ensemble] its ensemble and seed (the seed is also in the core's run.json,
+in its scene path or --set lines).
 
 Interruption: SIGINT or SIGTERM stops the whole batch.  Jobs not yet started are dropped
 (their folders untouched); running ones get SIGTERM (the core traps it, writes run.json
@@ -69,6 +71,8 @@ class Job:
     out: Path
     expected: float = 0.0   # expected seconds, for the ETA
     command: str = "run"    # the core's command: run (DEM) or exact (static solver)
+    ensemble: str = ""      # a realisation of [ensemble NAME]: NAME, and its seed (in harness.json)
+    seed: int = None
 
     @property
     def label(self):
@@ -90,7 +94,7 @@ class Outcome:
 def jobs_for(cases, runs_root):
     """One Job per variant of each case, outputs in runs_root/<case>/<variant>."""
     return [Job(c.name, v.name, v.scene, list(v.sets), Path(runs_root) / c.name / v.name,
-                c.runtime / len(c.variants), v.command)
+                c.runtime / len(c.variants), v.command, v.ensemble, v.seed)
             for c in cases for v in c.variants]
 
 
@@ -292,6 +296,8 @@ def _record(outcome, cmd, ident):
               "returncode": outcome.returncode, "wall_seconds": round(outcome.wall, 6),
               "ok": outcome.ok, "cause": outcome.cause, "kind": outcome.job.command,
               "identity": ident, "outputs": output_digests(folder)}
+    if outcome.job.ensemble:
+        record.update(ensemble=outcome.job.ensemble, seed=outcome.job.seed)
     files.write_text(folder / "harness.json", json.dumps(record, indent=1) + "\n")
 
 

@@ -181,7 +181,11 @@ def gather(folder, cases, binary, runs_root, out):
         if mine is None:
             refused.append((remote.label, "no such variant in the catalogue now"))
             continue
-        if (str(mine.scene), mine.sets, mine.command) != (str(remote.scene), remote.sets, remote.command):
+        if str(mine.scene) != str(remote.scene):
+            refused.append((remote.label, f"its scene is {mine.scene} here, {remote.scene} in the export "
+                                          "(gather with the catalogue that was exported)"))
+            continue
+        if (mine.sets, mine.command) != (remote.sets, remote.command):
             refused.append((remote.label, "its case.txt variant changed since the export (export again)"))
             continue
         ident = identity(mine, binary, binary_id)

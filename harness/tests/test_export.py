@@ -238,3 +238,16 @@ def test_gnu_parallel_runs_the_exported_list_to_the_bytes_of_a_local_run(tmp_pat
         assert main(["gather", str(folder)]) == 0
     for n in NAMES:
         assert outputs(gathered / "runs" / "packing" / n) == outputs(local / "runs" / "packing" / n), n
+
+
+def test_gather_with_another_catalogue_says_so(springs, tmp_path, monkeypatch, capsys):
+    folder = tmp_path / "shared"
+    assert main(["export", "spring", "--to", str(folder)]) == 0
+    assert run_jobs(folder, range(7)) == [0] * 7
+    shutil.copytree(springs / "cases", tmp_path / "elsewhere")
+    monkeypatch.setenv("BALLAST_CASES", str(tmp_path / "elsewhere"))
+    capsys.readouterr()
+    assert main(["gather", str(folder)]) == 1
+    out = capsys.readouterr().out
+    assert f"NOT GATHERED spring/soft: its scene is {tmp_path / 'elsewhere' / 'springs' / 'spring.scene'} here" in out
+    assert "0 run(s) gathered, 0 already here, 7 not gathered" in out

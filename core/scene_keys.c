@@ -229,12 +229,14 @@ const struct bal_key bal_scene_keys[] = {
      "1: the discs start with the file's vx vy omega; 0: at rest"},
 
     /* [stage NAME] */
-    {BAL_SEC_STAGE, "cycles", BAL_KEY_LONG, G(cycles), NULL, 1, 0, 1e15, NULL,
-     "number of calculation cycles in this stage (0: the stage is skipped)"},
+    {BAL_SEC_STAGE, "cycles", BAL_KEY_LONG, G(cycles), NULL, 0, 0, 1e15, NULL,
+     "number of calculation cycles in this stage (0: the stage is skipped); this or time"},
+    {BAL_SEC_STAGE, "time", BAL_KEY_DOUBLE, G(time), NULL, 0, 0, BIG, NULL,
+     "or the stage's simulated time: ceil(time/dt) cycles, the same time whatever dt is"},
     {BAL_SEC_STAGE, "ramp", BAL_KEY_LONG, G(ramp), "0", 0, 0, 1, NULL,
      "1: gravity rises linearly from zero over this stage's cycles (MLH Sec. 4)"},
     {BAL_SEC_STAGE, "stop_ke", BAL_KEY_DOUBLE, G(stop_ke), "0", 0, 0, BIG, NULL,
-     "stop the stage once E_k <= stop_ke E_el (0: off); cycles is then the most"},
+     "stop the stage once E_k <= stop_ke E_el (0: off); cycles (or time) is then the most"},
     {BAL_SEC_STAGE, "stop_stress", BAL_KEY_DOUBLE, G(stop_stress), "0", 0, 0, BIG, NULL,
      "... and the disc stresses change by <= this share of the largest between checks"},
     {BAL_SEC_STAGE, "check_every", BAL_KEY_LONG, G(check_every), "100", 0, 1, 1e15, NULL,

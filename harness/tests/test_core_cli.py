@@ -134,3 +134,28 @@ def test_full_disk_is_an_io_error_and_leaves_no_temporary_file(full_disk, comman
     assert not [n for n in left if n.endswith(".tmp")], left
     # What is left says why: at most a run.json, and no result file.
     assert set(left) <= {"run.json"}, left
+
+
+@needs_ballast
+def test_run_ends_with_a_summary_of_what_it_simulated(tmp_path):
+    """Issue 23: a run says on exit how it ended, its cycles, the simulated time (the dt it used)
+    and the energy imbalance, so a stage count that covers a fraction of the time meant shows;
+    the same stage given in time covers the same time whatever dt is."""
+    import json
+    import re
+    line = re.compile(r"ballast run: ok, (\d+) cycles, (\S+) s simulated \(dt (\S+)\), wall \S+ s, "
+                      r"energy imbalance \S+ of the energy through the run\n")
+    scene = tmp_path / "drop.scene"
+    scene.write_text("[settings]\ndt = 1e-3\ngravity = 0 -9.81\n[material m]\nkn = 1e3\ndensity = 1\n"
+                     "[disc d]\nx = 0 1\nr = 0.1\nmaterial = m\n[stage fall]\ntime = 0.25\n")
+    seen = []
+    for dt in ("1e-3", "2.5e-4"):
+        done = ballast("run", scene, "--out", tmp_path / dt, "--set", f"settings.dt={dt}")
+        assert done.returncode == 0, done.stderr
+        m = line.fullmatch(done.stdout)
+        assert m, done.stdout
+        seen.append((int(m.group(1)), float(m.group(2))))
+        stage = json.loads((tmp_path / dt / "run.json").read_text())["stages"][0]
+        assert stage["stage_time"] == 0.25 and stage["max_cycles"] == stage["cycles"] == seen[-1][0]
+    assert seen[0][0] == 250 and seen[1][0] == 1000
+    assert seen[0][1] == pytest.approx(0.25, rel=1e-12) and seen[1][1] == pytest.approx(0.25, rel=1e-12)

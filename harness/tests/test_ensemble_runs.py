@@ -4,7 +4,7 @@ The test ensemble is harness/tests/ensemble (a tiny seeded packing, eight seeds)
 a catalogue of its own:
 
 - whatever -j and whatever order, every realisation's outputs are the same bytes (wall-clock
-  fields of run.json aside), and realisations of different seeds differ in every file the
+  fields of run.json and of the core's summary line aside), and realisations of different seeds differ in every file the
   core writes; each realisation's outputs carry its seed (run.json's --set lines,
   harness.json's ensemble and seed);
 - the harness killed outright (SIGKILL) in the middle of the ensemble, then `run --resume`:
@@ -28,7 +28,7 @@ import pytest
 from harness import catalogue
 from harness.runner import jobs_for, run_all
 from harness.tests.fakes import tree_snapshot
-from harness.tests.test_interrupt import comparable, without_wall_clock
+from harness.tests.test_interrupt import comparable, without_summary_clock, without_wall_clock
 
 REPO = Path(__file__).resolve().parents[2]
 BALLAST = REPO / "bin" / "ballast"
@@ -66,8 +66,10 @@ def finish(proc, timeout=300):
 
 
 def outputs(folder):
-    """{file: bytes} of a run folder but harness.json, run.json's wall-clock fields masked."""
-    return {p.name: without_wall_clock(p.read_bytes()) if p.name == "run.json" else p.read_bytes()
+    """{file: bytes} of a run folder but harness.json, the wall clocks of run.json and of the
+    core's summary line (ballast.stdout) masked."""
+    mask = {"run.json": without_wall_clock, "ballast.stdout": without_summary_clock}
+    return {p.name: mask.get(p.name, bytes)(p.read_bytes())
             for p in sorted(Path(folder).iterdir()) if p.name != "harness.json"}
 
 

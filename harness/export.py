@@ -196,7 +196,10 @@ def gather(folder, cases, binary, runs_root, out):
         if not stale(mine, ident) and output_digests(mine.out) == output_digests(remote.out):
             kept.append(remote.label)
             continue
-        copy_run(remote.out, mine.out, folder)
+        changed = copy_run(remote.out, mine.out)
+        if changed:
+            refused.append((remote.label, changed))
+            continue
         gathered.append(remote.label)
     for label, why in refused:
         print(f"NOT GATHERED {label}: {why}", file=out)
@@ -205,10 +208,11 @@ def gather(folder, cases, binary, runs_root, out):
     return gathered, kept, refused
 
 
-def copy_run(source, dest, folder):
+def copy_run(source, dest):
     """dest becomes a copy of the finished run folder source: files copied into a hidden
     sibling, checked against the digests of source's harness.json, harness.json written last
-    (noting where it came from), then renamed into place."""
+    (noting where it came from), then renamed into place.  Returns '' when done, or why not
+    (dest then left as it was)."""
     record = json.loads((source / "harness.json").read_text())
     staging = dest.with_name(f".{dest.name}.gathering")
     old = dest.with_name(f".{dest.name}.old")
@@ -219,7 +223,7 @@ def copy_run(source, dest, folder):
             files.copy(path, staging / path.name)
     if output_digests(staging) != record["outputs"]:
         files.remove_tree(staging)
-        raise CatalogueError(f"{source}: its files changed while they were copied (is a job still running?)")
+        return "its files changed while they were copied (is a job still running?)"
     record["gathered_from"] = str(source)
     files.write_text(staging / "harness.json", json.dumps(record, indent=1) + "\n")
     files.remove_tree(old)
@@ -230,3 +234,4 @@ def copy_run(source, dest, folder):
     except OSError as exc:
         raise files.failure("write", dest, exc) from exc
     files.remove_tree(old)
+    return ""

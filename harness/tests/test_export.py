@@ -251,3 +251,24 @@ def test_gather_with_another_catalogue_says_so(springs, tmp_path, monkeypatch, c
     out = capsys.readouterr().out
     assert f"NOT GATHERED spring/soft: its scene is {tmp_path / 'elsewhere' / 'springs' / 'spring.scene'} here" in out
     assert "0 run(s) gathered, 0 already here, 7 not gathered" in out
+
+
+def test_a_run_that_changes_while_it_is_copied_is_not_gathered(springs, tmp_path, monkeypatch, capsys):
+    """A job still writing (run twice at once, say): the copy's digests differ from the record."""
+    folder = tmp_path / "shared"
+    assert main(["export", "spring", "--to", str(folder)]) == 0
+    assert run_jobs(folder, range(7)) == [0] * 7
+    real_copy = files.copy
+
+    def copy_a_changed_file(source, path):
+        real_copy(source, path)
+        if path.parent.name == ".k_s2.gathering" and path.name == "series.tsv":
+            path.write_text("changed under the copy\n")
+    monkeypatch.setattr(files, "copy", copy_a_changed_file)
+    capsys.readouterr()
+    assert main(["gather", str(folder)]) == 1
+    out = capsys.readouterr().out
+    assert "NOT GATHERED spring/k_s2: its files changed while they were copied" in out
+    assert "6 run(s) gathered, 0 already here, 1 not gathered" in out
+    runs = springs / "reports" / "runs" / "spring"
+    assert sorted(p.name for p in runs.iterdir()) == sorted(set(VARIANTS) - {"k_s2"})

@@ -26,13 +26,14 @@ from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_ro
 from . import catalogue, extremes, files, references, stability
 from . import families  # noqa: F401 -- registers every case family's expression functions
 from . import sweep as sweeps
-from .compare import RunStore, evaluate_all, folder_locator
+from . import sweep_grid
+from .compare import RunStore, folder_locator
 from .errors import Busy, CatalogueError, IniError
-from .gate import gate, sweep_table
+from .gate import gate
 from .lock import reports_lock
 from .rebaseline import rebaseline
 from .report import write_report
-from .runner import jobs_for, run_all, sigterm_as_interrupt, sweep_jobs
+from .runner import jobs_for, run_all, sigterm_as_interrupt
 
 USAGE_ERROR = 2
 IO_ERROR = 3         # as the core's exit code for an I/O error
@@ -142,11 +143,22 @@ def cmd_sweep(args):
     cases = load_cases()
     case = catalogue.select(cases, [args.case])[0]
     variant = sweep_variant(case, args.variant)
-    key, values = parse_sweep(args.set)
-    jobs = sweep_jobs(case, variant, key, values, reports_root() / "sweeps")
+    keyed = sweep_grid.parse_sets(args.set)
+    jobs, extra = sweep_grid.jobs(case, variant, keyed, reports_root() / "sweeps", args.bin)
+    if extra:
+        print(f"sweep over the time step: every point keeps the stages' simulated time ({' '.join(extra)})")
     outcomes = run_all(jobs, args.bin, args.jobs, sys.stdout, resume=args.resume)
+    if any(o.io_error for o in outcomes):       # runs that could not be recorded: say so, no table
+        return runs_status(outcomes)
     checks = [c for c in load_checks(cases) if c.case == case.name and c.run_variants == [variant.name]]
-    print_sweep(case, variant, checks, jobs)
+    if not checks:
+        print(f"no checks of {case.name} use only variant '{variant.name}'")
+        return runs_status(outcomes)
+    results = sweep_grid.evaluate(checks, jobs)
+    print(sweep_grid.table([j.variant for j in jobs], checks, results))
+    path = reports_root() / "sweeps" / case.name / f"sweep_{variant.name}.tsv"
+    sweep_grid.write_tsv(path, jobs, checks, results)
+    print(f"wrote {path}")
     return runs_status(outcomes)
 
 
@@ -217,26 +229,6 @@ def sweep_variant(case, name):
     return case.variants[0]
 
 
-def parse_sweep(text):
-    """'KEY=V1,V2,...' -> (KEY, [V1, V2, ...])."""
-    key, sep, values = text.partition("=")
-    values = [v.strip() for v in values.split(",") if v.strip()]
-    if not sep or not key or not values or any("/" in v for v in values):
-        raise CatalogueError(f"--set needs KEY=V1,V2,... (no '/' in values), got '{text}'")
-    return key, values
-
-
-def print_sweep(case, variant, checks, jobs):
-    if not checks:
-        print(f"no checks of {case.name} use only variant '{variant.name}'")
-        return
-    by_label = {}
-    for job in jobs:
-        store = RunStore(lambda c, v, folder=job.out: folder)
-        by_label[job.variant] = evaluate_all(checks, store)
-    print(sweep_table([j.variant for j in jobs], checks, by_label))
-
-
 # ---------------------------------------------------------------- arguments
 
 def parser():
@@ -258,9 +250,11 @@ def parser():
                           help="skip the stability limits (first variant of each case) and extreme probes")
     rebase = _command(sub, "rebaseline", cmd_rebaseline, "rewrite the regression values of CASE from its current outputs")
     rebase.add_argument("case", metavar="CASE")
-    sweep = _command(sub, "sweep", cmd_sweep, "run one variant once per value of a --set key and tabulate its checks")
+    sweep = _command(sub, "sweep", cmd_sweep, "run one variant at every point of a grid of --set values and "
+                                              "tabulate its checks, their error and each point's cost")
     sweep.add_argument("case", metavar="CASE")
-    sweep.add_argument("--set", required=True, metavar="KEY=V1,V2,...")
+    sweep.add_argument("--set", required=True, action="append", metavar="KEY=V1,V2,...",
+                       help="repeatable: several keys combine as a grid; a dt sweep keeps the simulated time")
     sweep.add_argument("--variant", metavar="NAME", help="the variant to sweep (needed when the case has several)")
     _runs(sweep)
     _runs(_selection(_command(sub, "cost", cmd_cost,

@@ -145,19 +145,3 @@ def gate(checks, store, reports_dir, out):
     write_summary(verdicts, Path(reports_dir) / "summary.json")
     write_junit(verdicts, Path(reports_dir) / "junit.xml")
     return exit_status(verdicts)
-
-
-def sweep_table(labels, checks, verdicts_by_label):
-    """A sweep's table: one row per check, one column per swept value ('value PASS/FAIL')."""
-    header = ["check", "reference", "tolerance"] + list(labels)
-    rows = []
-    for i, check in enumerate(checks):
-        first = verdicts_by_label[labels[0]][i]
-        rows.append([check.name, fmt_reference(first), first.tolerance] +
-                    [_sweep_cell(verdicts_by_label[label][i]) for label in labels])
-    widths = [max(len(r[j]) for r in [header] + rows) for j in range(len(header))]
-    return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in [header] + rows)
-
-
-def _sweep_cell(v):
-    return f"{fmt_number(v.value)} {v.result}"

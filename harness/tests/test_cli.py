@@ -1,4 +1,5 @@
 """The command line as a whole: list, sweep, validate, the wrapper script, and malformed series."""
+import json
 import os
 import subprocess
 from pathlib import Path
@@ -55,11 +56,29 @@ def test_sweep(project, capsys):
     out = capsys.readouterr().out
     sweeps = project / "reports" / "sweeps" / "spring"
     assert (sweeps / "k=1" / "series.tsv").exists() and (sweeps / "k=2" / "series.tsv").exists()
-    table = out[out.index("check"):].splitlines()
+    table = out[out.index("check"):out.index("wrote")].splitlines()
     assert table[0].split() == ["check", "reference", "tolerance", "k=1", "k=2"]
     rows = {line.split()[0]: line for line in table[1:]}
-    assert set(rows) == {"abs_at2", "interval_ek", "regress_mean"}       # checks of soft alone
-    assert rows["abs_at2"].split()[-4:] == ["2", "PASS", "4", "FAIL"]
+    assert set(rows) == {"abs_at2", "interval_ek", "regress_mean",       # checks of soft alone
+                         "(status)", "(steps)", "(particle-steps)", "(wall"}   # ... and each point's cost
+    # value, verdict and error against the reference 2 (abs tolerance): 0 at k=1, |4 - 2|/2 at k=2
+    assert rows["abs_at2"].split()[-8:] == ["2", "PASS", "err", "0.00e+00", "4", "FAIL", "err", "1.00e+00"]
+    assert rows["(status)"].split()[-2:] == ["ok", "ok"]
+    tsv = (sweeps / "sweep_soft.tsv").read_text().splitlines()
+    assert tsv[0].split("\t")[:3] == ["point", "sets", "status"] and len(tsv) == 1 + 2 * 3
+
+
+def test_sweep_with_several_keys_runs_their_grid(project, capsys):
+    """Issue 23: several --set options combine as a grid (the first key slowest); a key twice is
+    refused rather than one of them dropped in silence."""
+    assert main(["sweep", "spring", "--set", "k=1,2", "--set", "x=5,6,7", "--variant", "soft"]) == 0
+    out = capsys.readouterr().out
+    labels = out[out.index("check"):].splitlines()[0].split()[3:]
+    assert labels == ["k=1,x=5", "k=1,x=6", "k=1,x=7", "k=2,x=5", "k=2,x=6", "k=2,x=7"]
+    run = project / "reports" / "sweeps" / "spring" / "k=2,x=6"
+    assert json.loads((run / "run.json").read_text())["sets"][-2:] == ["k=2", "x=6"]
+    assert main(["sweep", "spring", "--set", "k=1,2", "--set", "k=3", "--variant", "soft"]) == 2
+    assert "--set k given twice" in capsys.readouterr().err
 
 
 def test_sweep_needs_a_variant_when_several(project, capsys):

@@ -104,8 +104,10 @@ test-valgrind: bin/ballast
 	@echo "test-valgrind: two_discs (damped), a pile (grid, stages) and the exact solver clean under memcheck"
 
 # ---- validation -----------------------------------------------------------
+# RESUME=1 keeps the runs an interrupted validate finished (--resume); CASES="a b" validates
+# those cases only and updates their part of the report.
 validate: all
-	$(PYTHON) -m harness validate --tier $(TIER) -j $(JOBS)
+	$(PYTHON) -m harness validate --tier $(TIER) -j $(JOBS) $(if $(RESUME),--resume) $(CASES)
 
 # Error against cost: every [sweep] of the tier's cases -> reports/sweeps/<case>/cost.tsv
 # (validate runs them too, between the gate and the report; `harness report` draws them).

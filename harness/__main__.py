@@ -96,19 +96,33 @@ def runs_status(outcomes):
     return 0 if all(o.ok for o in outcomes) else 1
 
 
+def subset(args):
+    """True when the command was given case names: it updates their part of the report only."""
+    return bool(getattr(args, "cases", None))
+
+
 def cmd_check(args):
     all_cases = load_cases()
     checks = load_checks(all_cases)
     cases = selected(args, all_cases)
-    return gate(references.for_cases(checks, cases), default_store(all_cases), reports_root(), sys.stdout)
+    return gate(references.for_cases(checks, cases), default_store(all_cases), reports_root(), sys.stdout,
+                keep_others=subset(args))
 
 
 def cmd_report(args):
+    """The report of the tier; given case names, their figures are drawn anew and the other cases
+    that have runs keep what an earlier report drew, so the report stays whole."""
     all_cases = load_cases()
     checks = load_checks(all_cases)
-    cases = selected(args, all_cases)
+    cases, render = selected(args, all_cases), None
+    if subset(args):
+        render = {c.name for c in cases}
+        tier = catalogue.select(all_cases, [], args.tier)
+        tier_names = {c.name for c in tier}
+        cases = [c for c in all_cases
+                 if c.name in render or (c.name in tier_names and (runs_root() / c.name).is_dir())]
     write_report(cases, references.for_cases(checks, cases), default_store(all_cases), runs_root(), reports_root(),
-                 sys.stdout)
+                 sys.stdout, render)
     return 0
 
 
@@ -122,7 +136,9 @@ def cmd_validate(args):
         # the first DEM variant of each case and the extreme probes (all variants:
         # `harness stability`); a measurement shown in the report, not a gate
         stab = argparse.Namespace(**vars(args))
-        stab.one_per_case, stab.extremes_only, stab.no_extremes = True, False, False
+        # the extreme probes belong to no case: a validate of some cases runs them only when asked
+        stab.one_per_case, stab.extremes_only = True, False
+        stab.no_extremes = subset(args) and not args.extremes
         stab.cap, stab.tolerance = 20000, 0.01
         try:
             cmd_stability(stab)
@@ -246,6 +262,8 @@ def parser():
     _selection(_command(sub, "report", cmd_report, "render figures, write reports/summary.md and reports/index.html"))
     validate = _runs(_selection(_command(sub, "validate", cmd_validate, "run + check + cost + report")))
     validate.add_argument("--no-sweeps", action="store_true", help="skip the declared sweeps (cost)")
+    validate.add_argument("--extremes", action="store_true",
+                          help="run the extreme probes even when cases are named (a validate of all cases runs them)")
     validate.add_argument("--no-stability", action="store_true",
                           help="skip the stability limits (first variant of each case) and extreme probes")
     rebase = _command(sub, "rebaseline", cmd_rebaseline, "rewrite the regression values of CASE from its current outputs")

@@ -117,3 +117,39 @@ def test_series_with_header_only_has_empty_columns(tmp_path):
     (tmp_path / "series.tsv").write_text("cycle\ttime\tEk\n")
     columns = read_series(tmp_path / "series.tsv")
     assert list(columns) == ["cycle", "time", "Ek"] and columns["Ek"].size == 0
+
+
+def test_validate_of_one_case_updates_its_part_and_keeps_the_rest(project, capsys):
+    """Issue 23: `validate CASE` checks and draws that case and leaves the other cases' verdicts
+    and figures in summary.json, junit.xml and index.html as an earlier validate wrote them."""
+    (project / "reference" / "slow.ref").write_text(
+        "[check slow_last]\ncase = slow\nvariant = only\nquantity = last(F)\nvalue = 10\n"
+        "tolerance = rel 1e-9\nkind = exact\nprovenance = F = k x with k = 1, x = 10\n")
+    assert main(["validate", "--tier", "full", "--no-stability"]) == 0
+    reports = project / "reports"
+    before = json.loads((reports / "summary.json").read_text())
+    spring = [v for v in before if v["case"] == "spring"]
+    assert spring and (reports / "figures" / "spring_force.png").exists()
+    figure = (reports / "figures" / "spring_force.png").stat().st_mtime_ns
+    capsys.readouterr()
+    assert main(["validate", "slow", "--tier", "full", "--no-stability"]) == 0
+    out = capsys.readouterr().out
+    assert "spring/" not in out                                   # spring was not run again
+    after = json.loads((reports / "summary.json").read_text())
+    assert [v for v in after if v["case"] == "spring"] == spring   # ... and its verdicts kept
+    assert 'classname="spring.' in (reports / "junit.xml").read_text()
+    page = (reports / "index.html").read_text()
+    assert "A linear spring" in page and "A slow case" in page
+    assert (reports / "figures" / "spring_force.png").stat().st_mtime_ns == figure   # not redrawn
+
+
+def test_validate_of_some_cases_runs_the_extreme_probes_only_when_asked(project, monkeypatch):
+    """Issue 23: the extreme probes belong to no case: a validate of all cases runs them, a
+    validate of named cases only with --extremes."""
+    import harness.__main__ as cli
+    seen = []
+    monkeypatch.setattr(cli, "cmd_stability", lambda a: seen.append(a.no_extremes) or 0)
+    for argv, skipped in ((["validate"], False), (["validate", "spring"], True),
+                          (["validate", "spring", "--extremes"], False)):
+        main(argv)
+        assert seen.pop() is skipped, argv

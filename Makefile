@@ -32,7 +32,7 @@ LIB_OBJ  := $(LIB_SRC:core/%.c=$(BUILD)/%.o)
 TEST_SRC := $(wildcard core/tests/check_*.c)
 BENCH_SRC := core/bench/bench.c
 
-.PHONY: all deps test test-c test-prefix test-py test-sanitize validate bench bench-scaling \
+.PHONY: all deps test test-c test-prefix test-py test-sanitize test-browser validate bench bench-scaling \
         bench-peer bench-modules bench-modules-count bench-scaling-count bench-flat bench-threads \
         clean keys sweep \
         test-valgrind
@@ -102,6 +102,12 @@ test-valgrind: bin/ballast
 	valgrind -q --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite,possible \
 	  bin/ballast exact cases/piles/pile30_smooth.scene --out $(BUILD)/valgrind/exact
 	@echo "test-valgrind: two_discs (damped), a pile (grid, stages) and the exact solver clean under memcheck"
+
+# The HTML report of the last validate in a real browser (headless chromium through
+# chromedriver: images decode, links resolve, no console error, size; reports/browser.png).
+test-browser:
+	sh .ci/install-browser-deps
+	$(PYTHON) -m pytest -q harness/tests/test_browser.py
 
 # ---- validation -----------------------------------------------------------
 # RESUME=1 keeps the runs an interrupted validate finished (--resume); CASES="a b" validates

@@ -227,9 +227,15 @@ def _stability(args, work):
         print(f"stability: {len(probes)} extreme probe(s)")
         rows = extremes.run_probes(args.bin, probes, work, args.jobs, sys.stdout, args.resume)
         stability.merge_tsv(rows, extremes.EXTREME_COLUMNS, reports_root() / "extremes.tsv", ("probe",))
+        findings = 0
         for r in rows:
-            print(f"  {r['group']}/{r['probe']}: {r['outcome']}{'' if r['as_expected'] == 'yes' else '  UNEXPECTED'}")
-        print(f"wrote {reports_root() / 'extremes.tsv'}")
+            print(f"  {r['group']}/{r['probe']}: {r['outcome']}")
+            if r["as_expected"] != "yes":
+                findings += 1
+                print(f"      finding: declared '{r['expect']}', behaved otherwise (above); a measurement "
+                      "for docs/stability.md, not a gate")
+        print(f"extreme probes: {len(rows) - findings} as declared, {findings} finding(s); the probes "
+              f"measure limits and never change the exit status; wrote {reports_root() / 'extremes.tsv'}")
     return status
 
 

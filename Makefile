@@ -33,7 +33,7 @@ LIB_OBJ  := $(LIB_SRC:core/%.c=$(BUILD)/%.o)
 TEST_SRC := $(wildcard core/tests/check_*.c)
 BENCH_SRC := core/bench/bench.c
 
-.PHONY: all deps test test-c test-prefix test-py test-sanitize validate bench bench-scaling \
+.PHONY: all deps test test-c test-prefix test-py test-sanitize test-browser validate bench bench-scaling \
         bench-peer bench-modules bench-modules-count bench-scaling-count bench-flat bench-threads \
         clean keys sweep \
         test-valgrind test-slurm
@@ -113,9 +113,17 @@ test-slurm: bin/ballast
 	@sh .ci/install-deps slurm
 	bash harness/tests/slurm/run
 
+# The HTML report of the last validate in a real browser (headless chromium through
+# chromedriver: images decode, links resolve, no console error, size; reports/browser.png).
+test-browser:
+	sh .ci/install-browser-deps
+	$(PYTHON) -m pytest -q harness/tests/test_browser.py
+
 # ---- validation -----------------------------------------------------------
+# RESUME=1 keeps the runs an interrupted validate finished (--resume); CASES="a b" validates
+# those cases only and updates their part of the report.
 validate: all
-	$(PYTHON) -m harness validate --tier $(TIER) -j $(JOBS)
+	$(PYTHON) -m harness validate --tier $(TIER) -j $(JOBS) $(if $(RESUME),--resume) $(CASES)
 
 # Error against cost: every [sweep] of the tier's cases -> reports/sweeps/<case>/cost.tsv
 # (validate runs them too, between the gate and the report; `harness report` draws them).

@@ -462,6 +462,8 @@ enum bal_status bal_sim_run(struct bal_sim *sim, FILE *series,
  * stage given in simulated time (to 1e-9 of a step: a time that is a whole
  * number of steps in exact arithmetic is that number of cycles). */
 long bal_sim_stage_cycles(const struct bal_sim *sim, int stage);
+/* 1: stage g was given in simulated time (`time`), 0: in cycles. */
+int bal_sim_stage_in_time(const struct bal_sim *sim, int stage);
 
 /* What a progress report sees: the stage running, its cycles so far and at
  * most, the cycles and the simulated time of the whole run so far. */

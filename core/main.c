@@ -184,6 +184,12 @@ static int cmd_info(const struct args *a)
     printf("dt fraction    %.17g\n", in.dt_fraction);
     printf("dt used        %.17g\n", in.dt);
     printf("stages         %d (%ld cycles)\n", sc.n_stages, cycles);
+    /* One line per stage, its cycles and the simulated time they cover at
+     * this dt (a sweep over dt keeps the time: harness/sweep_grid.py). */
+    for (int g = 0; g < sc.n_stages; g++)
+        printf("stage          %s %ld cycles %.17g s (%s)\n", sc.stages[g].name,
+               bal_sim_stage_cycles(sim, g), (double)bal_sim_stage_cycles(sim, g) * in.dt,
+               bal_sim_stage_in_time(sim, g) ? "time" : "cycles");
     bal_sim_free(sim);
     bal_scene_free(&sc);
     return 0;

@@ -53,7 +53,8 @@ const struct bal_key bal_scene_keys[] = {
     {BAL_SEC_SETTINGS, "dt", BAL_KEY_DOUBLE, S(dt), "0", 0, 0, BIG, NULL,
      "time step; 0 = dt_fraction x the critical-step estimate"},
     {BAL_SEC_SETTINGS, "dt_fraction", BAL_KEY_DOUBLE, S(dt_fraction), "0.1", 0, 1e-9, 1, NULL,
-     "fraction of the critical-step estimate (contact-network bound; ballast info prints it)"},
+     "fraction of the critical-step estimate (contact-network bound; ballast info prints it); "
+     "below 1: 1 is refused unless force_dt = 1"},
     {BAL_SEC_SETTINGS, "alpha", BAL_KEY_DOUBLE, S(alpha), "0", 0, 0, BIG, NULL,
      "global damping alpha, C = alpha m, C* = alpha I (C&S eqs 34-36), 1/time"},
     {BAL_SEC_SETTINGS, "beta", BAL_KEY_DOUBLE, S(beta), "0", 0, 0, BIG, NULL,

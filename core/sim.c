@@ -295,6 +295,11 @@ long bal_sim_stage_cycles(const struct bal_sim *s, int stage)
     return s->log[stage].max_cycles;
 }
 
+int bal_sim_stage_in_time(const struct bal_sim *s, int stage)
+{
+    return s->log[stage].in_time;
+}
+
 void bal_sim_set_progress(struct bal_sim *s, void (*report)(const struct bal_progress *, void *),
                           void *ctx, double seconds)
 {

@@ -145,6 +145,7 @@ struct bal_stage_log {
                             * walls at the last check (-1: never) */
     double unbalanced;     /* ΔF/F at the last check (-1: never) */
     long max_cycles;       /* the stage's cycles, or ceil(time/dt) (bal_build_stages) */
+    int in_time;           /* 1: the stage was given in simulated time */
 };
 
 /* Running sums of the energy audit (energy.c), from the first cycle. */

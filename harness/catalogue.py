@@ -56,7 +56,7 @@ from .ini import parse_file
 from .sweep_spec import parse as parse_sweep
 
 CASE_KEYS = {"tier", "title", "checks", "runtime", "stability"}
-VARIANT_KEYS = {"scene", "set", "command"}
+VARIANT_KEYS = {"scene", "set", "command", "label"}
 COMMANDS = ("run", "exact", "peer", "peer_rolling")
 FIGURE_KINDS = ("series", "network", "profile", "principal", "points", "curves", "errorbars", "fit")
 _COMMON = {"kind", "title", "variants", "paper"}
@@ -90,6 +90,7 @@ class Variant:
                              # peer_rolling: JYH's rolling against LAMMPS (harness/peer/rolling.py)
     ensemble: str = ""       # a realisation of [ensemble NAME]: NAME (and its seed); '' otherwise
     seed: int = None
+    label: str = ""          # what a figure's legend calls it ('' : its name)
 
 
 @dataclass
@@ -114,6 +115,7 @@ class Figure:
     groups: list = field(default_factory=list)   # fit: (label, [variants]) per group
     paper_points: list = field(default_factory=list)   # errorbars: (x, y, label) published values
     slope: str = "number"    # fit: how the legend gives a line's slope (SLOPES)
+    names: dict = field(default_factory=dict)   # variant -> its legend label (the variants' `label`)
 
 
 @dataclass
@@ -238,7 +240,8 @@ def _add_variant(case, section):
     command = section.get("command", "run")
     if command not in COMMANDS:
         raise section.error(f"command must be one of {', '.join(COMMANDS)}, not '{command}'")
-    case.variants.append(Variant(section.name, case.folder / section.require("scene"), sets, command))
+    case.variants.append(Variant(section.name, case.folder / section.require("scene"), sets, command,
+                                 label=section.get("label", "")))
 
 
 def _not_an_ensembles_name(case, section, name):
@@ -450,6 +453,7 @@ def _finish(case):
                 raise IniError(case.path, figure.line,
                                f"figure '{figure.name}' names unknown variant '{name}'")
         figure.variants = figure.variants or case.variant_names()
+        figure.names = {v.name: v.label for v in case.variants if v.label}
 
 
 def ensembles_of(cases):

@@ -550,9 +550,3 @@ def run_all(jobs, binary, workers=None, out=sys.stdout, tty=None, resume=False):
     return outcomes
 
 
-def sweep_jobs(case, variant, key, values, sweeps_root):
-    """One Job per value: the variant with KEY=value appended, outputs in sweeps_root/<case>/<KEY>=<V>."""
-    return [Job(case.name, f"{key}={v}", variant.scene, list(variant.sets) + [f"{key}={v}"],
-                Path(sweeps_root) / case.name / f"{key}={v}", case.runtime / len(case.variants),
-                variant.command)
-            for v in values]

@@ -406,7 +406,11 @@ def summary_text(name, rows):
         lines.append(f"  error <= {tol:g}: " + (f"{setting(r)}, error {_cell(r['error'])}, "
                                                  f"{r['particle_steps']} particle-steps"
                                                  if r else "no swept setting"))
-    bad = [f"{r['sweep']} x{number(r['factor'])}" for r in rows if failed(r)]
-    if bad:
-        lines.append(f"  failed (unstable or no run.json; no error): {', '.join(bad)}")
+    unstable = [f"{r['sweep']} x{number(r['factor'])}" for r in rows if r["status"] == "unstable"]
+    other = [f"{r['sweep']} x{number(r['factor'])}" for r in rows if failed(r) and r["status"] != "unstable"]
+    if unstable:
+        lines.append(f"  beyond the stability limit (the run-time guards stopped them; a measured limit of "
+                     f"the trade, not a gate): {', '.join(unstable)}")
+    if other:
+        lines.append(f"  no result (no usable run.json; not a gate): {', '.join(other)}")
     return "\n".join(lines)

@@ -159,3 +159,26 @@ def test_run_ends_with_a_summary_of_what_it_simulated(tmp_path):
         assert stage["stage_time"] == 0.25 and stage["max_cycles"] == stage["cycles"] == seen[-1][0]
     assert seen[0][0] == 250 and seen[1][0] == 1000
     assert seen[0][1] == pytest.approx(0.25, rel=1e-12) and seen[1][1] == pytest.approx(0.25, rel=1e-12)
+
+
+@needs_ballast
+def test_a_sweep_over_the_time_step_keeps_the_simulated_time(tmp_path):
+    """Issue 23: `harness sweep --set settings.dt=...` runs each stage given in cycles over the
+    same simulated time (stage.NAME.time overrides from `ballast info`), so halving dt doubles
+    the steps, and the table has each point's error and cost."""
+    import json
+    import sys
+    env = {**os.environ, "BALLAST_REPORTS": str(tmp_path), "PYTHONPATH": str(REPO)}
+    for var in ("BALLAST_CASES", "BALLAST_REFERENCE", "BALLAST_BIN"):
+        env.pop(var, None)
+    done = subprocess.run([sys.executable, "-m", "harness", "sweep", "two_discs", "--variant", "undamped",
+                           "--set", "settings.dt=0.01,0.005", "-j", "2"], cwd=REPO, env=env,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "keeps the stages' simulated time" in done.stdout and "(wall s)" in done.stdout
+    runs = [json.loads((tmp_path / "sweeps" / "two_discs" / f"settings.dt={dt}" / "run.json").read_text())
+            for dt in ("0.01", "0.005")]
+    assert runs[1]["steps"] == 2 * runs[0]["steps"]
+    assert runs[1]["time"] == pytest.approx(runs[0]["time"], rel=1e-12)
+    for run in runs:
+        assert [st["cycles"] * run["dt"] for st in run["stages"]] == pytest.approx([0.4, 6.0], rel=1e-12)

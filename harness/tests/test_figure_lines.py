@@ -97,3 +97,14 @@ def test_lines_alone_are_not_a_figure(tmp_path, store):
     case = load(tmp_path, "[figure m]\nvariants = b\nx = theta_r\ny = mr\nline = 2.5 0 K_m\n")
     out = plots.render_figure(case, case.figures[0], store, tmp_path)
     assert out.png is None and out.notes[-1] == "nothing to plot"
+
+
+def test_a_variant_label_names_its_curve_in_the_legend(tmp_path):
+    """Issue 23: legends say what a curve is (`label` of the variant), not the variant's name."""
+    folder = tmp_path / "cases" / "laws"
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "case.txt").write_text(CASE.replace("[variant a]\n", "[variant a]\nlabel = Model 1, delta = 1.6\n")
+                                     + "\n[figure m]\nx = cycle\ny = mr\n")
+    figure = catalogue.load(tmp_path / "cases")[0].figures[0]
+    assert plots.curve_title("a", "mr", figure) == "Model 1, delta = 1.6"
+    assert plots.curve_title("b", "mr", figure) == "b"               # no label: its name

@@ -403,7 +403,9 @@ def test_failed_points_have_no_error_and_say_why(project, capsys):
     assert main(["run", "spring"]) == 0
     assert main(["cost", "spring"]) == 0
     out = capsys.readouterr().out
-    assert "failed (unstable or no run.json; no error): blows_up x1, blows_up x2, no_output x1, no_output x2" in out
+    assert "beyond the stability limit (the run-time guards stopped them; a measured limit of the trade, " \
+           "not a gate): blows_up x1, blows_up x2" in out
+    assert "no result (no usable run.json; not a gate): no_output x1, no_output x2" in out
     rows = sweep.read_tsv(project / "reports" / "sweeps" / "spring" / "cost.tsv")
     by = {(r["sweep"], r["factor"]): r for r in rows}
     blown = by[("blows_up", 2.0)]

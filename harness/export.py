@@ -38,7 +38,7 @@ import os
 import shlex
 from pathlib import Path
 
-from . import REPO_ROOT, catalogue, files
+from . import REPO_ROOT, files
 from .errors import CatalogueError
 from .runner import Job, binary_identity, identity, jobs_for, output_digests, run_one, sha256_of, stale
 

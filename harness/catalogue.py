@@ -74,7 +74,7 @@ FIGURE_KIND_KEYS = {
 SLOPES = ("number", "asin")
 FIGURE_KEYS = set().union(*FIGURE_KIND_KEYS.values())
 LOGSCALES = {"": "", "x": "x", "y": "y", "xy": "xy", "yx": "xy"}
-PROFILE_XLABEL = "X = (x - x0) / l"
+PROFILE_XLABEL = "X = (x - x0) / l (-)"
 PROFILE_YLABEL = "S (compression positive, units m g / l)"
 NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 RANGE = re.compile(rf"^\s*({NUMBER})?\s*:\s*({NUMBER})?\s*$")

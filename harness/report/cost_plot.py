@@ -86,7 +86,7 @@ def render_cost(case, rows, figures_dir):
         return out
     figure = _CostAxes(out.title)
     if any(str(r["worst"]).startswith("vs finest: ") for r in rows):
-        figure.ylabel = "error: max |q - q_finest| / |q_finest| (against the finest swept run)"
+        figure.ylabel = "error against the finest swept run: max |q - q_finest| / |q_finest| (-)"
     errors = [y for pts in curves.values() for _, y, _ in pts]
     top = max(errors) * 10 if errors else 1.0
     names = list(dict.fromkeys(list(curves) + list(bad)))
@@ -134,6 +134,6 @@ class _CostAxes:
     """What gnuplot_script needs of a figure, for the cost diagram."""
     title: str
     xlabel: str = "cost: particle-steps (steps x discs)"
-    ylabel: str = "error: max |q - ref| / |ref| over the error terms"
+    ylabel: str = "error: max |q - ref| / |ref| over the error terms (-)"
     xrange: str = ""
     yrange: str = ""

@@ -62,7 +62,7 @@ FIGURE_KINDS = ("series", "network", "profile", "principal", "points", "curves",
 _COMMON = {"kind", "title", "variants", "paper"}
 _AXES = {"xlabel", "ylabel", "xrange", "yrange"}
 FIGURE_KIND_KEYS = {
-    "series": _COMMON | _AXES | {"x", "y", "line"},
+    "series": _COMMON | _AXES | {"x", "y", "line", "reference"},
     "network": _COMMON,
     "profile": _COMMON | _AXES | {"y", "row"},
     "principal": _COMMON,
@@ -74,7 +74,7 @@ FIGURE_KIND_KEYS = {
 SLOPES = ("number", "asin")
 FIGURE_KEYS = set().union(*FIGURE_KIND_KEYS.values())
 LOGSCALES = {"": "", "x": "x", "y": "y", "xy": "xy", "yx": "xy"}
-PROFILE_XLABEL = "X = (x - x0) / l"
+PROFILE_XLABEL = "X = (x - x0) / l (-)"
 PROFILE_YLABEL = "S (compression positive, units m g / l)"
 NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 RANGE = re.compile(rf"^\s*({NUMBER})?\s*:\s*({NUMBER})?\s*$")
@@ -116,6 +116,7 @@ class Figure:
     paper_points: list = field(default_factory=list)   # errorbars: (x, y, label) published values
     slope: str = "number"    # fit: how the legend gives a line's slope (SLOPES)
     names: dict = field(default_factory=dict)   # variant -> its legend label (the variants' `label`)
+    references: list = field(default_factory=list)   # series: checks whose reference value is drawn
 
 
 @dataclass
@@ -299,6 +300,7 @@ def _series(section, common):
                   y=section.require("y").split(), xlabel=section.get("xlabel", section.require("x")),
                   ylabel=section.get("ylabel", ""), xrange=_range(section, "xrange"),
                   yrange=_range(section, "yrange"), lines=[_line(section, e) for e in section.all("line")],
+                  references=[w for e in section.all("reference") for w in e.value.split()],
                   **common)
 
 

@@ -477,3 +477,13 @@ def test_self_convergence_is_against_the_finest_swept_run(project, capsys):
 def test_validate_accepts_a_sweep_measured_by_converge_alone(project):
     add_sweeps(project, "\n[sweep s]\nvariant = stiffer\nkeys = k=1\nfactors = 2\nconverge = last(F)\n")
     assert main(["check"]) in (0, 1)                      # no declaration error (exit 2)
+
+
+def test_labels_of_coinciding_points_are_merged():
+    """Issue 23: points of one curve at (nearly) the same cost and error get one label, not three
+    printed over each other; points apart keep their own."""
+    from harness.report.cost_plot import merged_labels
+    points = [(1000.0, 1e-5, "x0.5"), (1000.0, 1.01e-5, ""), (1010.0, 1.02e-5, "x2"), (1005.0, 0.99e-5, "x4"),
+              (4000.0, 1e-5, "x0.25")]
+    assert merged_labels(points) == [(1000.0, 1e-5, "x0.5, x2, x4"), (1000.0, 1.01e-5, ""), (1010.0, 1.02e-5, ""),
+                                     (1005.0, 0.99e-5, ""), (4000.0, 1e-5, "x0.25")]

@@ -1,4 +1,5 @@
-"""The command line: python3 -m harness {list,run,check,report,validate,rebaseline,sweep,cost}.
+"""The command line: python3 -m harness {list,run,check,report,validate,rebaseline,sweep,cost,
+stability,export,job,gather}.
 
 Each command is a small function that loads the catalogue and references, picks the
 cases, and hands over to runner, gate, report or rebaseline.  Exit statuses besides 0 and
@@ -23,7 +24,7 @@ from contextlib import nullcontext
 from pathlib import Path
 
 from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_root
-from . import catalogue, extremes, files, references, stability
+from . import catalogue, export, extremes, files, references, stability
 from . import families  # noqa: F401 -- registers every case family's expression functions
 from . import sweep as sweeps
 from . import sweep_grid
@@ -185,6 +186,26 @@ def cmd_cost(args):
     sweeps.run_declared(selected(args, all_cases), checks, args.bin, args.jobs, runs_root(),
                         reports_root() / "sweeps", sys.stdout, functools.partial(run_all, resume=args.resume))
     return 0
+def cmd_export(args):
+    """The selected cases' runs as a GNU parallel job list and a Slurm array (export.py)."""
+    cases = selected(args, load_cases())
+    if not cases:
+        raise CatalogueError("no cases selected")
+    export.export(cases, args.bin, args.to, sys.stdout)
+    return 0
+
+
+def cmd_job(args):
+    """One run of an export folder, where parallel or Slurm started it."""
+    return runs_status([export.run_job(args.dir, args.index, sys.stdout)])
+
+
+def cmd_gather(args):
+    """The finished runs of an export folder into reports/runs; 1 if some are not there."""
+    gathered, kept, refused = export.gather(args.dir, load_cases(), args.bin, runs_root(), sys.stdout)
+    return 1 if refused else 0
+
+
 STABILITY_RUNS = "stability-runs"     # the trial runs of `stability`, under the reports root
 
 
@@ -293,6 +314,22 @@ def parser():
     stab.add_argument("--extremes-only", action="store_true", help="only the probes of cases/extremes")
     stab.add_argument("--no-extremes", action="store_true", help="only the catalogue's limits")
     stab.add_argument("--one-per-case", action="store_true", help="only the first DEM variant of each case")
+    exp = _command(sub, "export", cmd_export,
+                   "write the selected cases' runs as a GNU parallel job list and a Slurm job-array "
+                   "script into DIR (docs/ensembles.md)", writes=False)
+    _selection(exp)
+    exp.add_argument("--to", required=True, type=Path, metavar="DIR",
+                     help="the export folder, seen at the same path by every machine that runs jobs")
+    exp.add_argument("--bin", type=Path, default=None, help="the core executable (default $BALLAST_BIN or bin/ballast)")
+    job = _command(sub, "job", cmd_job, "run job INDEX of an export folder (what jobs.txt and slurm.sh call)",
+                   writes=False)
+    job.add_argument("dir", type=Path, metavar="DIR")
+    job.add_argument("index", type=int, metavar="INDEX")
+    gat = _command(sub, "gather", cmd_gather,
+                   "copy the finished runs of an export folder into reports/runs, as `run` writes them")
+    gat.add_argument("dir", type=Path, metavar="DIR")
+    gat.add_argument("--bin", type=Path, default=None,
+                     help="the core executable the runs must have been made by (default $BALLAST_BIN or bin/ballast)")
     return p
 
 

@@ -73,6 +73,8 @@ class Job:
     command: str = "run"    # the core's command: run (DEM) or exact (static solver)
     ensemble: str = ""      # a realisation of [ensemble NAME]: NAME, and its seed (in harness.json)
     seed: int = None
+    probe: bool = False     # a sweep point that may lie past a stability limit: its unstable end
+                            # (exit 1) is a measured limit, reported as such and not as a failure
 
     @property
     def label(self):
@@ -323,6 +325,17 @@ def rate_text(runs, seconds):
     return f"{per_minute:.3g} runs/min" if per_minute >= 1 else f"{per_minute * 60:.3g} runs/h"
 
 
+def limit_found(outcome):
+    """Whether a failed run is a sweep point past its stability limit: a probing job (Job.probe)
+    whose run.json says the core ended it as unstable (its run-time guards)."""
+    if not outcome.job.probe or outcome.ok or outcome.skipped:
+        return False
+    try:
+        return read_run_json(outcome.job.out).get("status") == "unstable"
+    except (RunProblem, OSError):
+        return False
+
+
 class Progress:
     """What the runs have done so far, on out.
 
@@ -347,7 +360,7 @@ class Progress:
         self.long = self.total > long_batch
         self.period, self.clock = period, clock
         self.start = clock()
-        self.ran = self.kept = self.failed = 0
+        self.ran = self.kept = self.failed = self.limits = 0
         self.last_line = None       # when the last periodic line was printed (long batches off a tty)
 
     def eta(self):
@@ -372,7 +385,11 @@ class Progress:
             return
         self.ran += 1
         self.expected_done += outcome.job.expected
-        if not outcome.ok:
+        if limit_found(outcome):
+            self.limits += 1
+            self._write(f"LIMIT {outcome.job.label}: past its stability limit, the guards stopped it "
+                        f"(a measured point of the sweep, not a failure): {outcome.cause}", keep=True)
+        elif not outcome.ok:
             self.failed += 1
             self._write(f"FAILED {outcome.job.label}: {outcome.cause}", keep=True)
         if outcome.skip_reason:
@@ -381,13 +398,15 @@ class Progress:
             self._status(outcome)
             return
         line = f"[{self.done}/{self.total}] {outcome.job.label}  {outcome.wall:.2f} s  ETA {self.eta():.0f} s"
-        self._write(line + ("" if outcome.ok else "  FAILED"), keep=not self.tty)
+        self._write(line + ("" if outcome.ok else "  LIMIT" if limit_found(outcome) else "  FAILED"),
+                    keep=not self.tty)
 
     def status_line(self, last=None):
         """The long batch's line: done/total, per cent, rate, time left, the last run."""
         elapsed = self.clock() - self.start
         percent = 100.0 * self.done / self.total if self.total else 100.0
         counts = ([f"{self.failed} failed"] if self.failed else []) + ([f"{self.kept} kept"] if self.kept else [])
+        counts += [f"{self.limits} past their limit"] if self.limits else []
         notes = [f"last {last.job.label} {last.wall:.2f} s"] if last is not None and not last.skipped else []
         notes += [", ".join(counts)] if counts else []
         tail = f"  ({'; '.join(notes)})" if notes else ""
@@ -404,15 +423,17 @@ class Progress:
             self._write(self.status_line(outcome), keep=True)
 
     def close(self, outcomes):
-        failed = sum(not o.ok for o in outcomes)
+        limits = sum(limit_found(o) for o in outcomes)
+        failed = sum(not o.ok for o in outcomes) - limits
         if self.tty and self.total:
             self.out.write("\n")
         elapsed = self.clock() - self.start
         skipped = sum(o.skipped for o in outcomes)
         kept = f" ({skipped} kept from before)" if skipped else ""
         rate = f", {rate_text(self.ran, elapsed)}" if self.long else ""
-        self._write(f"{len(outcomes)} runs: {len(outcomes) - failed} ok{kept}, {failed} failed ({elapsed:.1f} s{rate})",
-                    keep=True)
+        beyond = f", {limits} past their stability limit (measured, not failures)" if limits else ""
+        self._write(f"{len(outcomes)} runs: {len(outcomes) - failed - limits} ok{kept}{beyond}, {failed} failed "
+                    f"({elapsed:.1f} s{rate})", keep=True)
 
     def _write(self, text, keep):
         prefix = "\r\x1b[K" if self.tty else ""

@@ -247,7 +247,7 @@ def jobs(case, sweeps_root):
             # (ballast refuses such a step otherwise); it runs, and the guards say if it is unstable
             out.append(Job(case.name, label, variant.scene, list(variant.sets) + sweep.sets(f) + FORCE,
                            Path(sweeps_root) / case.name / label, case.runtime / max(len(case.variants), 1),
-                           variant.command))
+                           variant.command, probe=True))
     return out
 
 

@@ -90,7 +90,8 @@ def jobs(case, variant, keyed, sweeps_root, binary):
     """One runner Job per grid point (with the time-keeping overrides of a dt sweep)."""
     extra = time_keeping(binary, variant) if any(k in DT_KEYS for k, _ in keyed) else []
     return [Job(case.name, label, variant.scene, list(variant.sets) + extra + sets,
-                sweeps_root / case.name / label, case.runtime / max(len(case.variants), 1), variant.command)
+                sweeps_root / case.name / label, case.runtime / max(len(case.variants), 1), variant.command,
+                probe=bool(extra))
             for label, sets in grid(keyed)], extra
 
 

@@ -1,5 +1,6 @@
 """Error against cost (harness/sweep.py): [sweep] declarations, the error of a run, the
 cheapest-setting table, `harness cost` and the report section, on the fake project."""
+import re
 import os
 import shutil
 from pathlib import Path
@@ -403,6 +404,10 @@ def test_failed_points_have_no_error_and_say_why(project, capsys):
     assert main(["run", "spring"]) == 0
     assert main(["cost", "spring"]) == 0
     out = capsys.readouterr().out
+    # Issue 23: a point past its limit is a measurement, said as one; a run without output fails
+    assert "LIMIT spring/blows_up_x2: past its stability limit" in out and "FAILED spring/blows_up" not in out
+    assert "FAILED spring/no_output_x2" in out
+    assert re.search(r"\d+ runs: \d+ ok, 2 past their stability limit \(measured, not failures\), 2 failed", out), out
     assert "beyond the stability limit (the run-time guards stopped them; a measured limit of the trade, " \
            "not a gate): blows_up x1, blows_up x2" in out
     assert "no result (no usable run.json; not a gate): no_output x1, no_output x2" in out

@@ -5,6 +5,7 @@
 #   make test         C unit tests (Check), symbol-prefix check, harness tests (pytest)
 #   make test-sanitize  C unit tests under AddressSanitizer + UndefinedBehaviorSanitizer
 #   make test-valgrind  one case under valgrind memcheck
+#   make test-slurm   harness export through a one-node Slurm on localhost (installs Slurm, MUNGE)
 #   make bench        dense-packing benchmark (median and spread of 5 repeats)
 #   make bench-peer   ballast against LAMMPS on the same physics (cross-check, then the race)
 #   make bench-flat   the 1 000 000- against the 20 000-disc rate, alternating in one process
@@ -32,10 +33,10 @@ LIB_OBJ  := $(LIB_SRC:core/%.c=$(BUILD)/%.o)
 TEST_SRC := $(wildcard core/tests/check_*.c)
 BENCH_SRC := core/bench/bench.c
 
-.PHONY: all deps test test-c test-prefix test-py test-sanitize validate bench bench-scaling \
+.PHONY: all deps test test-c test-prefix test-py test-sanitize test-browser validate bench bench-scaling \
         bench-peer bench-modules bench-modules-count bench-scaling-count bench-flat bench-threads bench-piles-poly \
         clean keys sweep \
-        test-valgrind
+        test-valgrind test-slurm
 
 all: deps bin/ballast
 
@@ -103,9 +104,26 @@ test-valgrind: bin/ballast
 	  bin/ballast exact cases/piles/pile30_smooth.scene --out $(BUILD)/valgrind/exact
 	@echo "test-valgrind: two_discs (damped), a pile (grid, stages) and the exact solver clean under memcheck"
 
+# The Slurm path of `harness export` for real (docs/ensembles.md): installs slurm-wlm and munge
+# (the optional group of .ci/install-deps), starts munged, slurmctld and slurmd on localhost
+# with a minimal config in a temporary folder, runs the test ensemble as a job array, gathers
+# it, compares it with a local run byte for byte, and always stops the daemons it started.
+# Not in make test or .ci/run (about 20 s once installed; needs root).
+test-slurm: bin/ballast
+	@sh .ci/install-deps slurm
+	bash harness/tests/slurm/run
+
+# The HTML report of the last validate in a real browser (headless chromium through
+# chromedriver: images decode, links resolve, no console error, size; reports/browser.png).
+test-browser:
+	sh .ci/install-browser-deps
+	$(PYTHON) -m pytest -q harness/tests/test_browser.py
+
 # ---- validation -----------------------------------------------------------
+# RESUME=1 keeps the runs an interrupted validate finished (--resume); CASES="a b" validates
+# those cases only and updates their part of the report.
 validate: all
-	$(PYTHON) -m harness validate --tier $(TIER) -j $(JOBS)
+	$(PYTHON) -m harness validate --tier $(TIER) -j $(JOBS) $(if $(RESUME),--resume) $(CASES)
 
 # Error against cost: every [sweep] of the tier's cases -> reports/sweeps/<case>/cost.tsv
 # (validate runs them too, between the gate and the report; `harness report` draws them).

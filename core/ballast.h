@@ -303,6 +303,8 @@ struct bal_stage_def {
     char name[BAL_NAME_MAX];
     int line;
     long cycles;              /* number of cycles, or the most when a stop rule is set */
+    double time;              /* or the stage's simulated time: ceil(time/dt) cycles (one of
+                               * the two is given; bal_sim_stage_cycles resolves them) */
     long ramp;                /* 1: gravity rises linearly from 0 over the stage (0) */
     double stop_ke;           /* stop when E_k <= stop_ke E_el (0: off) */
     double stop_stress;       /* ... and the stresses change by <= this (0: off) */
@@ -461,6 +463,28 @@ enum bal_status bal_sim_set_threads(struct bal_sim *sim, int threads, struct bal
  * cycles; when it becomes non-zero the run ends with BAL_EINTR. */
 enum bal_status bal_sim_run(struct bal_sim *sim, FILE *series,
                             volatile const sig_atomic_t *stop, struct bal_error *err);
+
+/* The cycles stage g runs at most: its `cycles`, or ceil(time/dt) for a
+ * stage given in simulated time (to 1e-9 of a step: a time that is a whole
+ * number of steps in exact arithmetic is that number of cycles). */
+long bal_sim_stage_cycles(const struct bal_sim *sim, int stage);
+/* 1: stage g was given in simulated time (`time`), 0: in cycles. */
+int bal_sim_stage_in_time(const struct bal_sim *sim, int stage);
+
+/* What a progress report sees: the stage running, its cycles so far and at
+ * most, the cycles and the simulated time of the whole run so far. */
+struct bal_progress {
+    int stage, n_stages;
+    const char *stage_name;
+    long stage_cycle, stage_cycles;
+    long step, steps;            /* the run's cycles so far, and at most */
+    double time, wall_seconds;
+};
+/* Call `report` from bal_sim_run about every `seconds` of wall-clock time
+ * (the clock is read once every 1024 cycles; NULL: no reports).  The
+ * callback only reads; the simulation's results do not depend on it. */
+void bal_sim_set_progress(struct bal_sim *sim, void (*report)(const struct bal_progress *, void *),
+                          void *ctx, double seconds);
 
 void bal_sim_info(const struct bal_sim *sim, struct bal_run_info *info);
 /* Bytes the simulation holds while it steps (every array at its allocated

@@ -578,7 +578,22 @@ enum bal_status bal_build_stages(struct bal_sim *s, struct bal_error *err)
     if (!s->log)
         return bal_error(err, BAL_ENOMEM, "%s: out of memory", sc->path);
     for (int g = 0; g < sc->n_stages; g++) {
-        s->log[g] = (struct bal_stage_log){0, 0, -1, -1, -1, -1};
+        const struct bal_stage_def *st = &sc->stages[g];
+        s->log[g] = (struct bal_stage_log){0, 0, -1, -1, -1, -1, st->cycles, 0};
+        if (st->given & (1u << bal_scene_key_index(BAL_SEC_STAGE, "time"))) {
+            /* ceil to 1e-9 of a step: time = 0.3 with dt = 0.1 is 3 cycles,
+             * not 4 because 0.3/0.1 = 3.0000000000000004. */
+            const double n = ceil(st->time / s->dt - 1e-9);
+            const int ki = bal_scene_key_index(BAL_SEC_STAGE, "time");
+            if (!(n <= 1e15))
+                return bal_error(err, BAL_EINVAL,
+                                 "%s:%d: time: [stage %s]: time %g with the time step %g is %g "
+                                 "cycles; expected at most 1e15", sc->path,
+                                 st->key_line[ki] > 0 ? st->key_line[ki] : st->line, st->name,
+                                 st->time, s->dt, st->time / s->dt);
+            s->log[g].max_cycles = n > 0 ? (long)n : 0;
+            s->log[g].in_time = 1;
+        }
         /* A strain rate whose step rate dt reaches 1 would carry the wall
          * onto (or past) the other in one cycle (walls.c). */
         for (int m = 0; m < sc->stages[g].n_moves; m++) {

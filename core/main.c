@@ -11,8 +11,11 @@
  * Exit codes: 0 success; 1 the run failed (unstable); 2 bad input or usage;
  * 3 input/output error; 4 out of memory; 130 interrupted.
  * A scene that fails to load or validate writes nothing.  A run that
- * starts writes run.json saying how it ended; series.tsv, discs.tsv,
- * contacts.tsv and walls.tsv appear only when the run completed.
+ * starts writes run.json saying how it ended; discs.tsv, contacts.tsv and
+ * walls.tsv appear only when the run completed, series.tsv too or when it
+ * was interrupted (the rows so far; run.json says "complete": false).
+ * `run` ends with a one-line summary on stdout, and on a terminal shows
+ * its progress on stderr once it has run for PROGRESS_AFTER seconds.
  */
 #include <errno.h>
 #include <signal.h>
@@ -20,11 +23,30 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "ballast.h"
 #include "exact.h"
 
 static volatile sig_atomic_t stop_requested;
+
+#define PROGRESS_AFTER 3.0 /* seconds of a run before its progress line appears */
+
+/* The progress line on a terminal: redrawn in place (\r), the stage, its
+ * cycles, the simulated time and the run's share done with the time left. */
+static void show_progress(const struct bal_progress *p, void *ctx)
+{
+    int *shown = ctx;
+    const double share = p->steps > 0 ? (double)p->step / (double)p->steps : 0;
+    char left[48] = "";
+    if (share > 0 && share < 1)
+        snprintf(left, sizeof left, ", %.0f s left", p->wall_seconds * (1 - share) / share);
+    fprintf(stderr, "\r\033[Kballast: stage %s (%d/%d) cycle %ld/%ld, t = %.6g s, %.0f %% of "
+                    "%ld cycles%s", p->stage_name, p->stage + 1, p->n_stages, p->stage_cycle + 1,
+            p->stage_cycles, p->time, 100 * share, p->steps, left);
+    fflush(stderr);
+    *shown = 1;
+}
 
 static void on_signal(int sig)
 {
@@ -143,7 +165,7 @@ static int cmd_info(const struct args *a)
     bal_sim_info(sim, &in);
     long cycles = 0;
     for (int g = 0; g < sc.n_stages; g++)
-        cycles += sc.stages[g].cycles;
+        cycles += bal_sim_stage_cycles(sim, g);
     printf("scene          %s\n", sc.path);
     printf("discs          %d\n", in.n_discs);
     printf("walls          %d\n", in.n_walls);
@@ -162,6 +184,12 @@ static int cmd_info(const struct args *a)
     printf("dt fraction    %.17g\n", in.dt_fraction);
     printf("dt used        %.17g\n", in.dt);
     printf("stages         %d (%ld cycles)\n", sc.n_stages, cycles);
+    /* One line per stage, its cycles and the simulated time they cover at
+     * this dt (a sweep over dt keeps the time: harness/sweep_grid.py). */
+    for (int g = 0; g < sc.n_stages; g++)
+        printf("stage          %s %ld cycles %.17g s (%s)\n", sc.stages[g].name,
+               bal_sim_stage_cycles(sim, g), (double)bal_sim_stage_cycles(sim, g) * in.dt,
+               bal_sim_stage_in_time(sim, g) ? "time" : "cycles");
     bal_sim_free(sim);
     bal_scene_free(&sc);
     return 0;
@@ -171,11 +199,13 @@ static int cmd_info(const struct args *a)
  * first: a run killed while this runs must not leave an old run.json saying
  * ok beside a missing series), or, after a failed run, the outputs it had
  * finished, so that only run.json, saying why, remains. */
-static void remove_outputs(const char *dir, int with_json)
+static void remove_outputs(const char *dir, int with_json, int keep_series)
 {
     const char *names[] = {"run.json", "series.tsv", "discs.tsv", "contacts.tsv", "walls.tsv",
                            "stress.tsv", "stress_grid.tsv"};
     for (size_t k = with_json ? 0 : 1; k < sizeof names / sizeof names[0]; k++) {
+        if (k == 1 && keep_series)
+            continue;
         char p[1200];
         snprintf(p, sizeof p, "%s/%s", dir, names[k]);
         remove(p);
@@ -216,8 +246,23 @@ static int prepare(const struct args *a, const char *cmd, struct bal_scene *sc,
         bal_scene_free(sc);
         return 3;
     }
-    remove_outputs(a->out, 1);
+    remove_outputs(a->out, 1, 0);
     return -1;
+}
+
+/* The one line a run ends with: how it ended, its cycles, the simulated
+ * and the wall-clock time, and the energy imbalance (run.json has more). */
+static void summary(const struct bal_sim *sim, enum bal_status st, int kept)
+{
+    struct bal_run_info in;
+    struct bal_energy en;
+    bal_sim_info(sim, &in);
+    bal_energy_report(sim, &en);
+    printf("ballast run: %s%s, %ld cycles, %.6g s simulated (dt %.6g), wall %.3g s, "
+           "energy imbalance %.3g of the energy through the run\n",
+           st == BAL_OK ? "ok" : bal_strerror(st), kept ? " (series.tsv so far kept)" : "",
+           in.steps, in.time, in.dt, in.wall_seconds, en.relative);
+    fflush(stdout);
 }
 
 static int cmd_run(const struct args *a)
@@ -235,10 +280,15 @@ static int cmd_run(const struct args *a)
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 
+    int shown = 0;
+    if (isatty(STDERR_FILENO))
+        bal_sim_set_progress(sim, show_progress, &shown, PROGRESS_AFTER);
+
     char tmp[1200];
     snprintf(tmp, sizeof tmp, "%s/series.tsv.tmp", a->out);
     FILE *series = fopen(tmp, "w");
     enum bal_status st;
+    int kept = 0; /* an interrupted run's series, the rows so far */
     if (!series) {
         st = bal_error(&err, BAL_EIO, "%s: cannot write: %s", tmp, strerror(errno));
     } else {
@@ -248,13 +298,18 @@ static int cmd_run(const struct args *a)
         bad |= fclose(series) != 0;
         if (st == BAL_OK && bad)
             st = bal_error(&err, BAL_EIO, "%s: write failed", tmp);
+        struct bal_error cerr = {0};
+        if (st == BAL_EINTR && !bad && bal_output_commit(a->out, "series.tsv", &cerr) == BAL_OK)
+            kept = 1;
         if (st == BAL_OK)
             st = bal_output_commit(a->out, "series.tsv", &err);
         if (st == BAL_OK)
             st = bal_output_state(sim, a->out, &err);
     }
+    if (shown)
+        fputs("\n", stderr);
     if (st != BAL_OK)
-        remove_outputs(a->out, 0);
+        remove_outputs(a->out, 0, kept);
     struct bal_error jerr = {0};
     enum bal_status js = bal_output_run_json(sim, a->out, sc.path, a->n_sets, a->sets, st,
                                              st == BAL_OK ? "" : err.msg, &jerr);
@@ -262,6 +317,7 @@ static int cmd_run(const struct args *a)
         fprintf(stderr, "%s\n", err.msg);
     if (js != BAL_OK)
         fprintf(stderr, "%s\n", jerr.msg);
+    summary(sim, st, kept);
     bal_sim_free(sim);
     bal_scene_free(&sc);
     return exit_code(st != BAL_OK ? st : js);
@@ -336,7 +392,7 @@ static int cmd_exact(const struct args *a)
     if (st == BAL_OK)
         st = write_exact(sim, &ex, a->out, &err);
     if (st != BAL_OK)
-        remove_outputs(a->out, 0);
+        remove_outputs(a->out, 0, 0);
     bal_sim_add_seconds(sim, ex.seconds);
     struct bal_error jerr = {0};
     enum bal_status js = bal_output_run_json(sim, a->out, sc.path, a->n_sets, a->sets, st,

@@ -359,6 +359,9 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
     json_string(f, status == BAL_OK ? "ok" : bal_strerror(status));
     fputs(",\n  \"message\": ", f);
     json_string(f, message ? message : "");
+    /* false: the run did not reach its end (an interrupted run keeps the
+     * series.tsv written so far, and nothing else) */
+    fprintf(f, ",\n  \"complete\": %s", status == BAL_OK ? "true" : "false");
     if (s) {
         /* The counters of bal_sim_info, read from the state (output.c sits
          * below the life cycle in sim.c, which writes series rows here). */
@@ -415,11 +418,13 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
             const struct bal_stage_def *st = &sc->stages[g];
             fprintf(f, ", \"cycles\": %ld, \"max_cycles\": %ld, \"stop_rule\": %s, \"stopped\": %s, "
                        "\"ke_over_ee\": ",
-                    s->log[g].cycles, st->cycles,
+                    s->log[g].cycles, s->log[g].max_cycles,
                     (st->stop_ke > 0 || st->stop_stress > 0 || st->stop_servo > 0 ||
                      st->stop_unbalanced > 0) ? "true" : "false",
                     s->log[g].stopped ? "true" : "false");
             json_number(f, s->log[g].ke_over_ee);
+            if (st->given & (1u << bal_scene_key_index(BAL_SEC_STAGE, "time")))
+                fprintf(f, ", \"stage_time\": %.17g", st->time);
             fputs(", \"stress_change\": ", f);
             json_number(f, s->log[g].stress_change);
             /* The servo and unbalanced rules only where a stage has them: a

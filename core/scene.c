@@ -490,6 +490,13 @@ static enum bal_status assign(void *item, enum bal_section_kind k,
         return err->code;
     *given |= 1u << ki;
     bal_scene_item_key_line(item, k)[ki] = w.line;
+    /* A stage's length is cycles or time: an override (--set, no line)
+     * of the one replaces the other, so a sweep can give a stage in time. */
+    if (k == BAL_SEC_STAGE && w.line <= 0 &&
+        (strcmp(key->name, "cycles") == 0 || strcmp(key->name, "time") == 0)) {
+        const int other = bal_scene_key_index(k, strcmp(key->name, "cycles") == 0 ? "time" : "cycles");
+        *given &= ~(1u << other);
+    }
     return BAL_OK;
 }
 

@@ -53,7 +53,8 @@ const struct bal_key bal_scene_keys[] = {
     {BAL_SEC_SETTINGS, "dt", BAL_KEY_DOUBLE, S(dt), "0", 0, 0, BIG, NULL,
      "time step; 0 = dt_fraction x the critical-step estimate"},
     {BAL_SEC_SETTINGS, "dt_fraction", BAL_KEY_DOUBLE, S(dt_fraction), "0.1", 0, 1e-9, 1, NULL,
-     "fraction of the critical-step estimate (contact-network bound; ballast info prints it)"},
+     "fraction of the critical-step estimate (contact-network bound; ballast info prints it); "
+     "below 1: 1 is refused unless force_dt = 1"},
     {BAL_SEC_SETTINGS, "alpha", BAL_KEY_DOUBLE, S(alpha), "0", 0, 0, BIG, NULL,
      "global damping alpha, C = alpha m, C* = alpha I (C&S eqs 34-36), 1/time"},
     {BAL_SEC_SETTINGS, "beta", BAL_KEY_DOUBLE, S(beta), "0", 0, 0, BIG, NULL,
@@ -234,12 +235,14 @@ const struct bal_key bal_scene_keys[] = {
      "1: the discs start with the file's vx vy omega; 0: at rest"},
 
     /* [stage NAME] */
-    {BAL_SEC_STAGE, "cycles", BAL_KEY_LONG, G(cycles), NULL, 1, 0, 1e15, NULL,
-     "number of calculation cycles in this stage (0: the stage is skipped)"},
+    {BAL_SEC_STAGE, "cycles", BAL_KEY_LONG, G(cycles), NULL, 0, 0, 1e15, NULL,
+     "number of calculation cycles in this stage (0: the stage is skipped); this or time"},
+    {BAL_SEC_STAGE, "time", BAL_KEY_DOUBLE, G(time), NULL, 0, 0, BIG, NULL,
+     "or the stage's simulated time: ceil(time/dt) cycles, the same time whatever dt is"},
     {BAL_SEC_STAGE, "ramp", BAL_KEY_LONG, G(ramp), "0", 0, 0, 1, NULL,
      "1: gravity rises linearly from zero over this stage's cycles (MLH Sec. 4)"},
     {BAL_SEC_STAGE, "stop_ke", BAL_KEY_DOUBLE, G(stop_ke), "0", 0, 0, BIG, NULL,
-     "stop the stage once E_k <= stop_ke E_el (0: off); cycles is then the most"},
+     "stop the stage once E_k <= stop_ke E_el (0: off); cycles (or time) is then the most"},
     {BAL_SEC_STAGE, "stop_stress", BAL_KEY_DOUBLE, G(stop_stress), "0", 0, 0, BIG, NULL,
      "... and the disc stresses change by <= this share of the largest between checks"},
     {BAL_SEC_STAGE, "check_every", BAL_KEY_LONG, G(check_every), "100", 0, 1, 1e15, NULL,

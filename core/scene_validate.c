@@ -301,9 +301,19 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
     if (s->n_stages == 0)
         return bal_error(err, BAL_EINVAL, "%s: no [stage] section: the run would never start; "
                                           "add e.g. [stage run] with cycles = N", s->path);
+    const uint32_t cycles_bit = 1u << bal_scene_key_index(BAL_SEC_STAGE, "cycles");
+    const uint32_t time_bit = 1u << bal_scene_key_index(BAL_SEC_STAGE, "time");
     for (int i = 0; i < s->n_stages; i++) {
         struct bal_stage_def *g = &s->stages[i];
         int servos = 0;
+        /* A stage's length: in cycles or in simulated time, one of them. */
+        if ((g->given & cycles_bit) && (g->given & time_bit))
+            return FAIL_AT(g, BAL_SEC_STAGE, "time", "[stage %s] gives both cycles and time; "
+                           "expected one of them (time: the cycles follow from dt)", g->name);
+        if (!(g->given & (cycles_bit | time_bit)))
+            return bal_error(err, BAL_EINVAL, "%s:%d: [stage %s]: cycles: required key is missing "
+                             "(give the stage's length as cycles = N, or as time = T in seconds "
+                             "of simulated time)", s->path, g->line, g->name);
         for (int m = 0; m < g->n_moves; m++) {
             const struct bal_move_def *mv = &g->moves[m];
             const char *key = bal_scene_key_for_control(mv->control);

@@ -290,20 +290,63 @@ static int stop_rule_met(struct bal_sim *s, const struct bal_stage_def *g, struc
     return met;
 }
 
+long bal_sim_stage_cycles(const struct bal_sim *s, int stage)
+{
+    return s->log[stage].max_cycles;
+}
+
+int bal_sim_stage_in_time(const struct bal_sim *s, int stage)
+{
+    return s->log[stage].in_time;
+}
+
+void bal_sim_set_progress(struct bal_sim *s, void (*report)(const struct bal_progress *, void *),
+                          void *ctx, double seconds)
+{
+    s->progress = report;
+    s->progress_ctx = ctx;
+    s->progress_seconds = seconds;
+}
+
+static double seconds_since(const struct timespec *t0)
+{
+    struct timespec t1;
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    return (double)(t1.tv_sec - t0->tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0->tv_nsec);
+}
+
+/* A progress report, when one is asked for and its period has passed. */
+static void report_progress(const struct bal_sim *s, const struct timespec *t0, double *next,
+                            int g, long c, long cycles)
+{
+    const double now = seconds_since(t0);
+    if (now < *next)
+        return;
+    *next = now + s->progress_seconds;
+    const struct bal_scene *sc = s->scene;
+    long steps = 0;
+    for (int k = 0; k < sc->n_stages; k++)
+        steps += k < g ? s->log[k].cycles : s->log[k].max_cycles;
+    const struct bal_progress p = {g, sc->n_stages, sc->stages[g].name, c, cycles,
+                                   s->step, steps, s->time, s->wall_seconds + now};
+    s->progress(&p, s->progress_ctx);
+}
+
 enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_atomic_t *stop,
                             struct bal_error *err)
 {
     const struct bal_scene *sc = s->scene;
     const long every = sc->settings.output_every;
-    struct timespec t0, t1;
+    struct timespec t0;
     clock_gettime(CLOCK_MONOTONIC, &t0);
+    double next_report = s->progress_seconds;
     enum bal_status status = BAL_OK;
     for (int g = 0; g < sc->n_stages && status == BAL_OK; g++) {
         const struct bal_stage_def *stage = &sc->stages[g];
         struct bal_stage_log *log = &s->log[g];
         const int rule = has_stop_rule(stage);
         bal_sim_set_stage(s, g);
-        const long cycles = stage->cycles;
+        const long cycles = log->max_cycles;
         for (long c = 0; c < cycles; c++) {
             if (stop && *stop) {
                 status = bal_error(err, BAL_EINTR, "%s: interrupted at step %ld", sc->path,
@@ -312,6 +355,8 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
             }
             if (stage->ramp)
                 s->gfac = (double)(c + 1) / (double)cycles;
+            if (s->progress && (c & 1023) == 1023)
+                report_progress(s, &t0, &next_report, g, c, cycles);
             const int check = rule && (c + 1) % stage->check_every == 0;
             /* A row after the last cycle of the run, and of a stage that asks
              * for one (output_at_end: the state where the next stage starts). */
@@ -343,8 +388,7 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
         status = check_finite(s, err);
     if (status == BAL_OK)
         status = bal_energy_guard(s, err);
-    clock_gettime(CLOCK_MONOTONIC, &t1);
-    s->wall_seconds += (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    s->wall_seconds += seconds_since(&t0);
     return status;
 }
 

@@ -144,6 +144,8 @@ struct bal_stage_log {
     double servo_error;    /* the largest |stress − target|/target of the stage's servo
                             * walls at the last check (-1: never) */
     double unbalanced;     /* ΔF/F at the last check (-1: never) */
+    long max_cycles;       /* the stage's cycles, or ceil(time/dt) (bal_build_stages) */
+    int in_time;           /* 1: the stage was given in simulated time */
 };
 
 /* Running sums of the energy audit (energy.c), from the first cycle. */
@@ -334,6 +336,10 @@ struct bal_sim {
     double time;
     int stage;
     double wall_seconds;
+    /* bal_sim_set_progress: called from bal_sim_run every progress_seconds */
+    void (*progress)(const struct bal_progress *, void *);
+    void *progress_ctx;
+    double progress_seconds;
 };
 
 /* Mass and moment of inertia of disc i: the same expressions as at creation

@@ -1,4 +1,5 @@
-"""The command line: python3 -m harness {list,run,check,report,validate,rebaseline,sweep,cost}.
+"""The command line: python3 -m harness {list,run,check,report,validate,rebaseline,sweep,cost,
+stability,export,job,gather}.
 
 Each command is a small function that loads the catalogue and references, picks the
 cases, and hands over to runner, gate, report or rebaseline.  Exit statuses besides 0 and
@@ -23,16 +24,17 @@ from contextlib import nullcontext
 from pathlib import Path
 
 from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_root
-from . import catalogue, extremes, files, references, stability
+from . import catalogue, export, extremes, files, references, stability
 from . import families  # noqa: F401 -- registers every case family's expression functions
 from . import sweep as sweeps
-from .compare import RunStore, evaluate_all, folder_locator
+from . import sweep_grid
+from .compare import RunStore, folder_locator
 from .errors import Busy, CatalogueError, IniError
-from .gate import gate, sweep_table
+from .gate import gate
 from .lock import reports_lock
 from .rebaseline import rebaseline
 from .report import write_report
-from .runner import jobs_for, run_all, sigterm_as_interrupt, sweep_jobs
+from .runner import jobs_for, run_all, sigterm_as_interrupt
 
 USAGE_ERROR = 2
 IO_ERROR = 3         # as the core's exit code for an I/O error
@@ -95,19 +97,33 @@ def runs_status(outcomes):
     return 0 if all(o.ok for o in outcomes) else 1
 
 
+def subset(args):
+    """True when the command was given case names: it updates their part of the report only."""
+    return bool(getattr(args, "cases", None))
+
+
 def cmd_check(args):
     all_cases = load_cases()
     checks = load_checks(all_cases)
     cases = selected(args, all_cases)
-    return gate(references.for_cases(checks, cases), default_store(all_cases), reports_root(), sys.stdout)
+    return gate(references.for_cases(checks, cases), default_store(all_cases), reports_root(), sys.stdout,
+                keep_others=subset(args))
 
 
 def cmd_report(args):
+    """The report of the tier; given case names, their figures are drawn anew and the other cases
+    that have runs keep what an earlier report drew, so the report stays whole."""
     all_cases = load_cases()
     checks = load_checks(all_cases)
-    cases = selected(args, all_cases)
+    cases, render = selected(args, all_cases), None
+    if subset(args):
+        render = {c.name for c in cases}
+        tier = catalogue.select(all_cases, [], args.tier)
+        tier_names = {c.name for c in tier}
+        cases = [c for c in all_cases
+                 if c.name in render or (c.name in tier_names and (runs_root() / c.name).is_dir())]
     write_report(cases, references.for_cases(checks, cases), default_store(all_cases), runs_root(), reports_root(),
-                 sys.stdout)
+                 sys.stdout, render)
     return 0
 
 
@@ -121,7 +137,9 @@ def cmd_validate(args):
         # the first DEM variant of each case and the extreme probes (all variants:
         # `harness stability`); a measurement shown in the report, not a gate
         stab = argparse.Namespace(**vars(args))
-        stab.one_per_case, stab.extremes_only, stab.no_extremes = True, False, False
+        # the extreme probes belong to no case: a validate of some cases runs them only when asked
+        stab.one_per_case, stab.extremes_only = True, False
+        stab.no_extremes = subset(args) and not args.extremes
         stab.cap, stab.tolerance = 20000, 0.01
         try:
             cmd_stability(stab)
@@ -142,11 +160,22 @@ def cmd_sweep(args):
     cases = load_cases()
     case = catalogue.select(cases, [args.case])[0]
     variant = sweep_variant(case, args.variant)
-    key, values = parse_sweep(args.set)
-    jobs = sweep_jobs(case, variant, key, values, reports_root() / "sweeps")
+    keyed = sweep_grid.parse_sets(args.set)
+    jobs, extra = sweep_grid.jobs(case, variant, keyed, reports_root() / "sweeps", args.bin)
+    if extra:
+        print(f"sweep over the time step: every point keeps the stages' simulated time ({' '.join(extra)})")
     outcomes = run_all(jobs, args.bin, args.jobs, sys.stdout, resume=args.resume)
+    if any(o.io_error for o in outcomes):       # runs that could not be recorded: say so, no table
+        return runs_status(outcomes)
     checks = [c for c in load_checks(cases) if c.case == case.name and c.run_variants == [variant.name]]
-    print_sweep(case, variant, checks, jobs)
+    if not checks:
+        print(f"no checks of {case.name} use only variant '{variant.name}'")
+        return runs_status(outcomes)
+    results = sweep_grid.evaluate(checks, jobs)
+    print(sweep_grid.table([j.variant for j in jobs], checks, results))
+    path = reports_root() / "sweeps" / case.name / f"sweep_{variant.name}.tsv"
+    sweep_grid.write_tsv(path, jobs, checks, results)
+    print(f"wrote {path}")
     return runs_status(outcomes)
 
 
@@ -157,6 +186,26 @@ def cmd_cost(args):
     sweeps.run_declared(selected(args, all_cases), checks, args.bin, args.jobs, runs_root(),
                         reports_root() / "sweeps", sys.stdout, functools.partial(run_all, resume=args.resume))
     return 0
+def cmd_export(args):
+    """The selected cases' runs as a GNU parallel job list and a Slurm array (export.py)."""
+    cases = selected(args, load_cases())
+    if not cases:
+        raise CatalogueError("no cases selected")
+    export.export(cases, args.bin, args.to, sys.stdout)
+    return 0
+
+
+def cmd_job(args):
+    """One run of an export folder, where parallel or Slurm started it."""
+    return runs_status([export.run_job(args.dir, args.index, sys.stdout)])
+
+
+def cmd_gather(args):
+    """The finished runs of an export folder into reports/runs; 1 if some are not there."""
+    gathered, kept, refused = export.gather(args.dir, load_cases(), args.bin, runs_root(), sys.stdout)
+    return 1 if refused else 0
+
+
 STABILITY_RUNS = "stability-runs"     # the trial runs of `stability`, under the reports root
 
 
@@ -199,9 +248,15 @@ def _stability(args, work):
         print(f"stability: {len(probes)} extreme probe(s)")
         rows = extremes.run_probes(args.bin, probes, work, args.jobs, sys.stdout, args.resume)
         stability.merge_tsv(rows, extremes.EXTREME_COLUMNS, reports_root() / "extremes.tsv", ("probe",))
+        findings = 0
         for r in rows:
-            print(f"  {r['group']}/{r['probe']}: {r['outcome']}{'' if r['as_expected'] == 'yes' else '  UNEXPECTED'}")
-        print(f"wrote {reports_root() / 'extremes.tsv'}")
+            print(f"  {r['group']}/{r['probe']}: {r['outcome']}")
+            if r["as_expected"] != "yes":
+                findings += 1
+                print(f"      finding: declared '{r['expect']}', behaved otherwise (above); a measurement "
+                      "for docs/stability.md, not a gate")
+        print(f"extreme probes: {len(rows) - findings} as declared, {findings} finding(s); the probes "
+              f"measure limits and never change the exit status; wrote {reports_root() / 'extremes.tsv'}")
     return status
 
 
@@ -215,26 +270,6 @@ def sweep_variant(case, name):
         raise CatalogueError(f"case '{case.name}' has several variants: pick one with --variant "
                                        f"({', '.join(case.variant_names())})")
     return case.variants[0]
-
-
-def parse_sweep(text):
-    """'KEY=V1,V2,...' -> (KEY, [V1, V2, ...])."""
-    key, sep, values = text.partition("=")
-    values = [v.strip() for v in values.split(",") if v.strip()]
-    if not sep or not key or not values or any("/" in v for v in values):
-        raise CatalogueError(f"--set needs KEY=V1,V2,... (no '/' in values), got '{text}'")
-    return key, values
-
-
-def print_sweep(case, variant, checks, jobs):
-    if not checks:
-        print(f"no checks of {case.name} use only variant '{variant.name}'")
-        return
-    by_label = {}
-    for job in jobs:
-        store = RunStore(lambda c, v, folder=job.out: folder)
-        by_label[job.variant] = evaluate_all(checks, store)
-    print(sweep_table([j.variant for j in jobs], checks, by_label))
 
 
 # ---------------------------------------------------------------- arguments
@@ -254,13 +289,17 @@ def parser():
     _selection(_command(sub, "report", cmd_report, "render figures, write reports/summary.md and reports/index.html"))
     validate = _runs(_selection(_command(sub, "validate", cmd_validate, "run + check + cost + report")))
     validate.add_argument("--no-sweeps", action="store_true", help="skip the declared sweeps (cost)")
+    validate.add_argument("--extremes", action="store_true",
+                          help="run the extreme probes even when cases are named (a validate of all cases runs them)")
     validate.add_argument("--no-stability", action="store_true",
                           help="skip the stability limits (first variant of each case) and extreme probes")
     rebase = _command(sub, "rebaseline", cmd_rebaseline, "rewrite the regression values of CASE from its current outputs")
     rebase.add_argument("case", metavar="CASE")
-    sweep = _command(sub, "sweep", cmd_sweep, "run one variant once per value of a --set key and tabulate its checks")
+    sweep = _command(sub, "sweep", cmd_sweep, "run one variant at every point of a grid of --set values and "
+                                              "tabulate its checks, their error and each point's cost")
     sweep.add_argument("case", metavar="CASE")
-    sweep.add_argument("--set", required=True, metavar="KEY=V1,V2,...")
+    sweep.add_argument("--set", required=True, action="append", metavar="KEY=V1,V2,...",
+                       help="repeatable: several keys combine as a grid; a dt sweep keeps the simulated time")
     sweep.add_argument("--variant", metavar="NAME", help="the variant to sweep (needed when the case has several)")
     _runs(sweep)
     _runs(_selection(_command(sub, "cost", cmd_cost,
@@ -275,6 +314,22 @@ def parser():
     stab.add_argument("--extremes-only", action="store_true", help="only the probes of cases/extremes")
     stab.add_argument("--no-extremes", action="store_true", help="only the catalogue's limits")
     stab.add_argument("--one-per-case", action="store_true", help="only the first DEM variant of each case")
+    exp = _command(sub, "export", cmd_export,
+                   "write the selected cases' runs as a GNU parallel job list and a Slurm job-array "
+                   "script into DIR (docs/ensembles.md)", writes=False)
+    _selection(exp)
+    exp.add_argument("--to", required=True, type=Path, metavar="DIR",
+                     help="the export folder, seen at the same path by every machine that runs jobs")
+    exp.add_argument("--bin", type=Path, default=None, help="the core executable (default $BALLAST_BIN or bin/ballast)")
+    job = _command(sub, "job", cmd_job, "run job INDEX of an export folder (what jobs.txt and slurm.sh call)",
+                   writes=False)
+    job.add_argument("dir", type=Path, metavar="DIR")
+    job.add_argument("index", type=int, metavar="INDEX")
+    gat = _command(sub, "gather", cmd_gather,
+                   "copy the finished runs of an export folder into reports/runs, as `run` writes them")
+    gat.add_argument("dir", type=Path, metavar="DIR")
+    gat.add_argument("--bin", type=Path, default=None,
+                     help="the core executable the runs must have been made by (default $BALLAST_BIN or bin/ballast)")
     return p
 
 

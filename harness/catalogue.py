@@ -56,13 +56,13 @@ from .ini import parse_file
 from .sweep_spec import parse as parse_sweep
 
 CASE_KEYS = {"tier", "title", "checks", "runtime", "stability"}
-VARIANT_KEYS = {"scene", "set", "command"}
+VARIANT_KEYS = {"scene", "set", "command", "label"}
 COMMANDS = ("run", "exact", "peer", "peer_rolling")
 FIGURE_KINDS = ("series", "network", "profile", "principal", "points", "curves", "errorbars", "fit")
 _COMMON = {"kind", "title", "variants", "paper"}
 _AXES = {"xlabel", "ylabel", "xrange", "yrange"}
 FIGURE_KIND_KEYS = {
-    "series": _COMMON | _AXES | {"x", "y", "line"},
+    "series": _COMMON | _AXES | {"x", "y", "line", "reference"},
     "network": _COMMON,
     "profile": _COMMON | _AXES | {"y", "row"},
     "principal": _COMMON,
@@ -74,7 +74,7 @@ FIGURE_KIND_KEYS = {
 SLOPES = ("number", "asin")
 FIGURE_KEYS = set().union(*FIGURE_KIND_KEYS.values())
 LOGSCALES = {"": "", "x": "x", "y": "y", "xy": "xy", "yx": "xy"}
-PROFILE_XLABEL = "X = (x - x0) / l"
+PROFILE_XLABEL = "X = (x - x0) / l (-)"
 PROFILE_YLABEL = "S (compression positive, units m g / l)"
 NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 RANGE = re.compile(rf"^\s*({NUMBER})?\s*:\s*({NUMBER})?\s*$")
@@ -90,6 +90,7 @@ class Variant:
                              # peer_rolling: JYH's rolling against LAMMPS (harness/peer/rolling.py)
     ensemble: str = ""       # a realisation of [ensemble NAME]: NAME (and its seed); '' otherwise
     seed: int = None
+    label: str = ""          # what a figure's legend calls it ('' : its name)
 
 
 @dataclass
@@ -114,6 +115,8 @@ class Figure:
     groups: list = field(default_factory=list)   # fit: (label, [variants]) per group
     paper_points: list = field(default_factory=list)   # errorbars: (x, y, label) published values
     slope: str = "number"    # fit: how the legend gives a line's slope (SLOPES)
+    names: dict = field(default_factory=dict)   # variant -> its legend label (the variants' `label`)
+    references: list = field(default_factory=list)   # series: checks whose reference value is drawn
 
 
 @dataclass
@@ -238,7 +241,8 @@ def _add_variant(case, section):
     command = section.get("command", "run")
     if command not in COMMANDS:
         raise section.error(f"command must be one of {', '.join(COMMANDS)}, not '{command}'")
-    case.variants.append(Variant(section.name, case.folder / section.require("scene"), sets, command))
+    case.variants.append(Variant(section.name, case.folder / section.require("scene"), sets, command,
+                                 label=section.get("label", "")))
 
 
 def _not_an_ensembles_name(case, section, name):
@@ -296,6 +300,7 @@ def _series(section, common):
                   y=section.require("y").split(), xlabel=section.get("xlabel", section.require("x")),
                   ylabel=section.get("ylabel", ""), xrange=_range(section, "xrange"),
                   yrange=_range(section, "yrange"), lines=[_line(section, e) for e in section.all("line")],
+                  references=[w for e in section.all("reference") for w in e.value.split()],
                   **common)
 
 
@@ -450,6 +455,7 @@ def _finish(case):
                 raise IniError(case.path, figure.line,
                                f"figure '{figure.name}' names unknown variant '{name}'")
         figure.variants = figure.variants or case.variant_names()
+        figure.names = {v.name: v.label for v in case.variants if v.label}
 
 
 def ensembles_of(cases):

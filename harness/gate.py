@@ -138,26 +138,22 @@ def exit_status(verdicts):
     return 0 if passed and not failed else 1
 
 
-def gate(checks, store, reports_dir, out):
-    """Evaluate checks, print the table to out, write summary.json and junit.xml; the exit status."""
+def gate(checks, store, reports_dir, out, keep_others=False):
+    """Evaluate checks, print the table to out, write summary.json and junit.xml; the exit status
+    (of these checks).  keep_others (a subset of the cases was asked for): summary.json and
+    junit.xml keep the verdicts an earlier gate wrote for the other cases, so checking one case
+    updates its part and leaves the rest."""
     verdicts = evaluate_all(checks, store)
     print(table(verdicts), file=out)
-    write_summary(verdicts, Path(reports_dir) / "summary.json")
-    write_junit(verdicts, Path(reports_dir) / "junit.xml")
+    summary = Path(reports_dir) / "summary.json"
+    written = verdicts
+    if keep_others:
+        mine = {v.case for v in verdicts}
+        try:
+            saved = read_summary(summary) if summary.is_file() else []
+        except (ValueError, KeyError, TypeError):
+            saved = []
+        written = [v for v in saved if v.case not in mine] + verdicts
+    write_summary(written, summary)
+    write_junit(written, Path(reports_dir) / "junit.xml")
     return exit_status(verdicts)
-
-
-def sweep_table(labels, checks, verdicts_by_label):
-    """A sweep's table: one row per check, one column per swept value ('value PASS/FAIL')."""
-    header = ["check", "reference", "tolerance"] + list(labels)
-    rows = []
-    for i, check in enumerate(checks):
-        first = verdicts_by_label[labels[0]][i]
-        rows.append([check.name, fmt_reference(first), first.tolerance] +
-                    [_sweep_cell(verdicts_by_label[label][i]) for label in labels])
-    widths = [max(len(r[j]) for r in [header] + rows) for j in range(len(header))]
-    return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in [header] + rows)
-
-
-def _sweep_cell(v):
-    return f"{fmt_number(v.value)} {v.result}"

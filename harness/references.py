@@ -211,6 +211,29 @@ def validate(checks, cases):
                 raise IniError(check.path, check.line,
                                f"check '{check.name}': case '{check.case}' has no variant '{variant}' "
                                f"(has: {', '.join(case.variant_names())})")
+    names = {(c.case, c.name) for c in checks}
+    for case in cases:
+        for figure in case.figures:
+            for name in figure.references:
+                if (case.name, name) not in names:
+                    raise IniError(case.path, figure.line, f"figure '{figure.name}': reference '{name}' is no "
+                                   f"check of case '{case.name}'")
+
+
+def reference_lines(figure, checks):
+    """The reference lines (slope 0, level, title) a figure draws for its `reference` checks: a
+    point reference's value, an interval's bounds."""
+    lines = []
+    for name in figure.references:
+        check = next((c for c in checks if c.name == name), None)
+        if check is None:
+            continue
+        if check.value is not None and check.tolerance in ("abs", "rel"):
+            lines.append((0.0, float(check.value), f"reference {name} ({check.kind}): {check.value:.6g}"))
+        else:
+            bounds = [b for b in (check.lo, check.hi) if b is not None]
+            lines += [(0.0, float(b), f"reference {name} ({check.kind}) bound {b:.6g}") for b in bounds]
+    return lines
 
 
 def for_cases(checks, cases):

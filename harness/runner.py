@@ -13,7 +13,9 @@ directory, so runs share no state and their results cannot depend on -j or on or
 After the run the folder holds the core's outputs plus ballast.stdout, ballast.stderr and,
 written last (tmp file + rename), harness.json: the command, exit code, wall time, on
 failure the cause, the run's identity (what made it: command, scene path and content hash,
---set overrides, the executable's hash) and the SHA-256 of every file the run left.
+--set overrides, the executable's hash), the SHA-256 of every file the run left, and for a
+realisation of an [ensemble] its ensemble and seed (the seed is also in the core's run.json,
+in its scene path or --set lines).
 
 Interruption: SIGINT or SIGTERM stops the whole batch.  Jobs not yet started are dropped
 (their folders untouched); running ones get SIGTERM (the core traps it, writes run.json
@@ -69,6 +71,10 @@ class Job:
     out: Path
     expected: float = 0.0   # expected seconds, for the ETA
     command: str = "run"    # the core's command: run (DEM) or exact (static solver)
+    ensemble: str = ""      # a realisation of [ensemble NAME]: NAME, and its seed (in harness.json)
+    seed: int = None
+    probe: bool = False     # a sweep point that may lie past a stability limit: its unstable end
+                            # (exit 1) is a measured limit, reported as such and not as a failure
 
     @property
     def label(self):
@@ -90,7 +96,7 @@ class Outcome:
 def jobs_for(cases, runs_root):
     """One Job per variant of each case, outputs in runs_root/<case>/<variant>."""
     return [Job(c.name, v.name, v.scene, list(v.sets), Path(runs_root) / c.name / v.name,
-                c.runtime / len(c.variants), v.command)
+                c.runtime / len(c.variants), v.command, v.ensemble, v.seed)
             for c in cases for v in c.variants]
 
 
@@ -292,22 +298,74 @@ def _record(outcome, cmd, ident):
               "returncode": outcome.returncode, "wall_seconds": round(outcome.wall, 6),
               "ok": outcome.ok, "cause": outcome.cause, "kind": outcome.job.command,
               "identity": ident, "outputs": output_digests(folder)}
+    if outcome.job.ensemble:
+        record.update(ensemble=outcome.job.ensemble, seed=outcome.job.seed)
     files.write_text(folder / "harness.json", json.dumps(record, indent=1) + "\n")
 
 
-class Progress:
-    """'[done/total] case/variant  1.23 s  ETA 4 s': redrawn with \\r on a tty, plain lines otherwise."""
+LONG_BATCH = 60      # a batch of more runs than this gets progress lines, not a line per run
+PERIOD = 30.0        # seconds between those lines off a terminal (on one, the line is redrawn)
 
-    def __init__(self, jobs, out, tty=None):
+
+def duration(seconds):
+    """A time left, as people read it: '45 s', '12 min 05 s', '3 h 20 min'."""
+    seconds = max(0, int(round(seconds)))
+    if seconds < 60:
+        return f"{seconds} s"
+    if seconds < 3600:
+        return f"{seconds // 60} min {seconds % 60:02d} s"
+    return f"{seconds // 3600} h {seconds % 3600 // 60:02d} min"
+
+
+def rate_text(runs, seconds):
+    """Runs per minute, or per hour when fewer than one a minute."""
+    if runs <= 0 or seconds <= 0:
+        return "- runs/min"
+    per_minute = runs * 60.0 / seconds
+    return f"{per_minute:.3g} runs/min" if per_minute >= 1 else f"{per_minute * 60:.3g} runs/h"
+
+
+def limit_found(outcome):
+    """Whether a failed run is a sweep point past its stability limit: a probing job (Job.probe)
+    whose run.json says the core ended it as unstable (its run-time guards)."""
+    if not outcome.job.probe or outcome.ok or outcome.skipped:
+        return False
+    try:
+        return read_run_json(outcome.job.out).get("status") == "unstable"
+    except (RunProblem, OSError):
+        return False
+
+
+class Progress:
+    """What the runs have done so far, on out.
+
+    A short batch (at most long_batch runs): one line per run, '[done/total] case/variant
+    1.23 s  ETA 4 s', redrawn in place (\\r) on a terminal, plain lines otherwise.
+
+    A long batch (an ensemble of hundreds of realisations): one status line, '[done/total]
+    46 %  12.3 runs/min  13 min 20 s left  (last case/variant 4.71 s; 2 failed, 10 kept)',
+    redrawn after every run on a terminal; off a terminal (a log, CI) printed after the first
+    run, then at most once every `period` seconds, and at the end.
+
+    Either way a failed or skipped run's cause is printed at once, on a line of its own; the
+    rate counts the runs that ran (not those kept by --resume) over the time since the start;
+    the time left scales the elapsed time by the expected run times (case.txt `runtime`) of
+    what is left against what has finished."""
+
+    def __init__(self, jobs, out, tty=None, long_batch=LONG_BATCH, period=PERIOD, clock=time.monotonic):
         self.total, self.done, self.out = len(jobs), 0, out
         self.expected_total = sum(j.expected for j in jobs)
         self.expected_done = 0.0
         self.tty = out.isatty() if tty is None else tty
-        self.start = time.monotonic()
+        self.long = self.total > long_batch
+        self.period, self.clock = period, clock
+        self.start = clock()
+        self.ran = self.kept = self.failed = self.limits = 0
+        self.last_line = None       # when the last periodic line was printed (long batches off a tty)
 
     def eta(self):
         """Seconds left, scaled from the expected run times of what has finished."""
-        elapsed = time.monotonic() - self.start
+        elapsed = self.clock() - self.start
         if self.done >= self.total:
             return 0.0
         if self.expected_done > 0:
@@ -317,27 +375,65 @@ class Progress:
     def finished(self, outcome):
         self.done += 1
         if outcome.skipped:     # took no time: leaves the ETA to the runs that do
+            self.kept += 1
             self.expected_total -= outcome.job.expected
+            if self.long:
+                self._status(outcome)
+                return
             self._write(f"[{self.done}/{self.total}] {outcome.job.label}  done before, kept (--resume)",
                         keep=not self.tty)
             return
+        self.ran += 1
         self.expected_done += outcome.job.expected
-        if not outcome.ok:
+        if limit_found(outcome):
+            self.limits += 1
+            self._write(f"LIMIT {outcome.job.label}: past its stability limit, the guards stopped it "
+                        f"(a measured point of the sweep, not a failure): {outcome.cause}", keep=True)
+        elif not outcome.ok:
+            self.failed += 1
             self._write(f"FAILED {outcome.job.label}: {outcome.cause}", keep=True)
         if outcome.skip_reason:
             self._write(f"SKIPPED {outcome.job.label}: {outcome.skip_reason}", keep=True)
+        if self.long:
+            self._status(outcome)
+            return
         line = f"[{self.done}/{self.total}] {outcome.job.label}  {outcome.wall:.2f} s  ETA {self.eta():.0f} s"
-        self._write(line + ("" if outcome.ok else "  FAILED"), keep=not self.tty)
+        self._write(line + ("" if outcome.ok else "  LIMIT" if limit_found(outcome) else "  FAILED"),
+                    keep=not self.tty)
+
+    def status_line(self, last=None):
+        """The long batch's line: done/total, per cent, rate, time left, the last run."""
+        elapsed = self.clock() - self.start
+        percent = 100.0 * self.done / self.total if self.total else 100.0
+        counts = ([f"{self.failed} failed"] if self.failed else []) + ([f"{self.kept} kept"] if self.kept else [])
+        counts += [f"{self.limits} past their limit"] if self.limits else []
+        notes = [f"last {last.job.label} {last.wall:.2f} s"] if last is not None and not last.skipped else []
+        notes += [", ".join(counts)] if counts else []
+        tail = f"  ({'; '.join(notes)})" if notes else ""
+        return (f"[{self.done}/{self.total}] {percent:.0f} %  {rate_text(self.ran, elapsed)}  "
+                f"{duration(self.eta())} left{tail}")
+
+    def _status(self, outcome):
+        if self.tty:
+            self._write(self.status_line(outcome), keep=False)
+            return
+        now = self.clock()
+        if self.last_line is None or now - self.last_line >= self.period or self.done == self.total:
+            self.last_line = now
+            self._write(self.status_line(outcome), keep=True)
 
     def close(self, outcomes):
-        failed = sum(not o.ok for o in outcomes)
+        limits = sum(limit_found(o) for o in outcomes)
+        failed = sum(not o.ok for o in outcomes) - limits
         if self.tty and self.total:
             self.out.write("\n")
-        elapsed = time.monotonic() - self.start
+        elapsed = self.clock() - self.start
         skipped = sum(o.skipped for o in outcomes)
         kept = f" ({skipped} kept from before)" if skipped else ""
-        self._write(f"{len(outcomes)} runs: {len(outcomes) - failed} ok{kept}, {failed} failed ({elapsed:.1f} s)",
-                    keep=True)
+        rate = f", {rate_text(self.ran, elapsed)}" if self.long else ""
+        beyond = f", {limits} past their stability limit (measured, not failures)" if limits else ""
+        self._write(f"{len(outcomes)} runs: {len(outcomes) - failed - limits} ok{kept}{beyond}, {failed} failed "
+                    f"({elapsed:.1f} s{rate})", keep=True)
 
     def _write(self, text, keep):
         prefix = "\r\x1b[K" if self.tty else ""
@@ -475,9 +571,3 @@ def run_all(jobs, binary, workers=None, out=sys.stdout, tty=None, resume=False):
     return outcomes
 
 
-def sweep_jobs(case, variant, key, values, sweeps_root):
-    """One Job per value: the variant with KEY=value appended, outputs in sweeps_root/<case>/<KEY>=<V>."""
-    return [Job(case.name, f"{key}={v}", variant.scene, list(variant.sets) + [f"{key}={v}"],
-                Path(sweeps_root) / case.name / f"{key}={v}", case.runtime / len(case.variants),
-                variant.command)
-            for v in values]

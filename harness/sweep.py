@@ -247,7 +247,7 @@ def jobs(case, sweeps_root):
             # (ballast refuses such a step otherwise); it runs, and the guards say if it is unstable
             out.append(Job(case.name, label, variant.scene, list(variant.sets) + sweep.sets(f) + FORCE,
                            Path(sweeps_root) / case.name / label, case.runtime / max(len(case.variants), 1),
-                           variant.command))
+                           variant.command, probe=True))
     return out
 
 
@@ -406,7 +406,11 @@ def summary_text(name, rows):
         lines.append(f"  error <= {tol:g}: " + (f"{setting(r)}, error {_cell(r['error'])}, "
                                                  f"{r['particle_steps']} particle-steps"
                                                  if r else "no swept setting"))
-    bad = [f"{r['sweep']} x{number(r['factor'])}" for r in rows if failed(r)]
-    if bad:
-        lines.append(f"  failed (unstable or no run.json; no error): {', '.join(bad)}")
+    unstable = [f"{r['sweep']} x{number(r['factor'])}" for r in rows if r["status"] == "unstable"]
+    other = [f"{r['sweep']} x{number(r['factor'])}" for r in rows if failed(r) and r["status"] != "unstable"]
+    if unstable:
+        lines.append(f"  beyond the stability limit (the run-time guards stopped them; a measured limit of "
+                     f"the trade, not a gate): {', '.join(unstable)}")
+    if other:
+        lines.append(f"  no result (no usable run.json; not a gate): {', '.join(other)}")
     return "\n".join(lines)

@@ -641,6 +641,101 @@ START_TEST(measure_series_row_at_stage_end)
 }
 END_TEST
 
+/* Issue 23: a stage given in simulated time runs ceil(time/dt) cycles, to
+ * 1e-9 of a step (0.0162 with dt 2.7e-3 is 6 cycles although 0.0162/2.7e-3
+ * is 6.000000000000001 in doubles), so changing dt keeps the time; a time
+ * between two steps takes the next; --set of one replaces the other. */
+START_TEST(measure_stage_in_time)
+{
+    static const char *scene = "[settings]\ndt = %s\n"
+                               "[material m]\nkn = 1e4\ndensity = 2.385\n"
+                               "[disc d]\nx = 0.5 1.25\nr = 0.3\nmaterial = m\n"
+                               "[stage a]\ntime = %s\n[stage b]\ncycles = 5\n";
+    struct { const char *dt, *time; long cycles; } cases[] = {
+        {"2.7e-3", "0.0162", 6}, {"1.35e-3", "0.0162", 12}, {"2.7e-3", "0.0163", 7},
+        {"0.1", "0.3", 3}, {"2.7e-3", "0", 0},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        struct tfx *f = tfx_newf("time", scene, cases[k].dt, cases[k].time);
+        ck_assert_int_eq(bal_sim_stage_cycles(f->sim, 0), cases[k].cycles);
+        ck_assert_int_eq(bal_sim_stage_cycles(f->sim, 1), 5);
+        ck_assert_int_eq(bal_sim_run(f->sim, NULL, NULL, &f->err), BAL_OK);
+        struct bal_run_info in;
+        bal_sim_info(f->sim, &in);
+        ck_assert_int_eq(in.steps, cases[k].cycles + 5);
+        tfx_release(f);
+    }
+    /* An override of cycles replaces time, and of time replaces cycles. */
+    struct tfx *f = tfx_parse("[settings]\ndt = 0.1\nforce_dt = 1\n[material m]\nkn = 1e4\ndensity = 2.385\n"
+                              "[disc d]\nx = 0.5 1.25\nr = 0.3\nmaterial = m\n"
+                              "[stage a]\ntime = 0.3\n[stage b]\ncycles = 5\n", "set");
+    ck_assert_int_eq(bal_scene_set(&f->sc, "stage.a.cycles=4", &f->err), BAL_OK);
+    ck_assert_int_eq(bal_scene_set(&f->sc, "stage.b.time=0.2", &f->err), BAL_OK);
+    ck_assert_int_eq(bal_scene_validate(&f->sc, &f->err), BAL_OK);
+    ck_assert_int_eq(tfx_create(f), BAL_OK);
+    ck_assert_int_eq(bal_sim_stage_cycles(f->sim, 0), 4);
+    ck_assert_int_eq(bal_sim_stage_cycles(f->sim, 1), 2);
+}
+END_TEST
+
+/* Both lengths, or none, are refused with the file, the line and the key;
+ * a time of more than 1e15 steps too. */
+START_TEST(measure_stage_length_refused)
+{
+    static const char *head = "[settings]\ndt = 1e-3\n[material m]\nkn = 1e4\ndensity = 2.385\n"
+                              "[disc d]\nx = 0.5 1.25\nr = 0.3\nmaterial = m\n";
+    char text[512];
+    snprintf(text, sizeof text, "%s[stage a]\ncycles = 3\ntime = 0.3\n", head);
+    struct tfx *f = tfx_parse(text, "both");
+    ck_assert_int_eq(bal_scene_validate(&f->sc, &f->err), BAL_EINVAL);
+    ck_assert_msg(t_contains(f->err.msg, "both:12: time:") && t_contains(f->err.msg, "both cycles and time"),
+                  "%s", f->err.msg);
+    tfx_release(f);
+    snprintf(text, sizeof text, "%s[stage a]\nramp = 1\n", head);
+    f = tfx_parse(text, "none");
+    ck_assert_int_eq(bal_scene_validate(&f->sc, &f->err), BAL_EINVAL);
+    ck_assert_msg(t_contains(f->err.msg, "none:10: [stage a]: cycles: required"), "%s", f->err.msg);
+    tfx_release(f);
+    snprintf(text, sizeof text, "%s[stage a]\ntime = 1e20\n", head);
+    f = tfx_parse(text, "long");
+    ck_assert_int_eq(bal_scene_validate(&f->sc, &f->err), BAL_OK);
+    ck_assert_int_eq(tfx_create(f), BAL_EINVAL);
+    ck_assert_msg(t_contains(f->err.msg, "long:11: time:"), "%s", f->err.msg);
+}
+END_TEST
+
+/* The progress report is called during a long run with what it says, and
+ * reading it changes nothing: positions bitwise those of a run without. */
+struct progress_seen { int calls; long last_step, steps; };
+static void count_progress(const struct bal_progress *p, void *ctx)
+{
+    struct progress_seen *seen = ctx;
+    seen->calls++;
+    ck_assert_int_ge(p->step, seen->last_step);
+    ck_assert_int_le(p->stage_cycle, p->stage_cycles);
+    seen->last_step = p->step;
+    seen->steps = p->steps;
+}
+
+START_TEST(measure_progress_reports_change_nothing)
+{
+    static const char *scene = "[settings]\ndt = 1e-3\n[material m]\nkn = 1e4\ndensity = 2.385\n"
+                               "[disc d]\nx = 0.5 1.25\nr = 0.3\nv = 0.1 0\nmaterial = m\n"
+                               "[disc e]\nx = 1.05 1.25\nr = 0.3\nmaterial = m\n"
+                               "[stage a]\ncycles = 3000\n[stage b]\ntime = 3\n";
+    struct tfx *a = tfx_new(scene, "plain"), *b = tfx_new(scene, "watched");
+    struct progress_seen seen = {0, 0, 0};
+    bal_sim_set_progress(b->sim, count_progress, &seen, 0); /* every 1024 cycles */
+    ck_assert_int_eq(bal_sim_run(a->sim, NULL, NULL, &a->err), BAL_OK);
+    ck_assert_int_eq(bal_sim_run(b->sim, NULL, NULL, &b->err), BAL_OK);
+    ck_assert_int_eq(seen.calls, 2 + 2); /* 3000 and 3000 cycles: at 1024 and 2048 of each */
+    ck_assert_int_eq(seen.steps, 6000);
+    const int i = t_slot(a, "d"), j = t_slot(b, "d");
+    ck_assert(memcmp(&a->sim->x[i], &b->sim->x[j], sizeof(double)) == 0);
+    ck_assert(memcmp(&a->sim->vx[i], &b->sim->vx[j], sizeof(double)) == 0);
+}
+END_TEST
+
 /* Issue 18: a series row is written only when every probe value is a
  * number; otherwise nothing of it is written and the probe is named by its
  * file, line and key. */
@@ -700,6 +795,9 @@ Suite *suite_measure(void)
     tcase_add_test(tc, measure_weight_follows_ramp);
     tcase_add_test(tc, measure_series_row_not_finite);
     tcase_add_test(tc, measure_series_row_at_stage_end);
+    tcase_add_test(tc, measure_stage_in_time);
+    tcase_add_test(tc, measure_stage_length_refused);
+    tcase_add_test(tc, measure_progress_reports_change_nothing);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -40,10 +40,11 @@ def now_text():
     return datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
 
 
-def write_report(cases, checks, store, runs_root, reports_dir, out=None):
-    """Render figures, write summary.md and index.html; return the index path."""
+def write_report(cases, checks, store, runs_root, reports_dir, out=None, render=None):
+    """Render figures, write summary.md and index.html; return the index path.  render: the
+    case names whose figures are drawn anew (None: all; gather)."""
     reports_dir = Path(reports_dir)
-    reports = gather(cases, checks, store, runs_root, reports_dir)
+    reports = gather(cases, checks, store, runs_root, reports_dir, render)
     revision, date = git_revision(), now_text()
     files.write_text(reports_dir / "summary.md", markdown(reports, revision, date) + stability_markdown(reports_dir))
     index = reports_dir / "index.html"

@@ -5,13 +5,14 @@ verdicts and its error-against-cost section (cost_plot.py); and the stability ta
 Verdicts come from reports/summary.json when it is newer than the runs and the references of
 a case, otherwise they are evaluated here.
 """
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from .. import files, sweep
 from ..compare import evaluate_all
 from ..errors import RunProblem
 from ..gate import read_summary
+from ..references import reference_lines
 from ..stability import read_tsv
 from ..tables import read_harness_record, read_run_json
 from .cost_plot import render_cost
@@ -73,6 +74,24 @@ def verdicts_for(case, checks, summary, saved, runs_root, store):
     return evaluate_all(mine, store), "evaluated by `report` (summary.json absent or older than the runs)"
 
 
+def with_references(figure, checks):
+    """The figure with its `reference` checks' values among its lines (a copy; the case's figure
+    is left as it is)."""
+    if not figure.references:
+        return figure
+    return replace(figure, lines=list(figure.lines) + reference_lines(figure, checks))
+
+
+def drawn_before(case, figure, figures_dir):
+    """The FigureOut of a figure an earlier report drew (its files, where they exist)."""
+    out = FigureOut(figure.name, figure.title, figure.paper)
+    png, svg = (Path(figures_dir) / f"{case.name}_{figure.name}.{ext}" for ext in ("png", "svg"))
+    out.png, out.svg = (png if png.is_file() else None), (svg if svg.is_file() else None)
+    if out.png is None and out.svg is None:
+        out.notes.append("not drawn yet: run `harness report` (or validate) with this case")
+    return out
+
+
 def _saved(summary):
     try:
         return read_summary(summary) if summary.is_file() else []
@@ -80,14 +99,20 @@ def _saved(summary):
         return []
 
 
-def gather(cases, checks, store, runs_root, reports_dir):
-    """A CaseReport per case: runs, rendered figures, verdicts."""
+def gather(cases, checks, store, runs_root, reports_dir, render=None):
+    """A CaseReport per case: runs, rendered figures, verdicts.  render (a set of case names, or
+    None for all): the cases whose figures are drawn anew; the others keep the figure files an
+    earlier report drew (a report of one case leaves the rest of the report as it was)."""
     summary = Path(reports_dir) / "summary.json"
     saved, figures_dir = _saved(summary), files.make_dirs(Path(reports_dir) / "figures")
     reports = []
     for case in cases:
         verdicts, source = verdicts_for(case, checks, summary, saved, runs_root, store)
-        figures = [render_figure(case, f, store, figures_dir) for f in case.figures]
+        if render is None or case.name in render:
+            mine = [c for c in checks if c.case == case.name]
+            figures = [render_figure(case, with_references(f, mine), store, figures_dir) for f in case.figures]
+        else:
+            figures = [drawn_before(case, f, figures_dir) for f in case.figures]
         reports.append(CaseReport(case, run_rows(case, runs_root), figures, verdicts, source,
                                   cost_section(case, reports_dir, figures_dir)))
     return reports

@@ -3,6 +3,7 @@ error against particle-steps on log-log axes, one curve per sweep, the default t
 marked, failed (unstable) points as crosses on a line at the top.  Drawn by gnuplot through
 plots.py.
 """
+import math
 import shutil
 import tempfile
 from dataclasses import dataclass
@@ -44,6 +45,29 @@ def cost_points(rows):
 
 UNSTABLE = "unstable"
 POINT_TYPES = (7, 6, 5, 4, 9, 8, 11, 10, 13, 12)
+# Where each curve's labels sit against their points (characters): curves take turns, so the
+# labels of curves through one point do not print over each other.
+LABEL_OFFSETS = ("left offset char 0.6,0.6", "left offset char 0.6,-0.9", "right offset char -0.6,-0.9",
+                 "right offset char -0.6,0.6")
+NEAR = (0.06, 0.12)     # decades in cost and error within which two points of a curve share a label
+
+
+def merged_labels(points, near=NEAR):
+    """The (x, y, label) of one curve with the labels of points that lie within `near` (decades,
+    log-log) of an earlier labelled point joined onto that one ('x0.5, x2, x4') and their own
+    blanked, so points that coincide are labelled once, legibly."""
+    out, placed = [list(p) for p in points], []
+    for p in out:
+        if not p[2]:
+            continue
+        for q in placed:
+            if abs(math.log10(p[0] / q[0])) < near[0] and abs(math.log10(p[1] / q[1])) < near[1]:
+                q[2] += ", " + p[2]
+                p[2] = ""
+                break
+        else:
+            placed.append(p)
+    return [tuple(p) for p in out]
 
 
 def render_cost(case, rows, figures_dir):
@@ -62,7 +86,7 @@ def render_cost(case, rows, figures_dir):
         return out
     figure = _CostAxes(out.title)
     if any(str(r["worst"]).startswith("vs finest: ") for r in rows):
-        figure.ylabel = "error: max |q - q_finest| / |q_finest| (against the finest swept run)"
+        figure.ylabel = "error against the finest swept run: max |q - q_finest| / |q_finest| (-)"
     errors = [y for pts in curves.values() for _, y, _ in pts]
     top = max(errors) * 10 if errors else 1.0
     names = list(dict.fromkeys(list(curves) + list(bad)))
@@ -71,11 +95,13 @@ def render_cost(case, rows, figures_dir):
         for i, name in enumerate(names):
             if name in curves:
                 path = Path(workdir) / f"curve{i}.dat"
-                files.write_text(path, "".join(f"{x!r}\t{y!r}\t{label}\n" for x, y, label in curves[name]))
+                files.write_text(path, "".join(f"{x!r}\t{y!r}\t\"{label}\"\n"
+                                               for x, y, label in merged_labels(curves[name])))
                 # point types cycle filled/open, so curves that coincide (verlet on centred) stay visible
                 clauses += [f"{gp_string(path)} using 1:2 with linespoints pt {POINT_TYPES[i % len(POINT_TYPES)]} "
                             f"ps {1.0 if i % 2 == 0 else 1.6} lc {i + 1} title {gp_string(name)}",
-                            f"{gp_string(path)} using 1:2:3 with labels left offset char 0.6,0.5 tc lt {i + 1} notitle"]
+                            f"{gp_string(path)} using 1:2:3 with labels {LABEL_OFFSETS[i % len(LABEL_OFFSETS)]} "
+                            f"tc lt {i + 1} notitle"]
             if name in bad:
                 path = Path(workdir) / f"failed{i}.dat"
                 files.write_text(path, "".join(f"{x!r}\t{top!r}\t\"{label}\"\n" for x, label in bad[name]))
@@ -108,6 +134,6 @@ class _CostAxes:
     """What gnuplot_script needs of a figure, for the cost diagram."""
     title: str
     xlabel: str = "cost: particle-steps (steps x discs)"
-    ylabel: str = "error: max |q - ref| / |ref| over the error terms"
+    ylabel: str = "error: max |q - ref| / |ref| over the error terms (-)"
     xrange: str = ""
     yrange: str = ""

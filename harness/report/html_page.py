@@ -1,7 +1,7 @@
 """reports/index.html: the report as one self-contained page, from what contents.py gathered.
 
 Figures are inlined (SVG as a base64 data URI, PNG as fallback), so index.html opens without
-a server or any other file.
+a server or any other file; an SVG above SVG_INLINE_MAX is linked instead (its PNG inlined).
 """
 import base64
 import html
@@ -38,16 +38,25 @@ def table_html(headers, rows):
     return f"<table><tr>{head}</tr>\n" + "\n".join(f"<tr>{''.join(r)}</tr>" for r in rows) + "</table>"
 
 
+SVG_INLINE_MAX = 512 * 1024   # a larger SVG (a force network of thousands of lines) is linked, its PNG inlined
+
+
 def image_html(figure):
-    """The figure inlined: SVG as a data URI, else PNG, else only its notes."""
-    if figure.svg:
+    """The figure inlined: SVG as a data URI, else PNG, else only its notes.  An SVG above
+    SVG_INLINE_MAX bytes is not inlined: its PNG is, with a link to the SVG file (in figures/,
+    beside index.html), so the page stays small enough to open at once."""
+    link = ""
+    if figure.svg and (figure.svg.stat().st_size <= SVG_INLINE_MAX or not figure.png):
         src = "data:image/svg+xml;base64," + base64.b64encode(figure.svg.read_bytes()).decode()
     elif figure.png:
         src = "data:image/png;base64," + base64.b64encode(figure.png.read_bytes()).decode()
+        if figure.svg:
+            link = (f" (<a href=\"figures/{esc(figure.svg.name)}\">vector version</a>, "
+                    f"{figure.svg.stat().st_size / 1e6:.1f} MB)")
     else:
         src = ""
     img = f"<img alt=\"{esc(figure.title)}\" src=\"{src}\">" if src else "<p class=\"bad\">(no figure)</p>"
-    notes = "".join(f"<br><span class=\"bad\">{esc(n)}</span>" for n in figure.notes)
+    notes = link + "".join(f"<br><span class=\"bad\">{esc(n)}</span>" for n in figure.notes)
     paper = f"<blockquote>{esc(figure.paper)}</blockquote>" if figure.paper else ""
     return f"<figure>{img}<figcaption><b>{esc(figure.title)}</b>{notes}{paper}</figcaption></figure>"
 

@@ -63,9 +63,12 @@ def gp_string(text):
 
 
 def curve_title(variant, column, figure):
+    """A curve's legend: the variant's `label` (its name when it has none), and the column when
+    the figure draws several."""
     if len(figure.variants) == 1:
         return column
-    return variant if len(figure.y) == 1 else f"{variant}: {column}"
+    name = figure.names.get(variant, variant)
+    return name if len(figure.y) == 1 else f"{name}: {column}"
 
 
 def figure_data(case, figure, store, workdir):

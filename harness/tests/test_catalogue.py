@@ -121,3 +121,17 @@ def test_stability_value_is_checked(tmp_path):
     write(tmp_path, "fam", CASE.replace("runtime = 1\n", "runtime = 1\nstability = maybe\n"))
     with pytest.raises(IniError, match="stability must be yes or no, not 'maybe'"):
         catalogue.load(tmp_path)
+
+
+def test_every_axis_of_the_catalogue_says_its_unit():
+    """Issue 23: each axis label of every figure ends with its unit in parentheses: '(kPa)', '(s)',
+    '(m g / l)', '(-)' for a pure number or a count, '(BALL units of force)' where the paper has
+    none (C&S: 'No attempts have been made to relate the units used in BALL to physical units')."""
+    import re
+    from pathlib import Path
+    unit = re.compile(r"\([^()]+\)\s*$")
+    missing = [f"{c.name}/{f.name}: {axis} '{label}'"
+               for c in catalogue.load(Path(__file__).resolve().parents[2] / "cases") for f in c.figures
+               if f.kind not in ("network", "principal")
+               for axis, label in (("xlabel", f.xlabel), ("ylabel", f.ylabel)) if not unit.search(label or "")]
+    assert not missing, "axis labels without a unit: " + "; ".join(missing)

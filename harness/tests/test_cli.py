@@ -1,4 +1,5 @@
 """The command line as a whole: list, sweep, validate, the wrapper script, and malformed series."""
+import json
 import os
 import subprocess
 from pathlib import Path
@@ -55,11 +56,29 @@ def test_sweep(project, capsys):
     out = capsys.readouterr().out
     sweeps = project / "reports" / "sweeps" / "spring"
     assert (sweeps / "k=1" / "series.tsv").exists() and (sweeps / "k=2" / "series.tsv").exists()
-    table = out[out.index("check"):].splitlines()
+    table = out[out.index("check"):out.index("wrote")].splitlines()
     assert table[0].split() == ["check", "reference", "tolerance", "k=1", "k=2"]
     rows = {line.split()[0]: line for line in table[1:]}
-    assert set(rows) == {"abs_at2", "interval_ek", "regress_mean"}       # checks of soft alone
-    assert rows["abs_at2"].split()[-4:] == ["2", "PASS", "4", "FAIL"]
+    assert set(rows) == {"abs_at2", "interval_ek", "regress_mean",       # checks of soft alone
+                         "(status)", "(steps)", "(particle-steps)", "(wall"}   # ... and each point's cost
+    # value, verdict and error against the reference 2 (abs tolerance): 0 at k=1, |4 - 2|/2 at k=2
+    assert rows["abs_at2"].split()[-8:] == ["2", "PASS", "err", "0.00e+00", "4", "FAIL", "err", "1.00e+00"]
+    assert rows["(status)"].split()[-2:] == ["ok", "ok"]
+    tsv = (sweeps / "sweep_soft.tsv").read_text().splitlines()
+    assert tsv[0].split("\t")[:3] == ["point", "sets", "status"] and len(tsv) == 1 + 2 * 3
+
+
+def test_sweep_with_several_keys_runs_their_grid(project, capsys):
+    """Issue 23: several --set options combine as a grid (the first key slowest); a key twice is
+    refused rather than one of them dropped in silence."""
+    assert main(["sweep", "spring", "--set", "k=1,2", "--set", "x=5,6,7", "--variant", "soft"]) == 0
+    out = capsys.readouterr().out
+    labels = out[out.index("check"):].splitlines()[0].split()[3:]
+    assert labels == ["k=1,x=5", "k=1,x=6", "k=1,x=7", "k=2,x=5", "k=2,x=6", "k=2,x=7"]
+    run = project / "reports" / "sweeps" / "spring" / "k=2,x=6"
+    assert json.loads((run / "run.json").read_text())["sets"][-2:] == ["k=2", "x=6"]
+    assert main(["sweep", "spring", "--set", "k=1,2", "--set", "k=3", "--variant", "soft"]) == 2
+    assert "--set k given twice" in capsys.readouterr().err
 
 
 def test_sweep_needs_a_variant_when_several(project, capsys):
@@ -98,3 +117,39 @@ def test_series_with_header_only_has_empty_columns(tmp_path):
     (tmp_path / "series.tsv").write_text("cycle\ttime\tEk\n")
     columns = read_series(tmp_path / "series.tsv")
     assert list(columns) == ["cycle", "time", "Ek"] and columns["Ek"].size == 0
+
+
+def test_validate_of_one_case_updates_its_part_and_keeps_the_rest(project, capsys):
+    """Issue 23: `validate CASE` checks and draws that case and leaves the other cases' verdicts
+    and figures in summary.json, junit.xml and index.html as an earlier validate wrote them."""
+    (project / "reference" / "slow.ref").write_text(
+        "[check slow_last]\ncase = slow\nvariant = only\nquantity = last(F)\nvalue = 10\n"
+        "tolerance = rel 1e-9\nkind = exact\nprovenance = F = k x with k = 1, x = 10\n")
+    assert main(["validate", "--tier", "full", "--no-stability"]) == 0
+    reports = project / "reports"
+    before = json.loads((reports / "summary.json").read_text())
+    spring = [v for v in before if v["case"] == "spring"]
+    assert spring and (reports / "figures" / "spring_force.png").exists()
+    figure = (reports / "figures" / "spring_force.png").stat().st_mtime_ns
+    capsys.readouterr()
+    assert main(["validate", "slow", "--tier", "full", "--no-stability"]) == 0
+    out = capsys.readouterr().out
+    assert "spring/" not in out                                   # spring was not run again
+    after = json.loads((reports / "summary.json").read_text())
+    assert [v for v in after if v["case"] == "spring"] == spring   # ... and its verdicts kept
+    assert 'classname="spring.' in (reports / "junit.xml").read_text()
+    page = (reports / "index.html").read_text()
+    assert "A linear spring" in page and "A slow case" in page
+    assert (reports / "figures" / "spring_force.png").stat().st_mtime_ns == figure   # not redrawn
+
+
+def test_validate_of_some_cases_runs_the_extreme_probes_only_when_asked(project, monkeypatch):
+    """Issue 23: the extreme probes belong to no case: a validate of all cases runs them, a
+    validate of named cases only with --extremes."""
+    import harness.__main__ as cli
+    seen = []
+    monkeypatch.setattr(cli, "cmd_stability", lambda a: seen.append(a.no_extremes) or 0)
+    for argv, skipped in ((["validate"], False), (["validate", "spring"], True),
+                          (["validate", "spring", "--extremes"], False)):
+        main(argv)
+        assert seen.pop() is skipped, argv

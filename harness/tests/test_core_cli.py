@@ -134,3 +134,51 @@ def test_full_disk_is_an_io_error_and_leaves_no_temporary_file(full_disk, comman
     assert not [n for n in left if n.endswith(".tmp")], left
     # What is left says why: at most a run.json, and no result file.
     assert set(left) <= {"run.json"}, left
+
+
+@needs_ballast
+def test_run_ends_with_a_summary_of_what_it_simulated(tmp_path):
+    """Issue 23: a run says on exit how it ended, its cycles, the simulated time (the dt it used)
+    and the energy imbalance, so a stage count that covers a fraction of the time meant shows;
+    the same stage given in time covers the same time whatever dt is."""
+    import json
+    import re
+    line = re.compile(r"ballast run: ok, (\d+) cycles, (\S+) s simulated \(dt (\S+)\), wall \S+ s, "
+                      r"energy imbalance \S+ of the energy through the run\n")
+    scene = tmp_path / "drop.scene"
+    scene.write_text("[settings]\ndt = 1e-3\ngravity = 0 -9.81\n[material m]\nkn = 1e3\ndensity = 1\n"
+                     "[disc d]\nx = 0 1\nr = 0.1\nmaterial = m\n[stage fall]\ntime = 0.25\n")
+    seen = []
+    for dt in ("1e-3", "2.5e-4"):
+        done = ballast("run", scene, "--out", tmp_path / dt, "--set", f"settings.dt={dt}")
+        assert done.returncode == 0, done.stderr
+        m = line.fullmatch(done.stdout)
+        assert m, done.stdout
+        seen.append((int(m.group(1)), float(m.group(2))))
+        stage = json.loads((tmp_path / dt / "run.json").read_text())["stages"][0]
+        assert stage["stage_time"] == 0.25 and stage["max_cycles"] == stage["cycles"] == seen[-1][0]
+    assert seen[0][0] == 250 and seen[1][0] == 1000
+    assert seen[0][1] == pytest.approx(0.25, rel=1e-12) and seen[1][1] == pytest.approx(0.25, rel=1e-12)
+
+
+@needs_ballast
+def test_a_sweep_over_the_time_step_keeps_the_simulated_time(tmp_path):
+    """Issue 23: `harness sweep --set settings.dt=...` runs each stage given in cycles over the
+    same simulated time (stage.NAME.time overrides from `ballast info`), so halving dt doubles
+    the steps, and the table has each point's error and cost."""
+    import json
+    import sys
+    env = {**os.environ, "BALLAST_REPORTS": str(tmp_path), "PYTHONPATH": str(REPO)}
+    for var in ("BALLAST_CASES", "BALLAST_REFERENCE", "BALLAST_BIN"):
+        env.pop(var, None)
+    done = subprocess.run([sys.executable, "-m", "harness", "sweep", "two_discs", "--variant", "undamped",
+                           "--set", "settings.dt=0.01,0.005", "-j", "2"], cwd=REPO, env=env,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "keeps the stages' simulated time" in done.stdout and "(wall s)" in done.stdout
+    runs = [json.loads((tmp_path / "sweeps" / "two_discs" / f"settings.dt={dt}" / "run.json").read_text())
+            for dt in ("0.01", "0.005")]
+    assert runs[1]["steps"] == 2 * runs[0]["steps"]
+    assert runs[1]["time"] == pytest.approx(runs[0]["time"], rel=1e-12)
+    for run in runs:
+        assert [st["cycles"] * run["dt"] for st in run["stages"]] == pytest.approx([0.4, 6.0], rel=1e-12)

@@ -97,3 +97,37 @@ def test_lines_alone_are_not_a_figure(tmp_path, store):
     case = load(tmp_path, "[figure m]\nvariants = b\nx = theta_r\ny = mr\nline = 2.5 0 K_m\n")
     out = plots.render_figure(case, case.figures[0], store, tmp_path)
     assert out.png is None and out.notes[-1] == "nothing to plot"
+
+
+def test_a_variant_label_names_its_curve_in_the_legend(tmp_path):
+    """Issue 23: legends say what a curve is (`label` of the variant), not the variant's name."""
+    folder = tmp_path / "cases" / "laws"
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "case.txt").write_text(CASE.replace("[variant a]\n", "[variant a]\nlabel = Model 1, delta = 1.6\n")
+                                     + "\n[figure m]\nx = cycle\ny = mr\n")
+    figure = catalogue.load(tmp_path / "cases")[0].figures[0]
+    assert plots.curve_title("a", "mr", figure) == "Model 1, delta = 1.6"
+    assert plots.curve_title("b", "mr", figure) == "b"               # no label: its name
+
+
+def test_a_figure_draws_the_reference_of_the_check_it_names(tmp_path):
+    """Issue 23: `reference = CHECK` draws that check's reference (a value: its level; an interval:
+    its bounds) on the figure, from reference/*.ref, so the line cannot drift from the gate."""
+    from harness import references
+    folder = tmp_path / "cases" / "laws"
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "case.txt").write_text(CASE + "\n[figure m]\nx = cycle\ny = mr\nreference = eq band\n")
+    (tmp_path / "ref").mkdir()
+    (tmp_path / "ref" / "laws.ref").write_text(
+        "[check eq]\ncase = law\nvariant = a\nquantity = last(mr)\nvalue = 2.5\ntolerance = rel 1e-3\n"
+        "kind = exact\nprovenance = p\n\n[check band]\ncase = law\nvariant = a\nquantity = max(mr)\n"
+        "lo = 1\nhi = 4\ntolerance = interval\nkind = paper\nprovenance = p\n")
+    cases = catalogue.load(tmp_path / "cases")
+    checks = references.expand(references.load(tmp_path / "ref"), cases)
+    references.validate(checks, cases)
+    lines = references.reference_lines(cases[0].figures[0], checks)
+    assert [(slope, level) for slope, level, _ in lines] == [(0.0, 2.5), (0.0, 1.0), (0.0, 4.0)]
+    assert lines[0][2] == "reference eq (exact): 2.5"
+    (folder / "case.txt").write_text(CASE + "\n[figure m]\nx = cycle\ny = mr\nreference = nope\n")
+    with pytest.raises(IniError, match="reference 'nope' is no check of case 'law'"):
+        references.validate(checks, catalogue.load(tmp_path / "cases"))

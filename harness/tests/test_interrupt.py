@@ -206,6 +206,16 @@ def without_wall_clock(run_json):
     return text
 
 
+SUMMARY_WALL = re.compile(rb"(ballast run: .*), wall [^ ]+ s,")
+
+
+def without_summary_clock(stdout):
+    """ballast.stdout with the wall-clock time of the core's summary line masked."""
+    text, n = SUMMARY_WALL.subn(rb"\1, wall - s,", stdout)
+    assert n == (1 if stdout.startswith(b"ballast run: ") else 0), stdout   # `exact` prints none
+    return text
+
+
 def comparable(folder, root):
     """{file: content} of a run folder, wall-clock fields masked, the root replaced by '<root>'."""
     out = {}
@@ -213,10 +223,13 @@ def comparable(folder, root):
         data = path.read_bytes()
         if path.name == "run.json":
             data = without_wall_clock(data)
+        elif path.name == "ballast.stdout":
+            data = without_summary_clock(data)
         elif path.name == "harness.json":
             record = json.loads(data)
             record.pop("wall_seconds")
             record["outputs"].pop("run.json")           # its digest covers wall_seconds
+            record["outputs"].pop("ballast.stdout", None)   # ... and this the summary's wall time
             data = json.dumps(record, sort_keys=True).replace(str(root), "<root>")
         out[path.name] = data
     return out
@@ -294,11 +307,15 @@ def test_interrupted_sweep_resumes_to_the_uninterrupted_outputs(how, tmp_path, w
         time.sleep(0.05)
 
     # Nothing unfinished reads as a result: the held run is recorded as interrupted, the core
-    # said so in run.json and left no series.tsv; the run never started has no folder.
+    # said so in run.json ("complete": false) and kept only the series.tsv written so far (issue
+    # 23: an interrupted run keeps it); the run never started has no folder.
     record = harness_record(folder[HELD])
     assert not record["ok"] and record["cause"].startswith("interrupted: exit code 130")
-    assert json.loads((folder[HELD] / "run.json").read_text())["status"] == "interrupted"
-    assert not list(folder[HELD].glob("*.tsv*"))
+    held = json.loads((folder[HELD] / "run.json").read_text())
+    assert held["status"] == "interrupted" and held["complete"] is False
+    assert [p.name for p in folder[HELD].glob("*.tsv*")] == ["series.tsv"]
+    rows = (folder[HELD] / "series.tsv").read_text().splitlines()
+    assert rows[0].startswith("cycle\t") and all(r.count("\t") == rows[0].count("\t") for r in rows)
     with pytest.raises(RunProblem):
         load_run(folder[HELD])
     assert not folder[LABELS[3]].exists()

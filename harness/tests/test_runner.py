@@ -6,7 +6,7 @@ import re
 
 from harness import catalogue
 from harness.__main__ import main
-from harness.runner import Job, Progress, Outcome, command, jobs_for, run_all
+from harness.runner import LONG_BATCH, Job, Progress, Outcome, command, duration, jobs_for, rate_text, run_all
 from harness.tests.fakes import tree_snapshot
 
 
@@ -161,3 +161,69 @@ def test_the_cross_checks_run_their_scripts(project, runs):
     assert cmd[2:] == ["--out", str(job.out)]
     job.command = "peer"
     assert command(job, "bin/ballast")[1:3][1] == "--check-only"
+
+
+# ---------------------------------------------------------------- progress of long batches
+
+class Clock:
+    """A clock the test moves."""
+    def __init__(self):
+        self.now = 1000.0
+
+    def __call__(self):
+        return self.now
+
+
+def test_durations_and_rates_read_well():
+    assert [duration(s) for s in (0, 44.6, 60, 725, 3600, 12000)] == \
+        ["0 s", "45 s", "1 min 00 s", "12 min 05 s", "1 h 00 min", "3 h 20 min"]
+    assert rate_text(30, 60) == "30 runs/min" and rate_text(1, 120) == "30 runs/h"
+    assert rate_text(0, 10) == "- runs/min" and rate_text(1234, 60) == "1.23e+03 runs/min"
+
+
+def test_a_long_batch_off_a_terminal_prints_periodic_lines(tmp_path):
+    """300 realisations, one ending every 2 s: a line at the first, then one per 30 s and the last;
+    a failure at once; rate and time left in every line."""
+    jobs = [Job("c", f"e_s{i}", tmp_path, [], tmp_path, 1.0) for i in range(1, 301)]
+    clock, stream = Clock(), io.StringIO()
+    progress = Progress(jobs, stream, tty=False, clock=clock)
+    assert progress.long
+    for i, job in enumerate(jobs):
+        clock.now += 2.0
+        if i < 10:
+            progress.finished(Outcome(job, True, 0, 0.0, skipped=True))    # kept by --resume: no time
+            continue
+        failed = job.variant == "e_s100"
+        progress.finished(Outcome(job, not failed, 1 if failed else 0, 3.5, "exit code 1" if failed else ""))
+    progress.close([Outcome(j, True, 0, 1.0) for j in jobs])
+    lines = stream.getvalue().splitlines()
+    status = [l for l in lines if l.startswith("[")]
+    assert "\r" not in stream.getvalue()
+    assert status[0] == "[1/300] 0 %  - runs/min  9 min 58 s left  (1 kept)"       # printed at once
+    assert len(status) == 21       # the first (t = 2 s), one per 30 s from it (t = 32 ... 572 s), the last (600 s)
+    assert status[-1].startswith("[300/300] 100 %  ") and " 0 s left" in status[-1]
+    middle = next(l for l in status if l.startswith("[151/300]"))    # t = 302 s
+    # 141 runs ran (not the 10 kept) in 302 s: 28.0 a minute; 149 of 290 expected runs left
+    assert middle == "[151/300] 50 %  28 runs/min  5 min 19 s left  (last c/e_s151 3.50 s; 1 failed, 10 kept)"
+    assert "FAILED c/e_s100: exit code 1" in lines
+    assert lines.index("FAILED c/e_s100: exit code 1") < lines.index(middle)
+    assert lines[-1].startswith("300 runs: 300 ok, 0 failed (600.0 s, ")
+
+
+def test_a_long_batch_on_a_terminal_redraws_one_line(tmp_path):
+    jobs = [Job("c", f"e_s{i}", tmp_path, [], tmp_path, 1.0) for i in range(100)]
+    clock, stream = Clock(), io.StringIO()
+    progress = Progress(jobs, stream, tty=True, clock=clock)
+    for job in jobs[:40]:
+        clock.now += 3.0
+        progress.finished(Outcome(job, True, 0, 2.0))
+    text = stream.getvalue()
+    assert text.count("\r\x1b[K") == 40 and "\n" not in text
+    assert text.endswith("\r\x1b[K[40/100] 40 %  20 runs/min  3 min 00 s left  (last c/e_s39 2.00 s)")
+
+
+def test_a_short_batch_keeps_a_line_per_run(tmp_path):
+    jobs = [Job("c", f"v{i}", tmp_path, [], tmp_path, 1.0) for i in range(LONG_BATCH)]
+    progress = Progress(jobs, io.StringIO(), tty=False)
+    assert not progress.long
+    assert Progress(jobs + jobs[:1], io.StringIO(), tty=False).long

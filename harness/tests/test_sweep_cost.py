@@ -1,5 +1,6 @@
 """Error against cost (harness/sweep.py): [sweep] declarations, the error of a run, the
 cheapest-setting table, `harness cost` and the report section, on the fake project."""
+import re
 import os
 import shutil
 from pathlib import Path
@@ -403,7 +404,13 @@ def test_failed_points_have_no_error_and_say_why(project, capsys):
     assert main(["run", "spring"]) == 0
     assert main(["cost", "spring"]) == 0
     out = capsys.readouterr().out
-    assert "failed (unstable or no run.json; no error): blows_up x1, blows_up x2, no_output x1, no_output x2" in out
+    # Issue 23: a point past its limit is a measurement, said as one; a run without output fails
+    assert "LIMIT spring/blows_up_x2: past its stability limit" in out and "FAILED spring/blows_up" not in out
+    assert "FAILED spring/no_output_x2" in out
+    assert re.search(r"\d+ runs: \d+ ok, 2 past their stability limit \(measured, not failures\), 2 failed", out), out
+    assert "beyond the stability limit (the run-time guards stopped them; a measured limit of the trade, " \
+           "not a gate): blows_up x1, blows_up x2" in out
+    assert "no result (no usable run.json; not a gate): no_output x1, no_output x2" in out
     rows = sweep.read_tsv(project / "reports" / "sweeps" / "spring" / "cost.tsv")
     by = {(r["sweep"], r["factor"]): r for r in rows}
     blown = by[("blows_up", 2.0)]
@@ -475,3 +482,13 @@ def test_self_convergence_is_against_the_finest_swept_run(project, capsys):
 def test_validate_accepts_a_sweep_measured_by_converge_alone(project):
     add_sweeps(project, "\n[sweep s]\nvariant = stiffer\nkeys = k=1\nfactors = 2\nconverge = last(F)\n")
     assert main(["check"]) in (0, 1)                      # no declaration error (exit 2)
+
+
+def test_labels_of_coinciding_points_are_merged():
+    """Issue 23: points of one curve at (nearly) the same cost and error get one label, not three
+    printed over each other; points apart keep their own."""
+    from harness.report.cost_plot import merged_labels
+    points = [(1000.0, 1e-5, "x0.5"), (1000.0, 1.01e-5, ""), (1010.0, 1.02e-5, "x2"), (1005.0, 0.99e-5, "x4"),
+              (4000.0, 1e-5, "x0.25")]
+    assert merged_labels(points) == [(1000.0, 1e-5, "x0.5, x2, x4"), (1000.0, 1.01e-5, ""), (1010.0, 1.02e-5, ""),
+                                     (1005.0, 0.99e-5, ""), (4000.0, 1e-5, "x0.25")]

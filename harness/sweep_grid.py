@@ -1,0 +1,145 @@
+"""`harness sweep CASE --set KEY=V1,V2 [--set KEY2=W1,W2 ...]`: one variant run at every point
+of a grid of overrides, and a table of its checks with their error and the cost of each point.
+
+Several --set options combine as a GRID (every value of the first key with every value of the
+second, ...; the first key varies slowest).  A key given twice is refused, as is a value with
+'/' (it names the point's folder).  A point's label is 'KEY=V' for one key and 'KEY=V,KEY2=W'
+for several; its outputs go to reports/sweeps/<case>/<label>.
+
+A sweep over the time step (settings.dt or settings.dt_fraction) keeps the SIMULATED time of
+every stage fixed: `ballast info` of the unswept variant gives each stage's cycles and dt, and
+every point runs each stage given in cycles as `stage.NAME.time = cycles x dt` (a stage given
+in time already keeps it).  Without this a smaller step would cover a fraction of the time and
+nearly every check would fail for that reason alone.  Such a sweep also sets
+settings.force_dt = 1, as the declared error-against-cost sweeps do: a step past the stability
+estimate is a point to measure, and the run-time guards say whether it went unstable.
+
+The table has one row per check that reads the variant alone, one column per point: the value,
+its verdict and its error against the reference (|q - ref|/|ref|, |q - ref| when ref = 0; '-'
+for an interval, a trend or a value that could not be computed), and below them each point's
+cost: its status, steps, particle-steps and wall-clock seconds (run.json).  The same numbers go
+to reports/sweeps/<case>/sweep_<variant>.tsv, one row per point and check.
+"""
+import itertools
+import re
+import subprocess
+
+from . import files
+from .compare import RunStore, evaluate_all
+from .errors import CatalogueError
+from .gate import fmt_number, fmt_reference
+from .runner import Job
+from .sweep import deviation, run_cost
+
+DT_KEYS = ("settings.dt", "settings.dt_fraction")
+FORCE = "settings.force_dt=1"
+STAGE_LINE = re.compile(r"^stage\s+(\S+) (\d+) cycles (\S+) s \((time|cycles)\)$", re.M)
+DT_LINE = re.compile(r"^dt used\s+(\S+)", re.M)
+TSV_COLUMNS = ("point", "sets", "status", "steps", "particle_steps", "wall_seconds", "check", "value",
+               "reference", "error", "result")
+
+
+def parse_sets(texts):
+    """['KEY=V1,V2', ...] -> [(KEY, [V1, V2]), ...]; refuses a malformed option or a key twice."""
+    out = []
+    for text in texts:
+        key, sep, values = text.partition("=")
+        key = key.strip()
+        values = [v.strip() for v in values.split(",") if v.strip()]
+        if not sep or not key or not values or any("/" in v for v in values):
+            raise CatalogueError(f"--set needs KEY=V1,V2,... (no '/' in values), got '{text}'")
+        if key in [k for k, _ in out]:
+            raise CatalogueError(f"--set {key} given twice: give its values once, KEY=V1,V2,... "
+                                 "(several --set keys combine as a grid)")
+        out.append((key, values))
+    return out
+
+
+def grid(keyed):
+    """[(label, [KEY=V, ...])] of every combination, the first key varying slowest."""
+    points = []
+    for combo in itertools.product(*[[f"{k}={v}" for v in values] for k, values in keyed]):
+        points.append((",".join(combo), list(combo)))
+    return points
+
+
+def stages_of(binary, scene, sets):
+    """(dt, [(stage, cycles, seconds, given_in)]) from `ballast info` of the scene."""
+    cmd = [str(binary), "info", str(scene)] + [a for s in sets for a in ("--set", s)]
+    try:
+        done = subprocess.run(cmd, capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL)
+    except OSError as exc:
+        raise CatalogueError(f"cannot start {binary}: {exc.strerror}") from None
+    if done.returncode != 0:
+        raise CatalogueError(f"{' '.join(cmd)}: exit {done.returncode}: {done.stderr.strip()}")
+    dt = DT_LINE.search(done.stdout)
+    if not dt:
+        raise CatalogueError(f"cannot read 'dt used' from ballast info:\n{done.stdout}")
+    return float(dt.group(1)), [(m.group(1), int(m.group(2)), float(m.group(3)), m.group(4))
+                                for m in STAGE_LINE.finditer(done.stdout)]
+
+
+def time_keeping(binary, variant):
+    """The overrides that keep each stage's simulated time while dt is swept."""
+    dt, stages = stages_of(binary, variant.scene, variant.sets)
+    return [f"stage.{name}.time={repr(cycles * dt)}" for name, cycles, _, given in stages
+            if given == "cycles" and cycles > 0] + [FORCE]
+
+
+def jobs(case, variant, keyed, sweeps_root, binary):
+    """One runner Job per grid point (with the time-keeping overrides of a dt sweep)."""
+    extra = time_keeping(binary, variant) if any(k in DT_KEYS for k, _ in keyed) else []
+    return [Job(case.name, label, variant.scene, list(variant.sets) + extra + sets,
+                sweeps_root / case.name / label, case.runtime / max(len(case.variants), 1), variant.command,
+                probe=bool(extra))
+            for label, sets in grid(keyed)], extra
+
+
+def error_of(v):
+    """|q - ref| / |ref| of a verdict with a number for value and reference, else None."""
+    numeric = lambda x: isinstance(x, (int, float)) and not isinstance(x, bool)
+    if numeric(v.value) and numeric(v.reference):
+        return deviation(float(v.value), float(v.reference))
+    return None
+
+
+def evaluate(checks, jobs_):
+    """{label: (verdicts, cost)} of every point."""
+    out = {}
+    for job in jobs_:
+        store = RunStore(lambda c, v, folder=job.out: folder)
+        out[job.variant] = (evaluate_all(checks, store), run_cost(job.out))
+    return out
+
+
+def table(labels, checks, results):
+    """The printed table: checks by points ('value VERDICT err E'), then the cost rows."""
+    header = ["check", "reference", "tolerance"] + list(labels)
+    rows = []
+    for i, check in enumerate(checks):
+        first = results[labels[0]][0][i]
+        cells = []
+        for label in labels:
+            v = results[label][0][i]
+            err = error_of(v)
+            cells.append(f"{fmt_number(v.value)} {v.result}" + ("" if err is None else f" err {err:.2e}"))
+        rows.append([check.name, fmt_reference(first), first.tolerance] + cells)
+    for name, field in (("status", "status"), ("steps", "steps"), ("particle-steps", "particle_steps"),
+                        ("wall s", "wall_seconds")):
+        rows.append([f"({name})", "", ""] + [fmt_number(results[label][1].get(field)) for label in labels])
+    widths = [max(len(r[j]) for r in [header] + rows) for j in range(len(header))]
+    return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in [header] + rows)
+
+
+def write_tsv(path, jobs_, checks, results):
+    lines = ["\t".join(TSV_COLUMNS)]
+    for job in jobs_:
+        verdicts, cost = results[job.variant]
+        for check, v in zip(checks, verdicts):
+            err = error_of(v)
+            cells = [job.variant, " ".join(job.sets), str(cost.get("status")), fmt_number(cost.get("steps")),
+                     fmt_number(cost.get("particle_steps")), fmt_number(cost.get("wall_seconds")), check.name,
+                     fmt_number(v.value), fmt_reference(v), "-" if err is None else f"{err:.6g}", v.result]
+            lines.append("\t".join(c.replace("\t", " ") for c in cells))
+    files.make_dirs(path.parent)
+    files.write_text(path, "\n".join(lines) + "\n")

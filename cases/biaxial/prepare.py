@@ -30,6 +30,9 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from harness.families.biaxial import void_ratios_of  # noqa: E402
+
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 BANDS = 6
@@ -50,23 +53,12 @@ SPECIMENS = {
 }
 
 
-def segment_below(y, yc, r):
-    """Area of the discs (centres yc, radii r) below the line y."""
-    h = np.clip(y - (yc - r), 0.0, 2 * r)
-    return r * r * np.arccos(np.clip((r - h) / r, -1, 1)) - (r - h) * np.sqrt(np.maximum(2 * r * h - h * h, 0))
-
-
-def void_profile(x, y, r, box, bands=BANDS):
-    """(e of the whole specimen, [e of each band from the bottom up]) inside box (xl, xr, yb, yt)."""
-    xl, xr, yb, yt = box
-    solid = math.pi * float(np.sum(r * r))
-    e = ((xr - xl) * (yt - yb) - solid) / solid
-    edges = np.linspace(yb, yt, bands + 1)
-    out = []
-    for lo, hi in zip(edges[:-1], edges[1:]):
-        s = float(np.sum(segment_below(hi, y, r) - segment_below(lo, y, r)))
-        out.append(((xr - xl) * (hi - lo) - s) / s)
-    return e, out
+def void_profile(y, r, box, bands=BANDS):
+    """(e of the whole specimen, [e of each band from the bottom up]) inside box (xl, xr, yb, yt):
+    the harness's own function (harness/families/biaxial.py), so the report and the checks
+    compute the same numbers."""
+    e, per = void_ratios_of(y, r, box, bands)
+    return e, list(per)
 
 
 def read_tsv(path):
@@ -95,7 +87,7 @@ def prepare(name, seed, mu, delta):
     walls = {row[0]: [float(row[i]) for i in widx[1:]] for row in wrows}
     box = (walls["spec_left"][0], walls["spec_right"][0], walls["spec_bottom"][1], walls["spec_top"][1])
     x, y, r = (np.array([float(row[dn.index(k)]) for row in drows]) for k in ("x", "y", "r"))
-    e, prof = void_profile(x, y, r, box)
+    e, prof = void_profile(y, r, box)
     stage = info["stages"][0]
     text = (f"specimen {name}: [grains] seed {seed}, mu_prep {mu}, delta_prep {delta}, prepare.scene (cycles {stage['cycles']}, "
             f"stopped {stage['stopped']}, servo error {stage['servo_error']:.3g}, unbalanced {stage['unbalanced']:.3g})\n"

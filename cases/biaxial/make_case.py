@@ -139,9 +139,19 @@ stability = no
 """]
     for spec in SPECIMENS:
         parts.append(specimen_variant(f"specimen_{spec}", spec))
-    for mat in MATERIALS:
+    # the order is the order they run in: JYH Fig. 11's materials and delta = 1.6 first, then
+    # the halved rates (the longest runs), the other specimens, the density study, then the
+    # other deltas (0.8, 1.2 before the rest), so an interrupted full tier has the essentials
+    first = FIG11
+    rest = [m for m in MATERIALS if m not in FIG11]
+    rest = [m for m in rest if m in ("m1_d0.8", "m1_d1.2")] + [m for m in rest if m not in ("m1_d0.8", "m1_d1.2")]
+    for mat in first:
         for kpa in STRESSES:
             parts.append(variant(f"{mat}_s{kpa}", mat, kpa))
+    for mat in ("m0", "m1_d1.6"):
+        parts.append(variant(f"{mat}_s200_half", mat, 200, cycles=2 * FULL_CYCLES,
+                             extra=[f"stage.shear.strain_rate=spec_top {RATE / 2} spec_bottom"],
+                             comment="half the strain rate (0.25 /s), twice the cycles: the same strain"))
     for seed in SEEDS:
         for mat in ("m0", "m1_d1.6"):
             for kpa in STRESSES:
@@ -155,10 +165,9 @@ stability = no
         for mat in ("m0", "m1_d1.6"):
             parts.append(variant(f"{mat}_s200_{dens}", mat, 200, specimen=f"{dens}_r1",
                                  comment=f"density study: specimen {dens}_r1"))
-    for mat in ("m0", "m1_d1.6"):
-        parts.append(variant(f"{mat}_s200_half", mat, 200, cycles=2 * FULL_CYCLES,
-                             extra=[f"stage.shear.strain_rate=spec_top {RATE / 2} spec_bottom"],
-                             comment="half the strain rate (0.25 /s), twice the cycles: the same strain"))
+    for mat in rest:
+        for kpa in STRESSES:
+            parts.append(variant(f"{mat}_s{kpa}", mat, kpa))
     parts.append(fig11("full", [f"{m}_s200" for m in FIG11]))
     lo, hi = WINDOW["full"]
     parts.append("\n".join([

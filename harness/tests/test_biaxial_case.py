@@ -81,3 +81,20 @@ def test_committed_specimen_matches_its_statement(name):
     assert f"range {per.min():.4f} to {per.max():.4f}" in text
     if name.startswith("e025"):
         assert abs(e - 0.25) <= 0.01          # the recipe (mu_prep 0.4) on every seed; seed 1 within 0.005
+
+
+@pytest.mark.parametrize("name", ["e025_r1", "e025_r2", "e025_r3"])
+def test_committed_specimen_grading(name):
+    """JYH Sec. 5.1's grading, by area, of the 1008 discs of each seed: 6 to 9 mm, d50 = 7.6 mm,
+    C_u = d60/d10 = 1.3.  A sample of 1008 discs holds the curve only to its sampling error: the
+    share of the area below d50 scatters by about sqrt(0.25/1008) = 0.016, which on the curve's
+    slope between d50 and d60 (0.1 per 0.72 mm) is 0.11 mm; d60 the same, d10 0.04 mm, so C_u
+    scatters by about 0.017.  Bounds: d50 within 0.25 mm, C_u within 0.06 (2.3 and 3.5 of those);
+    measured d50 7.60, 7.48, 7.65 mm and C_u 1.30, 1.26, 1.28."""
+    dn, discs = read(CASE / "specimens" / name / "discs.tsv")
+    d = np.sort(2 * np.array([float(row[dn.index("r")]) for row in discs]))
+    share = np.cumsum(d * d) / np.sum(d * d)
+    d10, d50, d60 = (float(np.interp(q, share, d)) for q in (0.1, 0.5, 0.6))
+    assert 0.006 <= d[0] and d[-1] <= 0.009
+    assert abs(d50 - 0.0076) <= 0.00025
+    assert abs(d60 / d10 - 1.3) <= 0.06

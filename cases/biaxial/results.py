@@ -58,7 +58,7 @@ def main():
             dense = f"{f(dp)} / {f(dr)}"
         print(f"| {m} | {'%.1f / %.1f' % paper if paper else ''} | {f(p)} / {f(r)} | {f(c)} | {spread} | {dense} |")
     print()
-    print("| test | phi peak (rows=5) | phi residual | residual_drift | eps_a at peak | dilation | max(abs(sigma_h/target-1)) |")
+    print("| test | phi peak (rows=5) | phi residual | residual_drift(0.20, 0.30) | eps_a at peak | dilation | max(abs(sigma_h/target-1)) |")
     print("|---|---|---|---|---|---|---|")
     for m in ("m0", "m2_d0.4", "m1_d0.4", "m1_d1.6"):
         for s in (100, 200, 400):

@@ -27,7 +27,9 @@ BIAXIAL = {"spread", "sigma_v", "sigma_h", "mean_stress", "deviator", "phi", "ax
            "volumetric_strain", "shear_start", "phi_peak", "peak_cycle", "at_peak", "phi_residual",
            "window_mean", "residual_drift", "dilation", "phi_envelope", "cohesion_envelope", "setting"}
 ENSEMBLES = {"members", "seeds", "realisations", "over"}   # issue 22: over an [ensemble]'s realisations
-NAMES = NAMES_BEFORE | NAMES_ADDED | BIAXIAL | ENSEMBLES
+# issue 21's case: the planar void ratio of a specimen and its profile over height (biaxial)
+VOID_RATIO = {"void_ratio", "void_ratios", "band_heights", "initial_void_ratio"}
+NAMES = NAMES_BEFORE | NAMES_ADDED | BIAXIAL | ENSEMBLES | VOID_RATIO
 
 
 def _run(**columns):

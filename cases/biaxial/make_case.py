@@ -89,8 +89,8 @@ def curves(name, title, variants, y, ylabel, lo_hi=None):
 
 def profile(name, title, variants):
     return "\n".join([f"[figure {name}]", "kind = curves", f"title = {title}", f"variants = {' '.join(variants)}",
-                      "x = void_ratios(6)", "y = band_heights(6)", "xlabel = planar void ratio of the band",
-                      "ylabel = height of the band's middle / specimen height",
+                      "x = void_ratios(6)", "y = band_heights(6)", "xlabel = planar void ratio of the band (-)",
+                      "ylabel = height of the band's middle / specimen height (-)",
                       '''paper = "The multi-layer undercompaction technique ... was used to prepare a type of medium-dense specimen with planar void ratio 0.25." (JYH 2005, Sec. 5.1)''']) + "\n"
 
 
@@ -192,7 +192,7 @@ stability = no
         "paper_point = 0 24.4 JYH peak", "paper_point = 0.4 29.0 JYH peak", "paper_point = 1.6 42.3 JYH peak",
         "paper_point = 0 19.3 JYH residual", "paper_point = 0.4 23.0 JYH residual", "paper_point = 1.6 35.8 JYH residual",
         "paper_point = 0.4 26.5 JYH Model 2 peak", "paper_point = 0.4 20.7 JYH Model 2 residual",
-        "xlabel = delta", "ylabel = phi (degrees)", "yrange = 0:50", f"paper = {PAPER_FIG13}"]) + "\n")
+        "xlabel = shape parameter delta (-)", "ylabel = phi (degrees)", "yrange = 0:50", f"paper = {PAPER_FIG13}"]) + "\n")
     dense = [f"{m}_s100_e020" for m in ("m0", "m1_d0.4", "m1_d1.6")]
     parts.append("\n".join([
         "[figure fig13_e020]", "kind = errorbars",
@@ -202,13 +202,13 @@ stability = no
         f"y = ballast residual; phi_envelope('residual', '_s100', '_s200', '_s400', lo={lo}, hi={hi})",
         "paper_point = 0 24.4 JYH peak", "paper_point = 0.4 29.0 JYH peak", "paper_point = 1.6 42.3 JYH peak",
         "paper_point = 0 19.3 JYH residual", "paper_point = 0.4 23.0 JYH residual", "paper_point = 1.6 35.8 JYH residual",
-        "xlabel = delta", "ylabel = phi (degrees)", "yrange = 0:50"]) + "\n")
+        "xlabel = shape parameter delta (-)", "ylabel = phi (degrees)", "yrange = 0:50"]) + "\n")
     study = [f"{m}_s200{sfx}" for m in ("m0", "m1_d1.6") for sfx in ("_e020", "_e023", "", "_e030")]
     parts.append("\n".join([
         "[figure density]", "kind = points",
         "title = Density study at 200 kPa: peak phi against the void ratio at the start of shearing (delta = 0, then 1.6)",
         f"variants = {' '.join(study)}", "x = initial_void_ratio()", "y = phi_peak(rows=5)",
-        "xlabel = planar void ratio at the start of shearing", "ylabel = peak phi (degrees)"]) + "\n")
+        "xlabel = planar void ratio at the start of shearing (-)", "ylabel = peak phi (degrees)"]) + "\n")
     parts.append(profile("void_profiles", "Planar void ratio of 6 horizontal bands of each prepared specimen",
                          [f"specimen_{s}" for s in SPECIMENS]))
     return "\n".join(parts)

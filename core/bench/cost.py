@@ -155,11 +155,11 @@ def machine(cpu, repeats):
                          capture_output=True, text=True, check=True)
     m = {}
     for line in res.stdout.splitlines():
-        kv = dict(re.findall(r"(\w+)=([-+0-9.eEnaif]+)", line))
+        kv = dict(re.findall(r"(\w+)=(\S+)", line))
         words = line.split()
         key = words[1] if "=" not in words[1] else "clock"
-        if key == "triad":
-            key = "triad_" + kv.pop("level")
+        if key in ("triad", "triad256"):
+            key = key + "_" + kv.pop("level")
         m[key] = {k: float(v) for k, v in kv.items()}
     m["raw"] = res.stdout
     return m
@@ -192,6 +192,68 @@ def fmt(x, digits=3):
     return f"{x:.{digits}g}"
 
 
+# Floating-point operations of the pair loop of these scenes (loop_pow_s, contacts.c and
+# laws.h, counted from the C source; -ffp-contract=off and no -ffast-math keep every one):
+#   every candidate pair: dx, dy, r_i + r_j, dx^2 + dy^2, (r_i + r_j)^2        7
+#   every contact: sqrt 1, e = d/D 2 div, v_i - v_j 2, delta 1, F_n = k_n delta 1,
+#     s-dot 7, F_s += k_s s-dot dt 3, F_n tan(phi) + c 2, moments 2, force
+#     components 6, the four force and two moment sums 6                    33
+#   a sliding contact, more: the friction loss f_max (|F_s| - f_max) / k_s   4 (1 div)
+# (n-dot is not computed: with the power law and no dashpot nothing reads it.)
+FLOPS_PAIR, FLOPS_CONTACT, FLOPS_SLIDE = 7, 33, 4
+# the position and velocity passes (centred, undamped): 3 mul + 3 add and the
+# displacement since the last rebuild (2 sub, 2 mul, 1 add); 3 x (f m^-1 dt + g dt) + v
+FLOPS_POSITIONS, FLOPS_VELOCITIES = 11, 11
+
+
+def floors(result, mach, clock):
+    """The floor per phase and particle-step, in cycles, from the counts and the
+    machine: compute (AVX2 code at the measured peak rates; and today's scalar
+    code) and data movement (the bytes from beyond each cache level at the
+    measured vector-triad bandwidth of the level below)."""
+    ghz = clock / 1e9
+    bpc = {lvl: mach[f"triad256_{lvl}"]["gbs"] / ghz for lvl in ("L2", "L3", "memory")}
+    sq, dv = mach["sqrt"]["ns"] * ghz, mach["div"]["ns"] * ghz
+    sq4, dv4 = mach["sqrt256"]["ns"] * ghz, mach["div256"]["ns"] * ghz
+    out = [f"Floor (cycles per particle-step at {ghz:.3f} GHz; bandwidths of the AVX2 triad: "
+           f"L2 {bpc['L2']:.1f}, L3 {bpc['L3']:.1f}, memory {bpc['memory']:.1f} bytes/cycle; "
+           f"sqrt {sq:.1f} and division {dv:.1f} cycles scalar, {sq4:.2f} and {dv4:.2f} per "
+           f"element with AVX2; peak {mach['fma256']['flops_per_cycle']:.1f} flops/cycle "
+           f"AVX2 FMA, {mach['scalar']['flops_per_cycle']:.1f} scalar):", "",
+           "| scene | phase | flops | compute floor, AVX2 [scalar] | data floor | floor "
+           "| measured | measured / floor |", "|---|---|---|---|---|---|---|---|"]
+    for name, sc in result["scenes"].items():
+        c = sc["count"]
+        P, C, S = c["pairs_per_disc"], c["contacts_per_disc"], c["sliding_per_disc"]
+        tot_floor = 0
+        for phase, ph in sc["phases"].items():
+            if phase == "total":
+                continue
+            data = max(ph["D1_bytes"] / bpc["L2"], ph["L2_bytes"] / bpc["L3"]) + \
+                ph["L3_bytes"] / bpc["memory"]
+            flops, comp, comp_s = 0, 0, 0
+            if phase == "contacts":
+                flops = FLOPS_PAIR * P + FLOPS_CONTACT * C + FLOPS_SLIDE * S
+                other = flops - C - (2 * C + S)
+                comp = max(other / 16, C * sq4 + (2 * C + S) * dv4)
+                comp_s = max(other / 4, C * sq + (2 * C + S) * dv)
+            elif phase in ("positions", "velocities"):
+                flops = FLOPS_POSITIONS if phase == "positions" else FLOPS_VELOCITIES
+                comp, comp_s = flops / 16, flops / 4
+            floor = max(comp, data)
+            tot_floor += floor
+            ph["floor"] = {"flops": flops, "compute_avx2": comp, "compute_scalar": comp_s,
+                           "data": data, "floor": floor}
+            out.append(f"| {name} | {phase} | {fmt(flops)} | {fmt(comp)} [{fmt(comp_s)}] | "
+                       f"{fmt(data)} | {fmt(floor)} | {fmt(ph['cycles_median'])} | "
+                       f"{ph['cycles_median'] / floor:.1f} |" if floor > 0 else
+                       f"| {name} | {phase} | - | - | - | - | {fmt(ph['cycles_median'])} | - |")
+        m = sc["phases"]["total"]["cycles_median"]
+        sc["floor_total"] = tot_floor
+        out.append(f"| {name} | total | | | | {fmt(tot_floor)} | {fmt(m)} | {m / tot_floor:.1f} |")
+    return "\n".join(out)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--repeats", type=int, default=5, help="timed runs of each scene")
@@ -200,26 +262,28 @@ def main(argv=None):
                     help="reuse build/cost's scenes and callgrind outputs when present")
     a = ap.parse_args(argv)
     stamp = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
-    load0 = open("/proc/loadavg").read().split()[:3]
     scenes = make_scenes(a.reuse)
 
     # 1. counts (all four callgrind runs at once: they are counts, not times)
     procs = {}
     for name, scene in scenes.items():
         for ll in LLS:
-            cg = OUT / f"{name}-{ll}.callgrind"
-            if a.reuse and cg.exists() and (OUT / f"{name}-{ll}.count").exists():
-                procs[(name, ll)] = (None, cg, OUT / f"{name}-{ll}.count")
+            cg, count = OUT / f"{name}-{ll}.callgrind", OUT / f"{name}-{ll}.count"
+            if a.reuse and cg.exists() and count.exists() and "bench cost" in count.read_text():
+                procs[(name, ll)] = (None, cg, count)
             else:
                 procs[(name, ll)] = callgrind(scene, name, ll)
-    # 2., 3. while they run (they share the cores: hence the pinning and the medians)
-    mach = machine(a.cpu, 15)
-    print(mach["raw"], end="", flush=True)
-    runs = native(scenes, a.cpu, a.repeats)
-    mach2 = machine(a.cpu, 15)     # again after the timed runs: the clock seen then
     for key, (p, cg, count) in procs.items():
         if p is not None and p.wait() != 0:
             sys.exit(f"cost: callgrind failed for {key}: see {count}.log")
+    # 2., 3. then the times, pinned (the other users of the machine stay: hence the
+    # medians and ranges); the machine before and after the timed runs
+    load0 = open("/proc/loadavg").read().split()[:3]
+    mach = machine(a.cpu, 15)
+    print(mach["raw"], end="", flush=True)
+    runs = native(scenes, a.cpu, a.repeats)
+    mach2 = machine(a.cpu, 15)
+    print(mach2["raw"], end="", flush=True)
     load1 = open("/proc/loadavg").read().split()[:3]
 
     clock = max(mach["clock"]["clock_ghz"], mach2["clock"]["clock_ghz"]) * 1e9
@@ -237,6 +301,17 @@ def main(argv=None):
         r = runs[name]
         n_disc = info["N"]
         scene_res = {"count": info, "loops": loops, "runs": r, "phases": {}}
+        # The windows hold a sample of the rebuilds: the neighbour phase is
+        # scaled to the run's own rate (its cost per rebuild x rebuilds per cycle
+        # of the whole run), and the total is the sum of the phases.
+        scale = 1.0
+        if info["counted_rebuilds"] > 0:
+            scale = (info["rebuilds"] / info["steps"]) / (info["counted_rebuilds"] / info["counted_steps"])
+        for ll in LLS:
+            counts[ll]["neighbours"] = [v * scale for v in counts[ll]["neighbours"]]
+            counts[ll]["total"] = [sum(counts[ll][p][e] for p in list(PHASES) + ["outputs"])
+                                   for e in range(len(EVENTS))]
+        scene_res["neighbour_scale"] = scale
         for phase in list(PHASES) + ["outputs", "total"]:
             c3, c2 = counts["L3"][phase], counts["L2"][phase]
             ev = dict(zip(EVENTS, c3))
@@ -261,7 +336,8 @@ def main(argv=None):
     lines = [f"Measured {stamp} on this machine (load average {' '.join(load0)} before, "
              f"{' '.join(load1)} after); clock {clock / 1e9:.3f} GHz (measured, best of 15); "
              f"callgrind on {PERIOD // 1 and STEPS // PERIOD} windows of {WINDOW} cycles "
-             f"(every {PERIOD}) of the {STEPS}; times: {a.repeats} pinned repeats of bin/ballast.",
+             f"(every {PERIOD}) of the {STEPS}, the neighbour phase scaled to the run's rebuild rate; "
+             f"times: {a.repeats} pinned repeats of bin/ballast.",
              "",
              "| scene | phase | instructions | data reads | data writes | L1d-miss bytes "
              "| L2-miss bytes | L3-miss bytes | cycles, median [range] |",
@@ -280,8 +356,9 @@ def main(argv=None):
                      f"{int(c['counted_rebuilds'])} rebuilds in {int(c['counted_steps'])} counted "
                      f"cycles ({int(c['rebuilds'])} in all {int(c['steps'])}); timed: "
                      f"{s['rate_median']:.4g} particle-steps/s [{s['rate_min']:.4g}–"
-                     f"{s['rate_max']:.4g}], rebuilds per run "
+                     f"{s['rate_max']:.4g}], neighbour scale {s['neighbour_scale']:.3f}, rebuilds per run "
                      f"{sorted(set(x['rebuilds'] for x in s['runs']))}; pair loop {s['loops']}")
+    lines += ["", floors(result, mach, clock)]
     text = "\n".join(lines) + "\n"
     print(text)
     (OUT / "cost.md").write_text(text + "\n```\n" + mach["raw"] + mach2["raw"] + "```\n")

@@ -335,7 +335,7 @@ def main(argv=None):
 
     lines = [f"Measured {stamp} on this machine (load average {' '.join(load0)} before, "
              f"{' '.join(load1)} after); clock {clock / 1e9:.3f} GHz (measured, best of 15); "
-             f"callgrind on {PERIOD // 1 and STEPS // PERIOD} windows of {WINDOW} cycles "
+             f"callgrind on {STEPS // PERIOD} windows of {WINDOW} cycles "
              f"(every {PERIOD}) of the {STEPS}, the neighbour phase scaled to the run's rebuild rate; "
              f"times: {a.repeats} pinned repeats of bin/ballast.",
              "",

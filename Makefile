@@ -10,6 +10,7 @@
 #   make bench-peer   ballast against LAMMPS on the same physics (cross-check, then the race)
 #   make bench-flat   the 1 000 000- against the 20 000-disc rate, alternating in one process
 #   make bench-threads  2 OpenMP threads against 1 on the settled packing (20 000, 320 000 discs)
+#   make bench-cost   the cost model: per phase and particle-step, counts, bytes, cycles; the machine
 #   make clean
 
 # ---- settings -------------------------------------------------------------
@@ -34,7 +35,7 @@ TEST_SRC := $(wildcard core/tests/check_*.c)
 BENCH_SRC := core/bench/bench.c
 
 .PHONY: all deps test test-c test-prefix test-py test-sanitize test-browser validate bench bench-scaling \
-        bench-peer bench-modules bench-modules-count bench-scaling-count bench-flat bench-threads bench-piles-poly \
+        bench-peer bench-modules bench-modules-count bench-scaling-count bench-flat bench-threads bench-cost bench-piles-poly \
         clean keys sweep \
         test-valgrind test-slurm
 
@@ -239,6 +240,16 @@ bench-scaling-count: deps $(BUILD)/bench $(foreach n,$(SCALING_COUNT_N),$(BUILD)
 	    awk -v n=$$n '{ ps = n * 20; printf "%d %.1f %.2f %.2f %.3f %.3f\n", n, $$1 / ps, \
 	      $$5 / ps, $$6 / ps, $$8 / ps, $$9 / ps }'; \
 	done
+
+# The cost model of issue 24 (docs/benchmarks.md, "Cost model"): for the two scenes of
+# bench-peer, per phase and particle-step, instructions, data accesses and simulated misses
+# (callgrind, sampled windows), cycles from the phase timers of pinned runs, and what one
+# core can do (clock, peak flops, triad bandwidth).  About 15 minutes on the shared VM.
+$(BUILD)/cost_machine: core/bench/cost_machine.c | $(BUILD)
+	$(CC) -std=c11 -O2 -fno-tree-vectorize -Wall -Wextra -D_POSIX_C_SOURCE=200809L -o $@ $< -lm
+
+bench-cost: deps bin/ballast $(BUILD)/bench $(BUILD)/cost_machine
+	$(PYTHON) core/bench/cost.py
 
 keys: bin/ballast
 	bin/ballast keys

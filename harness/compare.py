@@ -38,11 +38,13 @@ class Verdict:
     passed: bool
     message: str
     skipped: bool = False  # SKIP: its run could not be made (passed is False, message says why)
+    known: str = ""        # KNOWN: outside its tolerance, as reference/ says it is (the reason)
 
     @property
     def result(self):
-        """PASS, FAIL or SKIP."""
-        return "SKIP" if self.skipped else "PASS" if self.passed else "FAIL"
+        """PASS, FAIL, SKIP or KNOWN (a documented discrepancy with a paper: neither passes nor
+        fails the gate, and is shown with its reason)."""
+        return "SKIP" if self.skipped else "KNOWN" if self.known else "PASS" if self.passed else "FAIL"
 
     def as_dict(self):
         """The summary.json record (keys as in the spec; non-finite numbers as null); a
@@ -54,13 +56,15 @@ class Verdict:
                "message": self.message}
         if self.skipped:
             out["skip"] = True
+        if self.known:
+            out["known"] = self.known
         return out
 
     @classmethod
     def from_dict(cls, d):
         return cls(d["case"], d["variant"], d["check"], d["quantity"], d["value"], d["reference"],
                    d["tolerance"], d["kind"], d["provenance"], d["pass"], d["message"],
-                   bool(d.get("skip", False)))
+                   bool(d.get("skip", False)), d.get("known", ""))
 
 
 def _json_number(x):
@@ -298,10 +302,18 @@ def evaluate_check(check, store):
         value, passed, message, skipped = None, False, str(exc), True
     except (RunProblem, EvalError) as exc:
         value, passed, message = None, False, str(exc)
+    known = ""
+    if check.known and value is not None and not skipped:
+        if passed:      # strict: a discrepancy that went away must leave reference/ and the docs
+            passed, message = False, (f"listed as a known discrepancy ({check.known}) but within its tolerance "
+                                      "now: remove 'known' from the check and update the docs")
+        else:
+            known = check.known
+            message = f"known discrepancy: {check.known}" + (f" ({message})" if message else "")
     return Verdict(case=check.case, variant=check.variant_label, check=check.name,
                    quantity=quantity_text(check), value=value, reference=reference_of(check),
                    tolerance=check.tolerance_text, kind=check.kind, provenance=check.provenance,
-                   passed=bool(passed), message=message, skipped=skipped)
+                   passed=bool(passed), message=message, skipped=skipped, known=known)
 
 
 def evaluate_all(checks, store):

@@ -21,7 +21,7 @@ from .ini import parse_file
 KINDS = ("analytic", "exact", "paper", "regression")
 TRENDS = ("increasing", "decreasing", "nondecreasing", "nonincreasing")
 KEYS = {"case", "variant", "quantity", "value", "tolerance", "kind", "provenance",
-        "lo", "hi", "variants", "other", "other_variant"}
+        "lo", "hi", "variants", "other", "other_variant", "known"}
 
 
 @dataclass
@@ -45,6 +45,7 @@ class Check:
     path: str = ""
     line: int = 0
     value_line: int = 0      # line of 'value = ...' (0 when absent); rebaseline rewrites it
+    known: str = ""          # a KNOWN DISCREPANCY with a paper: why ballast differs (kind paper only)
 
     @property
     def run_variants(self):
@@ -97,6 +98,14 @@ def _check(section):
                   variant=section.get("variant", ""), value=section.number("value"),
                   path=section.path, line=section.line, value_line=value.line if value else 0)
     _tolerance(check, section)
+    known = section.entry("known")
+    if known is not None:
+        if kind != "paper":
+            raise section.error("'known = REASON' (a known discrepancy) is for kind = paper only: ballast's "
+                                "own solutions and baselines must agree", known.line)
+        if not known.value.strip():
+            raise section.error("'known' needs the reason ballast differs, or where it is discussed", known.line)
+        check.known = known.value.strip()
     return check
 
 

@@ -37,6 +37,9 @@
  *                                         of STEPS cycles, bracketed for callgrind)
  *        bench --modules-summary CG_NORMAL COUNT_NORMAL CG_BARE COUNT_BARE WALL
  *                                        (what `make bench-modules-count` prints)
+ *        bench --cost SCENE PERIOD WINDOW  (any scene file on one thread, the
+ *                                         last WINDOW cycles of every PERIOD
+ *                                         bracketed for callgrind: make bench-cost)
  */
 #include <math.h>
 #include <stdio.h>
@@ -48,6 +51,7 @@
 #include <unistd.h>
 
 #include "ballast.h"
+#include "energy.h"
 #include "state.h"
 
 #define REPEATS 5
@@ -767,6 +771,89 @@ static int modules_step(const char *path, const char *pack, long steps, int repe
     return rc;
 }
 
+/* ------------------------------------------------------------------ */
+/* The cost model: `make bench-cost` (core/bench/cost.py)                */
+/* ------------------------------------------------------------------ */
+
+/* Any scene file (the race scenes of harness/peer/race.py), run through its
+ * stages on one thread as bal_sim_run does (with its energy guard every
+ * 256 cycles; a scene of the race writes one series row, at its end, which
+ * is left out), with callgrind collecting only windows of the run: the last
+ * `window` cycles of every `period`, after COST_WARM instrumented cycles
+ * that fill the simulated caches.  The windows sample a run whose cost
+ * changes as it goes (the settling packing); the rest runs uninstrumented.
+ * One line:
+ *   bench cost N= steps= counted_steps= particle_steps= rebuilds=
+ *       counted_rebuilds= counted_reorders= pairs_per_disc= contacts_per_disc=
+ *       wall_contacts_per_disc= sliding_per_disc=
+ * (particle_steps = N x counted_steps; the per-disc figures are means over
+ * the end of each window). */
+#define COST_WARM 3
+#define COST_GUARD_EVERY 256 /* ENERGY_CHECK_EVERY of sim.c */
+
+static int cost_run(const char *path, long period, long window)
+{
+    if (period < window + COST_WARM || window < 1) {
+        fprintf(stderr, "bench: --cost: period >= window + %d, window >= 1\n", COST_WARM);
+        return 2;
+    }
+    struct bal_scene sc;
+    struct bal_sim *sim = NULL;
+    struct bal_error err = {0};
+    bal_scene_default(&sc);
+    int rc = bal_scene_load(&sc, path, &err) != BAL_OK || bal_sim_create(&sim, &sc, &err) != BAL_OK ||
+             bal_sim_set_threads(sim, 1, &err) != BAL_OK;
+    long step = 0, counted = 0, rebuilds = 0, reorders = 0, rb0 = 0, ro0 = 0, samples = 0;
+    double pairs = 0, contacts = 0, walls = 0, sliding = 0;
+    for (int g = 0; rc == 0 && g < sc.n_stages; g++) {
+        bal_sim_set_stage(sim, g);
+        for (long c = 0; rc == 0 && c < sc.stages[g].cycles; c++, step++) {
+            const long ph = step % period;
+            if (ph == period - window - COST_WARM)
+                CALLGRIND_START_INSTRUMENTATION;
+            if (ph == period - window) {
+                CALLGRIND_TOGGLE_COLLECT;
+                rb0 = sim->rebuilds, ro0 = sim->reorders;
+            }
+            rc = bal_sim_step(sim, &err) != BAL_OK;
+            if (rc == 0 && sim->step % COST_GUARD_EVERY == 0)
+                rc = bal_energy_guard(sim, &err) != BAL_OK;
+            if (ph == period - 1) {
+                CALLGRIND_TOGGLE_COLLECT;
+                CALLGRIND_STOP_INSTRUMENTATION;
+                counted += window;
+                rebuilds += sim->rebuilds - rb0;
+                reorders += sim->reorders - ro0;
+                long w = 0, sl = 0;
+                for (long q = 0; q < sim->pw.n; q++)
+                    w += (sim->pw.flags[q] & BAL_PAIR_TOUCHING) != 0;
+                for (long q = 0; q < sim->pp.n; q++)
+                    sl += (sim->pp.flags[q] & BAL_PAIR_SLIDING) != 0;
+                pairs += (double)sim->pp.n / sim->n;
+                contacts += (double)count_contacts(sim) / sim->n;
+                walls += (double)w / sim->n;
+                sliding += (double)sl / sim->n;
+                samples++;
+            }
+        }
+    }
+    if (rc) {
+        fprintf(stderr, "bench: %s\n", err.msg);
+    } else if (samples == 0) {
+        fprintf(stderr, "bench: --cost: %s: no window of %ld cycles in %ld\n", path, period, step);
+        rc = 1;
+    } else {
+        printf("bench cost N=%d steps=%ld counted_steps=%ld particle_steps=%.0f rebuilds=%ld "
+               "counted_rebuilds=%ld counted_reorders=%ld pairs_per_disc=%.4f "
+               "contacts_per_disc=%.4f wall_contacts_per_disc=%.5f sliding_per_disc=%.4f\n",
+               sim->n, step, counted, (double)counted * sim->n, sim->rebuilds, rebuilds, reorders,
+               pairs / samples, contacts / samples, walls / samples, sliding / samples);
+    }
+    bal_sim_free(sim);
+    bal_scene_free(&sc);
+    return rc;
+}
+
 /* One `bench count` line, parsed. */
 struct count_line {
     char build[16];
@@ -1010,6 +1097,8 @@ int main(int argc, char **argv)
         return scaling_pair(argv[2], atol(argv[3]), atol(argv[4]), argc == 6 ? atoi(argv[5]) : 9);
     if (strcmp(argv[1], "--threads") == 0 && (argc == 5 || argc == 6))
         return threads_bench(argv[2], atol(argv[3]), atoi(argv[4]), argc == 6 ? atoi(argv[5]) : 9);
+    if (strcmp(argv[1], "--cost") == 0 && argc == 5)
+        return cost_run(argv[2], atol(argv[3]), atol(argv[4]));
     if (strcmp(argv[1], "--modules-summary") == 0 && argc == 7)
         return modules_summary(argv + 2);
     if (strcmp(argv[1], "--settling") == 0 && argc >= 3) {

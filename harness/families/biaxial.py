@@ -63,6 +63,18 @@ The expression functions (every one takes start=None as above; the arrays are th
     cohesion_envelope(kind, v1, v2, ..., lo=None, hi=None, rows=1)
     setting(key)                           the number a --set KEY=VALUE of this run gave key
 
+The specimen's density, from the final state (discs.tsv) inside the walls of the last row of
+series.tsv: the planar void ratio e = (W H - A_s) / A_s with A_s = pi sum r^2 (the overlaps of
+a packing under load, ~1e-3 of a diameter, are not subtracted), W and H between the walls'
+lines; and its profile over height, the same ratio in `bands` horizontal bands of equal
+height, each disc's area clipped to the band exactly (circular segments):
+
+    void_ratio()                           e of the whole specimen
+    initial_void_ratio(start=None)         e with the walls of the shearing's reference row (the
+                                           consolidated state; the disc areas do not change)
+    void_ratios(bands=6)                   e of each band, bottom to top (an array)
+    band_heights(bands=6)                  the bands' mid-heights over H, 0 to 1 (an array)
+
 Anything missing or unusable (a column, the stage, too few rows, a window outside the data, an
 envelope through variants that cannot make one) raises EvalError, so a check FAILs with it.
 """
@@ -74,6 +86,7 @@ import numpy as np
 
 from ..errors import EvalError
 from ..expressions import register, sibling_run
+from ..final_state import state
 
 COLUMNS = ("fy_top", "fy_bottom", "fx_left", "fx_right", "y_top", "y_bottom", "x_left", "x_right")
 SHEAR_STAGE = "shear"         # the stage whose start is the reference row, unless start= says
@@ -307,9 +320,37 @@ def setting_of(info, key):
 
 # ---------------------------------------------------------------- the expression functions
 
+# ---------------------------------------------------------------- the void ratio
+
+def segment_below(y, yc, r):
+    """The area of each disc (centre height yc, radius r) below the line at height y."""
+    h = np.clip(y - (yc - r), 0.0, 2 * r)
+    return r * r * np.arccos(np.clip((r - h) / r, -1.0, 1.0)) - (r - h) * np.sqrt(np.maximum(2 * r * h - h * h, 0.0))
+
+
+def void_ratios_of(yc, r, box, bands):
+    """(e of the box, [e per band, bottom to top]) of discs (yc, r) in box (x_left, x_right,
+    y_bottom, y_top)."""
+    xl, xr, yb, yt = box
+    if not (xr > xl and yt > yb):
+        raise EvalError(f"void ratio: the walls enclose no area (x {xl:g} to {xr:g}, y {yb:g} to {yt:g})")
+    solid = math.pi * float(np.sum(r * r))
+    if not solid > 0:
+        raise EvalError("void ratio: no disc area")
+    edges = np.linspace(yb, yt, bands + 1)
+    per = []
+    for lo, hi in zip(edges[:-1], edges[1:]):
+        s = float(np.sum(segment_below(hi, yc, r) - segment_below(lo, yc, r)))
+        if not s > 0:
+            raise EvalError(f"void ratio: band {lo:g} to {hi:g} holds no disc")
+        per.append(((xr - xl) * (hi - lo) - s) / s)
+    return ((xr - xl) * (yt - yb) - solid) / solid, np.array(per)
+
+
 NAMES = ("sigma_v", "sigma_h", "mean_stress", "deviator", "phi", "axial_strain", "lateral_strain",
          "volumetric_strain", "shear_start", "phi_peak", "peak_cycle", "at_peak", "phi_residual",
-         "window_mean", "residual_drift", "dilation", "phi_envelope", "cohesion_envelope", "setting")
+         "window_mean", "residual_drift", "dilation", "phi_envelope", "cohesion_envelope", "setting",
+         "void_ratio", "void_ratios", "band_heights", "initial_void_ratio")
 
 
 def bind(run, sibling=None):
@@ -421,7 +462,41 @@ def bind(run, sibling=None):
         """The number a --set KEY=VALUE of this run gave key (e.g. a material's delta)."""
         return setting_of(run.info, key)
 
-    return {"sigma_v": sigma_v, "sigma_h": sigma_h, "mean_stress": mean_stress, "deviator": deviator,
+    def density(bands):
+        bands = whole(bands, "void_ratios", "bands")
+        if not 1 <= bands <= 100:
+            raise EvalError(f"void_ratios(): bands must be 1 to 100, not {bands}")
+        missing = [c for c in ("x_left", "x_right", "y_bottom", "y_top") if c not in run.columns]
+        if missing or not len(run.columns["cycle"]):
+            raise EvalError(f"void ratio: series.tsv lacks the walls' positions ({', '.join(missing) or 'no rows'})")
+        box = tuple(float(run.columns[c][-1]) for c in ("x_left", "x_right", "y_bottom", "y_top"))
+        d = state(run).discs()
+        return void_ratios_of(d["y"], d["r"], box, bands)
+
+    def void_ratio():
+        """The planar void ratio of the final state: (area inside the walls - disc area) / disc area."""
+        return float(density(1)[0])
+
+    def initial_void_ratio(start=None):
+        """The planar void ratio at the start of the shearing (its reference row's walls)."""
+        t = specimen(start)
+        r = state(run).discs()["r"]
+        solid = math.pi * float(np.sum(r * r))
+        return float((t.width[0] * t.height[0] - solid) / solid)
+
+    def void_ratios(bands=6):
+        """The void ratio of `bands` horizontal bands of equal height, bottom to top."""
+        return density(bands)[1]
+
+    def band_heights(bands=6):
+        """The mid-heights of the bands of void_ratios(bands), over the specimen's height."""
+        bands = whole(bands, "band_heights", "bands")
+        if not 1 <= bands <= 100:
+            raise EvalError(f"band_heights(): bands must be 1 to 100, not {bands}")
+        return (np.arange(bands) + 0.5) / bands
+
+    return {"void_ratio": void_ratio, "initial_void_ratio": initial_void_ratio, "void_ratios": void_ratios, "band_heights": band_heights,
+            "sigma_v": sigma_v, "sigma_h": sigma_h, "mean_stress": mean_stress, "deviator": deviator,
             "phi": phi, "axial_strain": axial_strain, "lateral_strain": lateral_strain,
             "volumetric_strain": volumetric_strain, "shear_start": shear_start, "phi_peak": phi_peak,
             "peak_cycle": peak_cycle, "at_peak": at_peak, "phi_residual": phi_residual,

@@ -16,7 +16,7 @@ h1{margin-bottom:.2em} h2{border-bottom:2px solid #ccc;padding-bottom:.2em;margi
 table{border-collapse:collapse;margin:.5em 0 1em;font-size:.9em}
 th,td{border:1px solid #ccc;padding:.25em .5em;text-align:left;vertical-align:top}
 th{background:#f2f2f2} td.num{text-align:right;font-family:monospace;white-space:nowrap}
-.PASS{background:#d9f2d9;font-weight:bold} .FAIL{background:#f8d0d0;font-weight:bold} .SKIP{background:#eeeeee;font-weight:bold}
+.PASS{background:#d9f2d9;font-weight:bold} .FAIL{background:#f8d0d0;font-weight:bold} .SKIP{background:#eeeeee;font-weight:bold} .KNOWN{background:#fde9c8;font-weight:bold}
 .bad{color:#a00} figure{margin:1em 0} figure img{max-width:100%;border:1px solid #ddd}
 figcaption{font-size:.9em;color:#444} blockquote{margin:.4em 0 0 1em;padding-left:.8em;border-left:3px solid #bbb;font-style:italic} code{background:#f4f4f4;padding:0 .2em} .meta{color:#555}
 """

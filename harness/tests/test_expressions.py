@@ -27,10 +27,12 @@ BIAXIAL = {"spread", "sigma_v", "sigma_h", "mean_stress", "deviator", "phi", "ax
            "volumetric_strain", "shear_start", "phi_peak", "peak_cycle", "at_peak", "phi_residual",
            "window_mean", "residual_drift", "dilation", "phi_envelope", "cohesion_envelope", "setting"}
 ENSEMBLES = {"members", "seeds", "realisations", "over"}   # issue 22: over an [ensemble]'s realisations
+# issue 21's case: the planar void ratio of a specimen and its profile over height (biaxial)
+VOID_RATIO = {"void_ratio", "void_ratios", "band_heights", "initial_void_ratio"}
 # issue 22: the statistics of polydisperse piles over an ensemble (families/pile_stats.py)
 PILE_STATS = {"ens_X", "ens_S", "ens_S_se", "dip", "dip_se", "profile_dip", "coordination", "ens_forces",
               "tail_rate", "tail_ks", "ens_fluct", "ens_rho", "log10"}
-NAMES = NAMES_BEFORE | NAMES_ADDED | BIAXIAL | ENSEMBLES | PILE_STATS
+NAMES = NAMES_BEFORE | NAMES_ADDED | BIAXIAL | ENSEMBLES | VOID_RATIO | PILE_STATS
 
 
 def _run(**columns):

@@ -175,3 +175,43 @@ def test_check_skips_the_checks_of_a_run_that_says_it_was_skipped(project, runs,
     assert status == 0
     records = json.loads((project / "reports" / "summary.json").read_text())
     assert sum(r.get("skip", False) for r in records) == 5
+
+
+def test_a_known_discrepancy_is_shown_and_neither_passes_nor_fails(tmp_path):
+    """A paper check with `known = REASON` that misses its paper value is KNOWN: printed with its
+    reason, counted apart, not failing the gate; one that agrees after all FAILs (strict), so the
+    docs that discuss the discrepancy cannot outlive it.  Only kind = paper may be known."""
+    from harness import references
+    from harness.compare import Verdict, evaluate_check
+    from harness.gate import counts_text, exit_status, table
+    import pytest
+    from harness.errors import IniError
+    text = ("[check phi]\ncase = c\nvariant = v\nquantity = 1 + 0 * 20\nvalue = 24.4\ntolerance = abs 1.9\n"
+            "kind = paper\nprovenance = JYH Sec. 5.2\nknown = ballast's specimen is looser: cases/biaxial/README.md\n")
+    path = tmp_path / "x.ref"
+    path.write_text(text)
+    check = references.load(tmp_path)[0]
+    import numpy as np
+    from harness.tables import Run
+
+    from harness.compare import RunStore
+    run = Run(folder=None, info={"status": "ok", "dt": 1.0}, columns={"cycle": np.arange(3.0), "time": np.arange(3.0)})
+
+    class Store(RunStore):
+        def __init__(self):
+            super().__init__(lambda c, v: tmp_path)
+
+        def get(self, case, variant):
+            return run
+    v = evaluate_check(check, Store())
+    assert v.result == "KNOWN" and not v.passed and "looser" in v.message
+    ok = Verdict("c", "v", "other", "q", 1.0, 1.0, "abs 0", "exact", "p", True, "")
+    assert counts_text([ok, v]) == "1 passed, 0 failed, 1 known discrepancy with a paper"
+    assert exit_status([ok, v]) == 0
+    assert "KNOWN c/phi: ballast's specimen is looser" in table([ok, v])
+    path.write_text(text.replace("value = 24.4", "value = 1.5"))
+    agrees = evaluate_check(references.load(tmp_path)[0], Store())
+    assert agrees.result == "FAIL" and "remove 'known'" in agrees.message
+    path.write_text(text.replace("kind = paper", "kind = exact"))
+    with pytest.raises(IniError, match="for kind = paper only"):
+        references.load(tmp_path)

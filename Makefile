@@ -35,7 +35,7 @@ TEST_SRC := $(wildcard core/tests/check_*.c)
 BENCH_SRC := core/bench/bench.c
 
 .PHONY: all deps test test-c test-prefix test-py test-sanitize test-browser validate bench bench-scaling \
-        bench-peer bench-modules bench-modules-count bench-scaling-count bench-flat bench-threads bench-cost \
+        bench-peer bench-modules bench-modules-count bench-scaling-count bench-flat bench-threads bench-cost bench-piles-poly \
         clean keys sweep \
         test-valgrind test-slurm
 
@@ -139,6 +139,12 @@ bench: deps $(BUILD)/bench
 	$(BUILD)/bench cases/bench/dense.scene
 	$(BUILD)/bench --settling cases/bench/dense.scene 20000
 	$(BUILD)/bench --pile cases/piles/pile30_bumpy.scene
+
+# Realisations per hour per core of the polydisperse L0 = 100 pile at r_d = 1/30
+# (issue 22): 20 seeds one after the other, CPU time per realisation, cycles to rest,
+# and what a series row every cycle would cost (docs/benchmarks.md).
+bench-piles-poly: all
+	$(PYTHON) core/bench/piles_poly.py bin/ballast cases/piles_poly/pile_poly.scene 20 --every-cycle 3
 
 # What each optional module costs: one simulation per configuration from the same
 # settled packing, then the all-off configuration in a build without the modules

@@ -188,7 +188,11 @@ struct bal_fill_def {
  * (slope 60).  Bottom `smooth`: row 0 rests on a floor wall NAME_floor with
  * only its two corner stones held; `bumpy`: row 0 is held at spacing
  * d (1 + c) and the rows above sit in its hollows (spacing max(d, d(1 + c))),
- * each row at the lowest height where it does not overlap the row below. */
+ * each row at the lowest height where it does not overlap the row below.
+ * With size_spread = r_d > 0 (MLH Sec. 4.4) every disc, held or free, has
+ * its own diameter d (1 + r), r uniform in [−r_d/2, r_d/2) from GSL's
+ * mt19937 seeded with `seed`, drawn in scene order; specimen.c says where
+ * the discs then go. */
 struct bal_pile_def {
     char name[BAL_NAME_MAX];
     int line;
@@ -198,6 +202,8 @@ struct bal_pile_def {
     double origin[2];     /* left end of the base, floor height (0 0) */
     int bottom;           /* 0: smooth, 1: bumpy (smooth) */
     double c;             /* spacing factor of row 0 on a bumpy bottom (0) */
+    double size_spread;   /* r_d of MLH Sec. 4.4, 0 <= r_d < 1 (0: equal discs) */
+    unsigned long seed;   /* seed of the diameters' generator, 1 ... 2^32 - 1 (1) */
     char material[BAL_NAME_MAX];
     char wall_material[BAL_NAME_MAX];
     BAL_SECTION_TAIL;

@@ -447,9 +447,15 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
             fprintf(f, "%s\n    {\"name\": ", p ? "," : "");
             json_string(f, pd->name);
             fprintf(f, ", \"L\": %ld, \"rows\": %ld, \"discs\": %ld, \"d\": %.17g, \"x0\": %.17g, "
-                       "\"width\": %.17g}",
+                       "\"width\": %.17g",
                     pd->L, rows, bal_specimen_pile_count(pd), pd->d, pd->origin[0],
                     (double)(pd->L - 1) * s0 + pd->d);
+            /* A polydisperse pile names its realisation: the spread and the
+             * seed of its diameters, whether the scene or a --set gave them
+             * (an equal-disc pile keeps the run.json it had). */
+            if (pd->size_spread > 0)
+                fprintf(f, ", \"size_spread\": %.17g, \"seed\": %lu", pd->size_spread, pd->seed);
+            fputs("}", f);
         }
         fputs("\n  ]", f);
     }

@@ -180,6 +180,11 @@ const struct bal_key bal_scene_keys[] = {
      "smooth: row 0 on a floor wall NAME_floor, corner stones held; bumpy: row 0 held"},
     {BAL_SEC_PILE, "c", BAL_KEY_DOUBLE, Q(c), "0", 0, -0.5, 1, NULL,
      "bumpy bottom: row 0 spacing d0 (1 + c) (MLH Sec. 4.1)"},
+    {BAL_SEC_PILE, "size_spread", BAL_KEY_DOUBLE, Q(size_spread), "0", 0, 0, 1, NULL,
+     "r_d < 1: each diameter d0 (1 + r), r uniform in [-r_d/2, r_d/2), held discs too (MLH "
+     "Sec. 4.4); 0 = equal discs"},
+    {BAL_SEC_PILE, "seed", BAL_KEY_LONG, Q(seed), "1", 0, 1, 4294967295.0, NULL,
+     "seed of GSL's mt19937 that draws the diameters (same seed, same pile on every machine)"},
     {BAL_SEC_PILE, "material", BAL_KEY_NAME, Q(material), NULL, 1, 0, 0, NULL,
      "material of the discs"},
     {BAL_SEC_PILE, "wall_material", BAL_KEY_NAME, Q(wall_material), "", 0, 0, 0, NULL,

@@ -237,6 +237,9 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
         struct bal_pile_def *p = &s->piles[i];
         if (check_material_ref(s, p, BAL_SEC_PILE, "material", p->material, 1, err))
             return err->code;
+        if (!(p->size_spread < 1))
+            return FAIL_AT(p, BAL_SEC_PILE, "size_spread", "expected 0 <= size_spread < 1 "
+                           "(diameters d (1 + r), |r| <= size_spread/2), got %g", p->size_spread);
         if (p->bottom == 0) {
             if (!*p->wall_material)
                 return FAIL_AT(p, BAL_SEC_PILE, "wall_material", "%s",

@@ -13,6 +13,8 @@
  *   [pile]  equal discs on a triangular lattice (MLH Sec. 4, Fig. 2): row M
  *           holds L − 3M (30°) or L − M (60°) discs, each row at the lowest
  *           height where it touches the row below (struct bal_pile_def);
+ *           with size_spread > 0, discs of random diameters on the same
+ *           lattice (MLH Sec. 4.4; lay_pile_spread below).
  *   [grains] n discs from a grading curve, placed at random without
  *           overlap in a rectangle (below);
  *   [import] the discs of a discs.tsv a run wrote, unchanged (read when the
@@ -54,6 +56,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <gsl/gsl_errno.h>
 #include <gsl/gsl_rng.h>
 
 #include "scene.h"
@@ -205,6 +208,136 @@ static int lay_pile(const struct bal_pile_def *p, int mat, struct bal_specimen *
         below = first;
         n_below = n;
     }
+    return k;
+}
+
+/* ------------------------------------------------------------------ */
+/* The polydisperse pile (MLH Sec. 4.4)                                */
+/* ------------------------------------------------------------------ */
+
+/* MLH: "we change the particle size of each particle slightly to the
+ * diameter d_i = d0 (1 + r_d^i), where r_d^i is a random number
+ * homogeneously distributed in the interval [−r_d/2, r_d/2]".  The choices
+ * the sentence leaves open, and ballast's:
+ *
+ *   which discs   every disc of the pile, the held ones of a bumpy bottom
+ *                 and the corner stones of a smooth one too (the literal
+ *                 reading of "each particle");
+ *   the numbers   gsl_rng_mt19937 seeded with the pile's `seed` (GSL's own
+ *                 integer generator: the same stream on every machine), one
+ *                 gsl_rng_uniform u in [0, 1) per disc in scene order (row 0
+ *                 left to right, then row 1, ...), r = r_d (u − 1/2);
+ *   held row 0    bumpy: at the equal-disc pile's places (the centres on one
+ *                 line, spacing d0 (1 + c)), only the sizes changed; they may
+ *                 overlap (held discs never move).  smooth: each disc on the
+ *                 floor (centre at its own radius above it);
+ *   free rows     each disc as close to its lattice site as it can be without
+ *                 overlapping its neighbours in the row: the x that minimise
+ *                 Σ (x_a − X_a)² subject to x_{a+1} − x_a ≥ r_a + r_{a+1}
+ *                 (separate_row), then the row at the lowest height where no
+ *                 disc of it overlaps a disc below, as for equal discs.  With
+ *                 equal discs no constraint binds and this is lay_pile's
+ *                 layout; lay_pile itself still lays size_spread = 0, so the
+ *                 monodisperse piles are unchanged bit for bit.
+ *
+ * The pile's base width and its x0 in run.json stay those of the
+ * equal-disc pile: X = (x − x0)/l is measured on the same lattice. */
+
+/* The x of one row: the least-squares projection of the lattice sites X
+ * onto the rows without overlap, x_{a+1} − x_a ≥ g_a = r_a + r_{a+1}.  With
+ * G_a = Σ_{b<a} g_b and y_a = x_a − G_a the constraints read y_a ≤ y_{a+1}:
+ * the isotonic regression of X_a − G_a, solved exactly by pooling adjacent
+ * violators (each pool at the mean of its members).  Mirror-symmetric, and
+ * the identity when no constraint binds.  work holds 3 n doubles. */
+static void separate_row(const double *X, const double *r, long n, double *x, double *work)
+{
+    double *G = work, *sum = work + n, *count = work + 2 * n;
+    long pools = 0;
+    G[0] = 0;
+    for (long a = 1; a < n; a++)
+        G[a] = G[a - 1] + (r[a - 1] + r[a]);
+    for (long a = 0; a < n; a++) {
+        sum[pools] = X[a] - G[a];
+        count[pools] = 1;
+        pools++;
+        /* merge while the last pool's mean is below the one before it */
+        while (pools > 1 && sum[pools - 1] * count[pools - 2] < sum[pools - 2] * count[pools - 1]) {
+            sum[pools - 2] += sum[pools - 1];
+            count[pools - 2] += count[pools - 1];
+            pools--;
+        }
+    }
+    for (long q = 0, a = 0; q < pools; q++) {
+        const double mean = sum[q] / count[q];
+        for (long m = 0; m < (long)count[q]; m++, a++)
+            x[a] = mean + G[a];
+    }
+}
+
+/* A pile whose discs have random diameters (size_spread > 0; the choices
+ * above).  Returns the index after the last disc, or -1 when out of memory. */
+static int lay_pile_spread(const struct bal_pile_def *p, int mat, struct bal_specimen *d, int k)
+{
+    const double dd = p->d, r0 = 0.5 * dd;
+    const double s0 = p->bottom == 1 ? dd * (1 + p->c) : dd;
+    const double s = p->bottom == 1 ? dd * fmax(1.0, 1 + p->c) : dd;
+    const double xc = p->origin[0] + r0 + 0.5 * (double)(p->L - 1) * s0;
+    const long total = bal_specimen_pile_count(p);
+    double *X = malloc(4 * (size_t)p->L * sizeof *X);
+    gsl_error_handler_t *previous = gsl_set_error_handler_off();
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_set_error_handler(previous);
+    if (!X || !rng) {
+        free(X);
+        if (rng)
+            gsl_rng_free(rng);
+        return -1;
+    }
+    gsl_rng_set(rng, p->seed);
+    for (long q = 0; q < total; q++)
+        d->r[k + q] = r0 * (1 + p->size_spread * (gsl_rng_uniform(rng) - 0.5));
+    gsl_rng_free(rng);
+
+    const int start = k;
+    for (long M = 0; pile_row_count(p, M) > 0; M++) {
+        const long n = pile_row_count(p, M);
+        const double spacing = M == 0 ? s0 : s;
+        const int first = k;
+        for (long a = 0; a < n; a++)
+            X[a] = xc + ((double)a - 0.5 * (double)(n - 1)) * spacing;
+        if (M == 0 && p->bottom == 1) {
+            for (long a = 0; a < n; a++)
+                d->x[first + a] = X[a];
+        } else {
+            separate_row(X, d->r + first, n, d->x + first, X + p->L);
+        }
+        for (long a = 0; a < n; a++, k++) {
+            const double ra = d->r[k];
+            double y = p->origin[1] + (p->bottom == 1 ? r0 : ra);
+            if (M > 0) {
+                y = -INFINITY;
+                for (int b = start; b < first; b++) {
+                    const double reach = ra + d->r[b], dx = fabs(d->x[k] - d->x[b]);
+                    if (dx < reach)
+                        y = fmax(y, d->y[b] + sqrt(reach * reach - dx * dx));
+                }
+            }
+            d->y[k] = y;
+            d->mat[k] = mat;
+            d->row[k] = (int32_t)M;
+            d->fixed[k] = M == 0 && (p->bottom == 1 || a == 0 || a == n - 1);
+        }
+        if (M > 0) { /* one height per row: the highest any of its discs needs */
+            double y = -INFINITY;
+            for (int q = first; q < k; q++)
+                y = fmax(y, d->y[q]);
+            if (!isfinite(y)) /* nothing below within reach (not for these lattices) */
+                y = d->y[first - 1] + dd;
+            for (int q = first; q < k; q++)
+                d->y[q] = y;
+        }
+    }
+    free(X);
     return k;
 }
 
@@ -415,9 +548,14 @@ enum bal_status bal_specimen_generate(const struct bal_scene *sc, int n, struct 
     for (int f = 0; f < sc->n_fills; f++)
         k = lay_fill(&sc->fills[f], bal_scene_find(sc, BAL_SEC_MATERIAL, sc->fills[f].material),
                      d, k);
-    for (int p = 0; p < sc->n_piles; p++)
-        k = lay_pile(&sc->piles[p], bal_scene_find(sc, BAL_SEC_MATERIAL, sc->piles[p].material),
-                     d, k);
+    for (int p = 0; p < sc->n_piles; p++) {
+        const struct bal_pile_def *pd = &sc->piles[p];
+        const int mat = bal_scene_find(sc, BAL_SEC_MATERIAL, pd->material);
+        k = pd->size_spread > 0 ? lay_pile_spread(pd, mat, d, k) : lay_pile(pd, mat, d, k);
+        if (k < 0)
+            return bal_error(err, BAL_ENOMEM, "%s:%d: [pile %s]: out of memory for its layout",
+                             sc->path, pd->line, pd->name);
+    }
     for (int g = 0; g < sc->n_grains; g++) {
         k = lay_grains(sc, &sc->grains[g],
                        bal_scene_find(sc, BAL_SEC_MATERIAL, sc->grains[g].material), d, k, err);

@@ -8,6 +8,7 @@
  * the file name, the line and the key ("bad:3: frction:").
  */
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -1000,6 +1001,21 @@ static const struct bad_scene bad_piles[] = {
     {"pile without d", PILE_HEAD "[pile p]\nL = 5\nmaterial = g\nwall_material = w\n" STAGE, 'v',
      "bad:6: [pile p]: d: required key is missing"},
     {"c beyond its range", PILE_HEAD "[pile p]\nc = 1.5\n", 'p', "bad:7: c: 1.5 is out of range"},
+    {"negative size_spread", PILE_HEAD "[pile p]\nsize_spread = -0.1\n", 'p',
+     "bad:7: size_spread: -0.1 is out of range"},
+    {"size_spread beyond its range", PILE_HEAD "[pile p]\nsize_spread = 1.5\n", 'p',
+     "bad:7: size_spread: 1.5 is out of range"},
+    {"size_spread of 1 (a diameter could reach d/2)",
+     PILE_HEAD "[pile p]\nL = 5\nd = 0.83\nbottom = bumpy\nsize_spread = 1\nmaterial = g\n" STAGE, 'v',
+     "bad:10: size_spread: expected 0 <= size_spread < 1"},
+    {"seed 0 (GSL's mt19937 would take 4357)", PILE_HEAD "[pile p]\nseed = 0\n", 'p',
+     "bad:7: seed: 0 is out of range"},
+    {"seed beyond 32 bits", PILE_HEAD "[pile p]\nseed = 4294967296\n", 'p',
+     "bad:7: seed: 4.29497e+09 is out of range"},
+    {"seed not whole", PILE_HEAD "[pile p]\nseed = 2.5\n", 'p',
+     "bad:7: seed: expected an integer, got '2.5'"},
+    {"size_spread not a number", PILE_HEAD "[pile p]\nsize_spread = 1/30\n", 'p',
+     "bad:7: size_spread: expected one finite number, got '1/30'"},
 };
 
 START_TEST(scene_pile_refused)
@@ -1040,6 +1056,255 @@ START_TEST(scene_pile_smallest)
     ck_assert_int_eq(f->sim->n, 1);
     ck_assert_int_eq(f->sim->n_walls, 0);
     ck_assert_int_eq(f->sim->fixed[0], 1);
+}
+END_TEST
+
+/* ------------------------------------------------------------------ */
+/* The polydisperse pile (MLH Sec. 4.4): size_spread and seed          */
+/* ------------------------------------------------------------------ */
+
+/* The discs a pile scene generates, in scene order (no simulation built:
+ * the generator alone). */
+struct spread_pile {
+    struct tfx *f;
+    struct bal_specimen d;
+    long n;
+};
+
+static void spread_pile_make(struct spread_pile *p, const char *name, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static void spread_pile_make(struct spread_pile *p, const char *name, const char *fmt, ...)
+{
+    static char text[4096];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(text, sizeof text, fmt, ap);
+    va_end(ap);
+    p->f = tfx_parse(text, name);
+    ck_assert_int_eq(bal_scene_validate(&p->f->sc, &p->f->err), BAL_OK);
+    p->n = bal_specimen_count(&p->f->sc);
+    ck_assert_int_eq(bal_specimen_generate(&p->f->sc, (int)p->n, &p->d, &p->f->err), BAL_OK);
+}
+
+static void spread_pile_free(struct spread_pile *p)
+{
+    bal_specimen_free(&p->d);
+    tfx_release(p->f);
+}
+
+/* The distribution of the diameters: d_i = d0 (1 + q_i), q_i uniform in
+ * [−r_d/2, r_d/2).  15251 discs (L = 301), r_d = 0.2.  Bounds exactly (up
+ * to the rounding of r0 (1 + q)); the mean, the variance r_d²/12 and the
+ * ten bin counts within 5 standard errors of a uniform sample of that size:
+ * SE(mean) = r_d/√(12 N), SE(variance) = √(4/45) (r_d/2)²/√N, SE(bin) =
+ * √(N 0.1 0.9).  The numbers are fixed by the seed; 5 standard errors is
+ * the statistical tolerance, which a correct generator fails with any
+ * seed with probability below 1e-6 per moment (and the extremes within
+ * 10 r_d/N of the bounds, e^-10).  Two seeds are tried. */
+START_TEST(scene_pile_spread_distribution)
+{
+    const double d0 = 0.83, rd = 0.2, r0 = d0 / 2, a = rd / 2;
+    const unsigned long seeds[] = {20261125, 7};
+    for (size_t k = 0; k < sizeof seeds / sizeof seeds[0]; k++) {
+        struct spread_pile p;
+        spread_pile_make(&p, "spread",
+                         "[material g]\nkn = 1e5\ndensity = 2.385\n"
+                         "[pile p]\nL = 301\nd = %.17g\nbottom = bumpy\nsize_spread = %.17g\n"
+                         "seed = %lu\nmaterial = g\n[stage s]\ncycles = 1\n",
+                         d0, rd, seeds[k]);
+        const long N = p.n;
+        ck_assert_int_eq(N, pile_n30(301));
+        double sum = 0, sum2 = 0, lo = INFINITY, hi = -INFINITY;
+        long bins[10] = {0};
+        for (long i = 0; i < N; i++) {
+            const double q = p.d.r[i] / r0 - 1;
+            ck_assert_msg(q >= -a - 1e-15 && q < a + 1e-15, "disc %ld: q = %.17g", i, q);
+            sum += q;
+            lo = fmin(lo, q);
+            hi = fmax(hi, q);
+            int b = (int)floor((q + a) / rd * 10);
+            bins[b < 0 ? 0 : b > 9 ? 9 : b]++;
+        }
+        const double mean = sum / (double)N;
+        for (long i = 0; i < N; i++) {
+            const double q = p.d.r[i] / r0 - 1;
+            sum2 += (q - mean) * (q - mean);
+        }
+        const double var = sum2 / (double)(N - 1), sq = sqrt((double)N);
+        ck_assert_msg(fabs(mean) <= 5 * rd / sqrt(12.0) / sq, "mean %g", mean);
+        ck_assert_msg(fabs(var - rd * rd / 12) <= 5 * sqrt(4.0 / 45) * a * a / sq,
+                      "variance %g, expected %g", var, rd * rd / 12);
+        for (int b = 0; b < 10; b++)
+            ck_assert_msg(fabs((double)bins[b] - 0.1 * (double)N) <= 5 * sqrt(0.09 * (double)N),
+                          "bin %d holds %ld of %ld", b, bins[b], N);
+        ck_assert_msg(lo < -a + 10 * rd / (double)N && hi > a - 10 * rd / (double)N,
+                      "extremes %g %g", lo, hi);
+        spread_pile_free(&p);
+    }
+}
+END_TEST
+
+/* The numbers are GSL's mt19937: with seed 5489 its first three outputs are
+ * those of Matsumoto & Nishimura's reference mt19937ar (init_genrand(5489)):
+ * 3499211612, 581869302, 3890346734, each u = k / 2^32 (gsl_rng_uniform).
+ * So the first three discs (row 0, from the left) have exactly these radii
+ * on every machine.  The same seed gives the same pile bit for bit; another
+ * seed another; and with size_spread = 0 the seed changes nothing. */
+START_TEST(scene_pile_spread_seed)
+{
+    const double d0 = 1, rd = 0.5, r0 = 0.5;
+    const char *scene = "[material g]\nkn = 1e5\ndensity = 1.2732395447351628\n"
+                        "[pile p]\nL = 22\nd = 1\nbottom = bumpy\nsize_spread = %.17g\n"
+                        "seed = %lu\nmaterial = g\n[stage s]\ncycles = 1\n";
+    struct spread_pile p, q;
+    spread_pile_make(&p, "seed", scene, rd, 5489ul);
+    const double ref[3] = {3499211612.0, 581869302.0, 3890346734.0};
+    for (int i = 0; i < 3; i++)
+        ck_assert_double_eq(p.d.r[i], r0 * (1 + rd * (ref[i] / 4294967296.0 - 0.5)));
+    (void)d0;
+    spread_pile_make(&q, "seed", scene, rd, 5489ul);
+    const size_t bytes = (size_t)p.n * sizeof(double);
+    ck_assert(memcmp(p.d.r, q.d.r, bytes) == 0);
+    ck_assert(memcmp(p.d.x, q.d.x, bytes) == 0);
+    ck_assert(memcmp(p.d.y, q.d.y, bytes) == 0);
+    spread_pile_free(&q);
+    spread_pile_make(&q, "seed", scene, rd, 5490ul);
+    long same = 0;
+    for (long i = 0; i < p.n; i++)
+        same += p.d.r[i] == q.d.r[i];
+    ck_assert_int_eq(same, 0);
+    spread_pile_free(&q);
+    spread_pile_free(&p);
+    /* size_spread = 0: equal discs, whatever the seed */
+    spread_pile_make(&p, "seed", scene, 0.0, 1ul);
+    spread_pile_make(&q, "seed", scene, 0.0, 99ul);
+    ck_assert(memcmp(p.d.x, q.d.x, (size_t)p.n * sizeof(double)) == 0);
+    ck_assert(memcmp(p.d.y, q.d.y, (size_t)p.n * sizeof(double)) == 0);
+    for (long i = 0; i < p.n; i++)
+        ck_assert(p.d.r[i] == r0 && q.d.r[i] == r0);
+    spread_pile_free(&q);
+    spread_pile_free(&p);
+}
+END_TEST
+
+/* The layout (specimen.c, lay_pile_spread), for bumpy bottoms with c = 0,
+ * −1/150 and 1/15, a 60° pile and a smooth bottom:
+ *   - the held row: bumpy, every disc at its lattice site on the line
+ *     oy + d/2; smooth, each disc on the floor (y = oy + r_i), the two
+ *     corner stones held;
+ *   - nothing overlaps that may not (only held discs may), and the
+ *     simulation builds (bal_sim_create refuses overlaps);
+ *   - each row M ≥ 1 at one height, resting on the one below: its lowest
+ *     clearance over the discs below is zero;
+ *   - each free row is the least-squares projection of its lattice sites
+ *     X_a onto x_{a+1} − x_a ≥ r_a + r_{a+1}: the optimality conditions of
+ *     that convex problem hold (feasibility; the prefix sums P_a =
+ *     Σ_{b≤a} (x_b − X_b) are ≤ 0, the multipliers −P_a; P_{n−1} = 0; and
+ *     P_a = 0 wherever neighbours a, a + 1 do not touch).
+ * Tolerance: 1e-12 d for distances (LATTICE_REL); 1e-11 d for the prefix
+ * sums, which add up to 100 displacements computed from sums of 100
+ * diameters. */
+START_TEST(scene_pile_spread_layout)
+{
+    static const struct {
+        double c, rd;
+        int slope60, smooth;
+        long L;
+        unsigned long seed;
+    } cases[] = {
+        {0.0, 1.0 / 30, 0, 0, 100, 3},   /* MLH Sec. 4.4, Fig. 8(b) */
+        {0.0, 2.0 / 3000, 0, 0, 100, 4}, /* Fig. 8(a) */
+        {-1.0 / 150, 0.05, 0, 0, 22, 5},
+        {1.0 / 15, 0.1, 0, 0, 19, 6},
+        {0.0, 0.3, 1, 0, 12, 7},
+        {0.0, 0.2, 0, 1, 16, 8},
+    };
+    const double d = 0.83, ox = -1.7, oy = 0.45, r0 = d / 2;
+    const double tol = LATTICE_REL * d;
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        const int smooth = cases[k].smooth;
+        const long L = cases[k].L;
+        char text[1024];
+        snprintf(text, sizeof text,
+                 "[material g]\nkn = 1e5\ndensity = 2.385\n[material w]\nkn = 1e5\n"
+                 "[pile p]\nL = %ld\nslope = %s\nd = %.17g\norigin = %.17g %.17g\nbottom = %s\n"
+                 "c = %.17g\nsize_spread = %.17g\nseed = %lu\nmaterial = g\nwall_material = w\n"
+                 "[stage s]\ncycles = 1\n",
+                 L, cases[k].slope60 ? "60" : "30", d, ox, oy, smooth ? "smooth" : "bumpy",
+                 cases[k].c, cases[k].rd, cases[k].seed);
+        struct spread_pile p;
+        spread_pile_make(&p, "layout", "%s", text);
+        const struct bal_specimen *D = &p.d;
+        const double c = smooth ? 0 : cases[k].c;
+        const double s0 = d * (1 + c), s = d * fmax(1.0, 1 + c);
+        const double xc = ox + r0 + 0.5 * (double)(L - 1) * s0;
+        int rows = 0;
+        for (long i = 0; i < p.n; i++)
+            rows = D->row[i] + 1 > rows ? D->row[i] + 1 : rows;
+        long first = 0;
+        for (int M = 0; M < rows; M++) {
+            const long n = L - (cases[k].slope60 ? 1 : 3) * M;
+            ck_assert_int_eq(D->row[first], M);
+            ck_assert_int_eq(D->row[first + n - 1], M);
+            const double spacing = M == 0 ? s0 : s;
+            for (long a = 0; a < n; a++) {
+                const long i = first + a;
+                const double X = xc + ((double)a - 0.5 * (double)(n - 1)) * spacing;
+                if (M == 0) {
+                    ck_assert_int_eq(D->fixed[i], !smooth || a == 0 || a == n - 1);
+                    ck_assert_double_eq_tol(D->y[i], oy + (smooth ? D->r[i] : r0), tol);
+                    if (!smooth)
+                        ck_assert_double_eq_tol(D->x[i], X, tol);
+                } else {
+                    ck_assert_int_eq(D->fixed[i], 0);
+                    ck_assert_double_eq(D->y[i], D->y[first]); /* one height per row */
+                }
+            }
+            if (M > 0) { /* resting on the row below, overlapping nothing below */
+                /* (one assertion per row: Check marks every passing one) */
+                double clearance = INFINITY, worst = INFINITY;
+                for (long a = first; a < first + n; a++)
+                    for (long b = 0; b < first; b++) {
+                        const double gap = hypot(D->x[a] - D->x[b], D->y[a] - D->y[b]) -
+                                           (D->r[a] + D->r[b]);
+                        worst = fmin(worst, gap);
+                        if (D->row[b] == M - 1)
+                            clearance = fmin(clearance, gap);
+                    }
+                ck_assert_msg(worst >= -tol, "case %zu, row %d overlaps a disc below by %g", k, M,
+                              -worst);
+                ck_assert_msg(fabs(clearance) <= tol, "case %zu, row %d floats %g above the row below",
+                              k, M, clearance);
+            }
+            if (M > 0 || smooth) { /* the projection's optimality conditions */
+                double P = 0;
+                for (long a = 0; a < n; a++) {
+                    const long i = first + a;
+                    P += D->x[i] - (xc + ((double)a - 0.5 * (double)(n - 1)) * spacing);
+                    ck_assert_msg(P <= 10 * tol, "case %zu, row %d: prefix sum %g > 0", k, M, P);
+                    if (a == n - 1) {
+                        ck_assert_msg(fabs(P) <= 10 * tol, "case %zu, row %d: P_n = %g", k, M, P);
+                        break;
+                    }
+                    const double gap = D->x[i + 1] - D->x[i] - (D->r[i] + D->r[i + 1]);
+                    ck_assert_msg(gap >= -tol, "case %zu, row %d: discs %ld, %ld overlap", k, M, i,
+                                  i + 1);
+                    if (gap > tol)
+                        ck_assert_msg(fabs(P) <= 10 * tol,
+                                      "case %zu, row %d: slack gap after disc %ld but P = %g", k, M,
+                                      i, P);
+                }
+            }
+            first += n;
+        }
+        ck_assert_int_eq(first, p.n);
+        spread_pile_free(&p);
+        /* The simulation builds: no overlap it would refuse. */
+        struct tfx *f = tfx_new(text, "layout");
+        ck_assert_int_eq(f->sim->n, (int)p.n);
+        tfx_release(f);
+    }
 }
 END_TEST
 
@@ -1160,6 +1425,9 @@ Suite *suite_scene(void)
     tcase_add_test(tc, scene_pile_bumpy_lattice);
     tcase_add_loop_test(tc, scene_pile_refused, 0, (int)(sizeof bad_piles / sizeof bad_piles[0]));
     tcase_add_test(tc, scene_pile_smallest);
+    tcase_add_test(tc, scene_pile_spread_distribution);
+    tcase_add_test(tc, scene_pile_spread_seed);
+    tcase_add_test(tc, scene_pile_spread_layout);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("fuzz");

@@ -10,6 +10,8 @@ harness/expressions.py: each module registers its own when it is imported.
     biaxial      sigma_v, phi, axial_strain, phi_peak, phi_residual, phi_envelope, ...: a biaxial
                  compression test and its strength envelope (JYH 2005)
     ensembles    members, seeds, realisations, over: the realisations of an [ensemble]
+    pile_stats   ens_S, dip, dip_se, coordination, ens_forces, tail_rate, ...: polydisperse
+                 piles over an [ensemble] (MLH 2000, Sec. 4.4)
 
 A new family is one module here that calls expressions.register, and its name below.  The
 order of the imports is the order in which an unknown-function message lists the names.
@@ -22,3 +24,4 @@ from . import collisions  # noqa: F401
 from . import rolling  # noqa: F401
 from . import biaxial  # noqa: F401
 from . import ensembles  # noqa: F401
+from . import pile_stats  # noqa: F401

@@ -207,7 +207,8 @@ def _points_script(case, figure, store, workdir, png, svg):
 
 
 def _sibling_of(store, case):
-    return lambda other: store.get(case.name, other)
+    """The case's other variants, and its ensembles' realisations (for over(), ens_S(), ...)."""
+    return Siblings(lambda other: store.get(case.name, other), case.ensemble_members())
 
 
 def _curves_script(case, figure, store, workdir, png, svg):

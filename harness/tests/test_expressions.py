@@ -29,7 +29,10 @@ BIAXIAL = {"spread", "sigma_v", "sigma_h", "mean_stress", "deviator", "phi", "ax
 ENSEMBLES = {"members", "seeds", "realisations", "over"}   # issue 22: over an [ensemble]'s realisations
 # issue 21's case: the planar void ratio of a specimen and its profile over height (biaxial)
 VOID_RATIO = {"void_ratio", "void_ratios", "band_heights", "initial_void_ratio"}
-NAMES = NAMES_BEFORE | NAMES_ADDED | BIAXIAL | ENSEMBLES | VOID_RATIO
+# issue 22: the statistics of polydisperse piles over an ensemble (families/pile_stats.py)
+PILE_STATS = {"ens_X", "ens_S", "ens_S_se", "dip", "dip_se", "profile_dip", "coordination", "ens_forces",
+              "tail_rate", "tail_ks", "ens_fluct", "ens_rho", "log10"}
+NAMES = NAMES_BEFORE | NAMES_ADDED | BIAXIAL | ENSEMBLES | VOID_RATIO | PILE_STATS
 
 
 def _run(**columns):
@@ -40,7 +43,7 @@ def _run(**columns):
 
 def test_every_family_registered_and_every_name_kept():
     assert list(expressions.registered()) == ["signals", "variants", "piles", "networks", "collisions",
-                                              "rolling", "biaxial", "ensembles"]
+                                              "rolling", "biaxial", "ensembles", "pile_stats"]
     names = {n for n, f in namespace(_run()).items() if callable(f)}
     assert names == NAMES
 

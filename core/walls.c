@@ -234,9 +234,13 @@ static void servo_control(struct bal_sim *s, struct bal_wall *w)
     for (long c = 0; c < p->n; c++) {
         if (p->j[c] != k || !(p->flags[c] & BAL_PAIR_TOUCHING))
             continue;
-        double rmin;
-        const struct bal_pair_law *L;
-        const double delta = bal_pairs_overlap(s, 1, c, &rmin, &L);
+        /* The overlap with this wall, from the wall's own geometry (the
+         * same arithmetic as bal_pairs_overlap, without calling back up
+         * into pairs.c, which calls bal_walls_closest). */
+        const int i = p->i[c];
+        double cx, cy;
+        const double delta = s->r[i] - sqrt(bal_walls_closest(w, s->x[i], s->y[i], &cx, &cy));
+        const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + w->material];
         /* dF_n/dδ: k_n, or ν k_n (δ/δ0)^(ν−1) under the power law */
         stiffness += s->normal_law == BAL_NORMAL_POWER && s->nu != 1.0
                          ? s->nu * L->kn * pow(fmax(delta, 0) / s->delta0, s->nu - 1)

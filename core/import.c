@@ -173,6 +173,33 @@ static int valid_wall_name(const char *v)
 static const char *const disc_columns[] = {"x", "y", "r", "theta", "vx", "vy", "omega", "fixed"};
 static const char *const wall_columns[] = {"name", "ax", "ay", "bx", "by"};
 
+/* The next line of text that is not blank, split into fields (p moves past
+ * it, line counts it): 1; 0 at the end of the text; -1 when it has too many
+ * columns (r->msg says so). */
+static int next_row(struct reader *r, char **p, int *line, struct fields *fl)
+{
+    while (**p || *line == 0) {
+        (*line)++;
+        char *nl = strchr(*p, '\n');
+        if (nl)
+            *nl = '\0';
+        char *cur = *p;
+        *p = nl ? nl + 1 : *p + strlen(*p);
+        if (is_blank(cur)) {
+            if (!nl)
+                return 0;
+            continue;
+        }
+        if (!split(cur, fl)) {
+            snprintf(r->msg, r->size, "%s:%d: more than %d columns", r->path, *line,
+                     IMPORT_MAX_COLUMNS);
+            return -1;
+        }
+        return 1;
+    }
+    return 0;
+}
+
 static enum bal_status read_discs(struct bal_import_def *imp, struct reader *r, char *text)
 {
     long n = 0, cap = 0;
@@ -180,25 +207,10 @@ static enum bal_status read_discs(struct bal_import_def *imp, struct reader *r, 
     int *rows = NULL;
     int header = 0, line = 0, velocity_columns = 0;
     enum bal_status st = BAL_OK;
-    for (char *p = text; *p || line == 0;) {
-        line++;
-        char *nl = strchr(p, '\n');
-        if (nl)
-            *nl = '\0';
-        char *cur = p;
-        p = nl ? nl + 1 : p + strlen(p);
-        if (is_blank(cur)) {
-            if (!nl)
-                break;
-            continue;
-        }
-        struct fields fl;
-        if (!split(cur, &fl)) {
-            snprintf(r->msg, r->size, "%s:%d: more than %d columns", r->path, line,
-                     IMPORT_MAX_COLUMNS);
-            st = BAL_EINVAL;
-            break;
-        }
+    char *p = text;
+    struct fields fl;
+    int got;
+    while ((got = next_row(r, &p, &line, &fl)) > 0) {
         if (!header) {
             header = 1;
             if (find_columns(r, &fl, disc_columns, BAL_IMPORT_COLUMNS, 4, line)) {
@@ -251,9 +263,9 @@ static enum bal_status read_discs(struct bal_import_def *imp, struct reader *r, 
             break;
         }
         rows[n++] = line;
-        if (!nl)
-            break;
     }
+    if (got < 0)
+        st = BAL_EINVAL;
     if (st == BAL_OK && !header) {
         snprintf(r->msg, r->size, "%s:1: empty: expected a header line and a row per disc", r->path);
         st = BAL_EINVAL;
@@ -281,25 +293,10 @@ static enum bal_status read_walls(struct bal_import_def *imp, struct reader *r, 
     struct bal_import_wall *walls = NULL;
     int header = 0, line = 0;
     enum bal_status st = BAL_OK;
-    for (char *p = text; *p || line == 0;) {
-        line++;
-        char *nl = strchr(p, '\n');
-        if (nl)
-            *nl = '\0';
-        char *cur = p;
-        p = nl ? nl + 1 : p + strlen(p);
-        if (is_blank(cur)) {
-            if (!nl)
-                break;
-            continue;
-        }
-        struct fields fl;
-        if (!split(cur, &fl)) {
-            snprintf(r->msg, r->size, "%s:%d: more than %d columns", r->path, line,
-                     IMPORT_MAX_COLUMNS);
-            st = BAL_EINVAL;
-            break;
-        }
+    char *p = text;
+    struct fields fl;
+    int got;
+    while ((got = next_row(r, &p, &line, &fl)) > 0) {
         if (!header) {
             header = 1;
             if (find_columns(r, &fl, wall_columns, 5, 5, line)) {
@@ -360,9 +357,9 @@ static enum bal_status read_walls(struct bal_import_def *imp, struct reader *r, 
         w->b[0] = v[2];
         w->b[1] = v[3];
         n++;
-        if (!nl)
-            break;
     }
+    if (got < 0)
+        st = BAL_EINVAL;
     if (st == BAL_OK && !header) {
         snprintf(r->msg, r->size, "%s:1: empty: expected a header line and a row per wall", r->path);
         st = BAL_EINVAL;

@@ -211,32 +211,41 @@ def _sibling_of(store, case):
     return Siblings(lambda other: store.get(case.name, other), case.ensemble_members())
 
 
-def _curves_script(case, figure, store, workdir, png, svg):
-    """Per variant, each y array expression against the x array expression: one line each."""
-    clauses, notes = [], []
+def _evaluated(case, figure, store, evaluate_with, notes):
+    """Per variant and per y of the figure, (variant, k, label, x, y): the figure's x and its
+    k-th y expression evaluated in the variant (evaluate_with: one number or an array); what
+    cannot be evaluated goes to notes and is left out."""
+    siblings = _sibling_of(store, case)
     for variant in figure.variants:
         try:
             run = store.get(case.name, variant)
-            x = evaluate_array(figure.x, run, _sibling_of(store, case))
+            x = evaluate_with(figure.x, run, siblings)
         except (RunProblem, EvalError) as problem:
             notes.append(f"{variant}: not drawn: {problem}")
             continue
         for k, (label, expr) in enumerate(zip(figure.labels, figure.y)):
             try:
-                y = evaluate_array(expr, run, _sibling_of(store, case))
+                y = evaluate_with(expr, run, siblings)
             except EvalError as problem:
                 notes.append(f"{variant}: {label}: not drawn: {problem}")
                 continue
-            if y.shape != x.shape:
-                notes.append(f"{variant}: {label}: not drawn: {y.size} values against {x.size} of x")
-                continue
-            kept = np.isfinite(x) & np.isfinite(y)
-            if not kept.all():
-                notes.append(f"{variant}: {label}: {int((~kept).sum())} non-finite point(s) not drawn")
-            path = Path(workdir) / f"{variant}_{k}.dat"
-            _write_columns(path, [x[kept], y[kept]])
-            clauses.append(f"{gp_string(path)} using 1:2 with lines title "
-                           f"{gp_string(curve_title(variant, label, figure))}")
+            yield variant, k, label, x, y
+
+
+def _curves_script(case, figure, store, workdir, png, svg):
+    """Per variant, each y array expression against the x array expression: one line each."""
+    clauses, notes = [], []
+    for variant, k, label, x, y in _evaluated(case, figure, store, evaluate_array, notes):
+        if y.shape != x.shape:
+            notes.append(f"{variant}: {label}: not drawn: {y.size} values against {x.size} of x")
+            continue
+        kept = np.isfinite(x) & np.isfinite(y)
+        if not kept.all():
+            notes.append(f"{variant}: {label}: {int((~kept).sum())} non-finite point(s) not drawn")
+        path = Path(workdir) / f"{variant}_{k}.dat"
+        _write_columns(path, [x[kept], y[kept]])
+        clauses.append(f"{gp_string(path)} using 1:2 with lines title "
+                       f"{gp_string(curve_title(variant, label, figure))}")
     if not clauses:
         return None, notes + ["nothing to plot"]
     return gnuplot_script(figure, clauses, png, svg), notes
@@ -259,20 +268,8 @@ PAPER_POINT_TYPES = (6, 4, 8, 12, 10)    # open circle, square, triangle, diamon
 def _errorbars_script(case, figure, store, workdir, png, svg):
     """A point per distinct x and series: the mean of the variants' y, a bar from least to largest."""
     samples, notes = [{} for _ in figure.y], []
-    for variant in figure.variants:
-        try:
-            run = store.get(case.name, variant)
-            x = evaluate(figure.x, run, _sibling_of(store, case))
-        except (RunProblem, EvalError) as problem:
-            notes.append(f"{variant}: not drawn: {problem}")
-            continue
-        for k, (label, expr) in enumerate(zip(figure.labels, figure.y)):
-            try:
-                y = evaluate(expr, run, _sibling_of(store, case))
-            except EvalError as problem:
-                notes.append(f"{variant}: {label}: not drawn: {problem}")
-                continue
-            samples[k].setdefault(number_key(x), []).append(y)
+    for _, k, _, x, y in _evaluated(case, figure, store, evaluate, notes):
+        samples[k].setdefault(number_key(x), []).append(y)
     clauses = []
     for k, label in enumerate(figure.labels):
         if not samples[k]:

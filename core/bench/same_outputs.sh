@@ -13,8 +13,8 @@
 # only what measures time or names the build:
 #   run.json       wall_seconds, particle_steps_per_s, timers
 #   ballast.stdout the summary line's wall time
-#   harness.json   wall_seconds, the binary's sha256, the run.json hash among
-#                  the outputs (run.json holds wall_seconds)
+#   harness.json   wall_seconds, the binary's sha256, the run.json and
+#                  ballast.stdout hashes among the outputs (both hold a wall time)
 #   every file     the two reports folders' paths (each run names its own)
 # Prints one line per differing file and a summary; exit 0 when none differs,
 # 1 when some do, 2 on usage.
@@ -36,6 +36,7 @@ CLOCKS = [
     ("harness.json", r'"wall_seconds": [^,\n]*'),
     ("harness.json", r'"sha256": "[0-9a-f]*"'),
     ("harness.json", r'"run\.json": "[0-9a-f]*"'),
+    ("harness.json", r'"ballast\.stdout": "[0-9a-f]*"'),
     ("ballast.stdout", r'wall [^ ]+ s'),
 ]
 

@@ -83,6 +83,11 @@ enum bal_grid_mode {
     BAL_GRID_OFF = 2   /* always all pairs (built once, never rebuilt) */
 };
 
+enum bal_skin_rule {
+    BAL_SKIN_FIXED = 0,  /* the skin as given (or 0.2 r_max) for the whole run */
+    BAL_SKIN_MOTION = 1  /* re-chosen at every rebuild from the measured motion (grid.c) */
+};
+
 enum bal_integrator {
     BAL_INTEGRATOR_CENTRED = 0, /* C&S eqs (20)-(23a), (35)-(36): v at half steps */
     BAL_INTEGRATOR_VERLET = 1,  /* velocity Verlet: x and v at whole steps */
@@ -105,6 +110,7 @@ struct bal_settings {
     double delta0;        /* normalisation δ0 of the power law, length (1) */
     int grid;             /* enum bal_grid_mode (auto) */
     double skin;          /* Verlet skin, length; 0 = auto (0) */
+    int skin_rule;        /* enum bal_skin_rule (fixed); with motion, `skin` is the first one */
     long output_every;    /* cycles between series rows (1) */
     double gamma_n;       /* viscous normal damping γ_n of MLH eq. (3), mass/time (0) */
     double psi;           /* exponent ψ of MLH eq. (3) (0) */
@@ -417,6 +423,7 @@ struct bal_run_info {
     double dt_fraction;       /* dt / dt_estimate */
     double wall_seconds;      /* wall-clock time spent stepping */
     long rebuilds;            /* neighbour-list rebuilds */
+    double skin;              /* the Verlet skin of the last rebuild */
     int grid_used;            /* 1 when the cell grid is in use */
     int n_discs, n_walls;
     long n_candidates;        /* candidate disc–disc pairs (last rebuild) */

@@ -303,6 +303,7 @@ enum bal_status bal_build_discs(struct bal_sim *s, struct bal_error *err)
         s->r_max = fmax(s->r_max, d.r[i]);
     s->use_grid = st->grid == BAL_GRID_ON || (st->grid == BAL_GRID_AUTO && n >= BAL_GRID_CROSSOVER);
     s->skin = st->skin > 0 ? st->skin : SKIN_SHARE_OF_RMAX * s->r_max;
+    s->skin_rule = st->skin_rule;
     double r_min = INFINITY;
     for (int i = 0; i < n; i++)
         r_min = fmin(r_min, d.r[i]);

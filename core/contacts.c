@@ -44,6 +44,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "contacts.h"
 #include "pairs.h"
@@ -56,6 +59,35 @@
 /* Candidates per chunk of the pair loop (below; pairs.c sizes the per-chunk
  * sums). */
 #define CLEAR_CHUNK BAL_PAIRS_CHUNK
+
+/* D = sqrt(D²) and e = (dx, dy)/D of the n touching contacts of a chunk,
+ * in place (q holds D², then D; ex, ey hold dx, dy, then e): two contacts
+ * per instruction where SSE2 exists (every x86-64), one otherwise; the same
+ * correctly rounded results either way.  The arrays have room for one more
+ * entry, padded with harmless values.  The square root and the two
+ * divisions share one divider, which the packed instructions use about as
+ * long as the scalar ones; in a pass of their own, many are in flight at
+ * once (AVX, four at a time, was tried: no faster, docs/benchmarks.md). */
+static inline __attribute__((always_inline)) void
+unit_vectors(double *restrict q, double *restrict ex, double *restrict ey, int n)
+{
+#if defined(__SSE2__)
+    q[n] = 1;
+    ex[n] = ey[n] = 0;
+    for (int k = 0; k < n; k += 2) {
+        const __m128d d = _mm_sqrt_pd(_mm_loadu_pd(q + k));
+        _mm_storeu_pd(q + k, d);
+        _mm_storeu_pd(ex + k, _mm_div_pd(_mm_loadu_pd(ex + k), d));
+        _mm_storeu_pd(ey + k, _mm_div_pd(_mm_loadu_pd(ey + k), d));
+    }
+#else
+    for (int k = 0; k < n; k++) {
+        q[k] = sqrt(q[k]);
+        ex[k] /= q[k];
+        ey[k] /= q[k];
+    }
+#endif
+}
 
 /* What a variant of the disc–disc loop is compiled with (PAIR_VARIANT),
  * one bit each: the power law (else the incremental one), the tangential
@@ -112,6 +144,16 @@ void bal_par_plan(struct bal_sim *s)
     struct bal_par *par = &s->par;
     const struct bal_pairs *p = &s->pp;
     const long chunks = chunks_of(p->n);
+    /* Each chunk's highest j, which the loop clears the sums up to: the
+     * list is the same until the next rebuild, so it is found once here
+     * rather than by a scan of the chunk every cycle. */
+    for (long k = 0; k < chunks; k++) {
+        const long c1 = (k + 1) * CLEAR_CHUNK < p->n ? (k + 1) * CLEAR_CHUNK : p->n;
+        int32_t top = -1;
+        for (long c = k * CLEAR_CHUNK; c < c1; c++)
+            top = p->j[c] > top ? p->j[c] : top;
+        par->chunk_top[k] = top;
+    }
     int ranges = par->threads;
     if (ranges > chunks / PAR_MIN_CHUNKS)
         ranges = (int)(chunks / PAR_MIN_CHUNKS);
@@ -148,6 +190,7 @@ void bal_par_free(struct bal_par *par)
     for (int t = 0; t < BAL_MAX_THREADS; t++)
         free(par->log[t]);
     free(par->chunk_sums);
+    free(par->chunk_top);
     free(par->chunk_roll);
     free(par->block_sums);
     memset(par, 0, sizeof *par);
@@ -184,7 +227,14 @@ static inline __attribute__((always_inline)) struct range_state
 range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int mods,
              const int logged)
 {
-    struct bal_pairs *restrict p = &s->pp;
+    /* The list's columns in locals: through p, the compiler reloaded each
+     * column's address from the struct after every store to another. */
+    const struct bal_pairs *p = &s->pp;
+    const int32_t *restrict pi = p->i, *restrict pj = p->j;
+    double *restrict pfn = p->fn, *restrict pfs = p->fs;
+    double *restrict pmr = p->mr, *restrict ptr = p->tr;
+    uint8_t *restrict pflags = p->flags;
+    const long pn = p->n;
     const double *restrict x = s->x, *restrict y = s->y;
     const double *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
     const double *restrict r = s->r;
@@ -208,6 +258,7 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
      * by one (energy.c). */
     const double budget = s->overlap_sieve;
     double *restrict chunk_sums = s->par.chunk_sums;
+    const int32_t *restrict chunk_top = s->par.chunk_top;
     double *restrict chunk_roll = s->par.chunk_roll;
     const long end = s->par.start[t + 1];
     const int zone = logged ? s->par.zone[t] : -1;
@@ -215,34 +266,55 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
     long n_log = logged ? s->par.log_n[t] : 0;
     int cleared = st.cleared, over = st.over;
     long c0 = st.c0;
-    for (; c0 < end && (!logged || p->i[c0] <= zone); c0 += CLEAR_CHUNK) {
-        const long c1 = c0 + CLEAR_CHUNK < p->n ? c0 + CLEAR_CHUNK : p->n;
-        int top = cleared;
-        for (long c = c0; c < c1; c++)
-            top = p->j[c] > top ? p->j[c] : top;
+    for (; c0 < end && (!logged || pi[c0] <= zone); c0 += CLEAR_CHUNK) {
+        const long c1 = c0 + CLEAR_CHUNK < pn ? c0 + CLEAR_CHUNK : pn;
+        const int top = chunk_top[c0 / CLEAR_CHUNK];
         if (top > cleared) {
             clear_sums(f, dsh, cleared + 1, top, damp);
             cleared = top;
         }
         double lost_fric = 0, lost_roll = 0; /* energy audit (energy.c) */
+        /* Pass 1: which candidates touch (eq. 8).  A short loop without
+         * branches on the answer; the touching ones are gathered, with
+         * their dx, dy and D^2, for the two passes below. */
+        int32_t tc[CLEAR_CHUNK + 1];
+        double tdx[CLEAR_CHUNK + 1], tdy[CLEAR_CHUNK + 1], tq[CLEAR_CHUNK + 1];
+        int nt = 0;
         for (long c = c0; c < c1; c++) {
-            const int i = p->i[c], j = p->j[c];
+            const int i = pi[c], j = pj[c];
             const double dx = x[j] - x[i], dy = y[j] - y[i];
             const double rs = r[i] + r[j];
             const double d2 = dx * dx + dy * dy;
-            if (d2 >= rs * rs) {
-                /* Not in contact (eq. 8): history is reset. */
-                p->fn[c] = 0;
-                p->flags[c] = 0;
+            const int touch = !(d2 >= rs * rs); /* (a NaN counts as touching) */
+            tc[nt] = (int32_t)(c - c0);
+            tdx[nt] = dx;
+            tdy[nt] = dy;
+            tq[nt] = d2;
+            nt += touch;
+            /* Not in contact: history is reset.  A candidate that did not
+             * touch in the last cycle either has none to reset (flags 0:
+             * F_n = F_s = 0), and is not written, so the near pairs of a
+             * wide skin cost the loop no stores.  (The rolling history is
+             * reset always: a re-sort negates it, which turns a zero into
+             * −0.) */
+            if (!touch & (roll || pflags[c])) {
+                pfn[c] = 0;
+                pflags[c] = 0;
                 if (shear)
-                    p->fs[c] = 0;
+                    pfs[c] = 0;
                 if (roll)
-                    p->mr[c] = p->tr[c] = 0;
-                continue;
+                    pmr[c] = ptr[c] = 0;
             }
+        }
+        /* Pass 2: D and e of the touching ones, several per instruction. */
+        unit_vectors(tq, tdx, tdy, nt);
+        /* Pass 3: the law at each touching contact, in the list's order. */
+        for (int q = 0; q < nt; q++) {
+            const long c = c0 + tc[q];
+            const int i = pi[c], j = pj[c];
+            const double rs = r[i] + r[j];
             const struct bal_pair_law *L = one_law ? one_law : &laws[mat[i] * n_mat + mat[j]];
-            const double dist = sqrt(d2);
-            const double ex = dx / dist, ey = dy / dist;
+            const double dist = tq[q], ex = tdx[q], ey = tdy[q];
             const double rvx = vx[i] - vx[j], rvy = vy[i] - vy[j];
             struct bal_kin k;
             k.ndot = rvx * ex + rvy * ey;
@@ -250,11 +322,11 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
             over |= k.delta > budget; /* a first sieve; bal_energy_overlap judges each pair */
 
             /* The chain of laws.h: normal -> damping -> tangential -> rolling. */
-            const double fn = bal_law_normal(&P, L, &k, p->fn[c]);
-            p->fn[c] = fn;
+            const double fn = bal_law_normal(&P, L, &k, pfn[c]);
+            pfn[c] = fn;
             double ftn = fn, fts = 0, dn = 0, ds = 0;
             /* A contact's lost rolling resistance (Model 2) lasts while it does. */
-            uint8_t flags = roll ? (uint8_t)(BAL_PAIR_TOUCHING | (p->flags[c] & BAL_PAIR_BROKEN))
+            uint8_t flags = roll ? (uint8_t)(BAL_PAIR_TOUCHING | (pflags[c] & BAL_PAIR_BROKEN))
                                  : BAL_PAIR_TOUCHING;
             if (damp) {
                 dn = bal_law_normal_dashpot(&P, L, &k);
@@ -263,8 +335,8 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
             if (shear && L->shear) {
                 const double tx = ey, ty = -ex;
                 k.sdot = rvx * tx + rvy * ty - (w[i] * r[i] + w[j] * r[j]);
-                const double fs = bal_law_tangential(&P, L, &k, fn, p->fs[c], &lost_fric, &flags);
-                p->fs[c] = fs;
+                const double fs = bal_law_tangential(&P, L, &k, fn, pfs[c], &lost_fric, &flags);
+                pfs[c] = fs;
                 fts = fs;
                 if (damp && !(flags & BAL_PAIR_SLIDING)) {
                     ds = bal_law_shear_dashpot(L, &k);
@@ -277,15 +349,15 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
                 const struct bal_roll R = bal_law_roll_of(L, bal_law_common_radius(r[i], r[j]));
                 const double wrel = w[i] - w[j];
                 const double dtheta = wrel * P.dt;
-                p->tr[c] += dtheta;
-                mr = bal_law_rolling(&P, R, fn, dtheta, p->mr[c], &lost_roll, &flags);
-                p->mr[c] = mr;
+                ptr[c] += dtheta;
+                mr = bal_law_rolling(&P, R, fn, dtheta, pmr[c], &lost_roll, &flags);
+                pmr[c] = mr;
                 if (damp) {
                     md = bal_law_rolling_dashpot(&P, L, R, k.delta, wrel);
                     mr += md;
                 }
             }
-            p->flags[c] = flags;
+            pflags[c] = flags;
             /* The moments on x and y: the shear force's, and the couple. */
             const double tqi = roll ? fts * r[i] - mr : fts * r[i];
             const double tqj = roll ? fts * r[j] + mr : fts * r[j];

@@ -208,6 +208,132 @@ static inline void cell_of(double x, double y, const struct bal_grid *g, double 
     *cy = bal_cell_index((y - g->y0) * inv_h, g->ny);
 }
 
+/* The disc–disc candidates of every disc, from the grid just binned, into
+ * rs (count of them).  The three cells of a row are adjacent in `list`: one
+ * range each.  Every disc of the nine cells is tested and stored, and k
+ * moves on only for a candidate: whether j > i and whether it is near are
+ * both unpredictable, and as branches they cost the rebuild about half its
+ * time.  With `band` (skin_rule = motion) it also counts, in *edge, the
+ * candidates in the outer half of the skin; without, that code is not
+ * compiled in. */
+static inline __attribute__((always_inline)) enum bal_status
+search(struct bal_sim *s, double inv_h, long *count, long *edge, const int band,
+       struct bal_error *err)
+{
+    const struct bal_grid *g = &s->grid;
+    struct bal_rebuild_scratch *rs = &s->rs;
+    const int n = s->n, nx = g->nx, ny = g->ny;
+    /* nb has room for one store past the limit. */
+    int32_t nb[MAX_NEIGHBOURS + 1];
+    int any_fixed = 0;
+    for (int i = 0; i < n; i++)
+        any_fixed |= s->fixed[i];
+    const double *restrict x = s->x, *restrict y = s->y, *restrict r = s->r;
+    const double skin = s->skin, half = 0.5 * skin;
+    long near = 0;
+    for (int i = 0; i < n; i++) {
+        /* its cell again, rather than two divisions of g->cell[i] */
+        int cx, cy;
+        cell_of(x[i], y[i], g, inv_h, &cx, &cy);
+        const int xlo = cx > 0 ? cx - 1 : 0, xhi = cx + 1 < nx ? cx + 1 : nx - 1;
+        const int ylo = cy > 0 ? cy - 1 : 0, yhi = cy + 1 < ny ? cy + 1 : ny - 1;
+        const double xi = x[i], yi = y[i], ri = r[i];
+        /* Two held discs never move: their contact is no part of the
+         * dynamics (rare: tested as a branch, after the rest). */
+        const int held = any_fixed && s->fixed[i];
+        int k = 0;
+        for (int yy = ylo; yy <= yhi; yy++) {
+            const int a1 = g->start[yy * nx + xhi + 1];
+            for (int a = g->start[yy * nx + xlo]; a < a1; a++) {
+                const int j = g->list[a];
+                const double dx = x[j] - xi, dy = y[j] - yi;
+                const double rs2 = ri + r[j], reach = rs2 + skin, d2 = dx * dx + dy * dy;
+                int keep = (j > i) & (d2 < reach * reach);
+                if (held)
+                    keep &= !s->fixed[j];
+                if (band)
+                    near += keep & (d2 < (rs2 + half) * (rs2 + half));
+                nb[k] = j;
+                k += keep;
+                if (k == MAX_NEIGHBOURS + 1) {
+                    char name[2 * BAL_NAME_MAX];
+                    bal_specimen_disc_name(s->scene, s->id[i], name, sizeof name);
+                    return bal_error(err, BAL_EUNSTABLE,
+                                     "%s: disc %s has more than %d neighbours within "
+                                     "reach at step %ld (piled up?)",
+                                     s->scene->path, name, MAX_NEIGHBOURS, s->step);
+                }
+            }
+        }
+        /* Insertion sort: k is small. */
+        for (int a = 1; a < k; a++) {
+            int32_t v = nb[a];
+            int b = a - 1;
+            while (b >= 0 && nb[b] > v) {
+                nb[b + 1] = nb[b];
+                b--;
+            }
+            nb[b + 1] = v;
+        }
+        for (int a = 0; a < k; a++)
+            if (push(rs, count, i, nb[a], err))
+                return err->code;
+    }
+    if (band)
+        *edge = *count - near;
+    return BAL_OK;
+}
+
+/* ------------------------------------------------------------------ */
+/* The skin from the measured motion (skin_rule = motion)              */
+/* ------------------------------------------------------------------ */
+
+/* A rebuild's cost per disc, in units of one candidate's cost in the pair
+ * loop for one cycle.  Measured on the settling race scene of bench-peer
+ * (20 000 discs falling, skin 0.15, 2026-11-27, docs/benchmarks.md): a
+ * rebuild took 69 ns a disc, and the pair loop 7.1 ns a candidate, 9.7. */
+#define REBUILD_COST_IN_CANDIDATES 25.0
+/* The rule's bounds, as shares of the largest radius, and its largest step
+ * (a factor) from one rebuild to the next. */
+#define SKIN_LO 0.05
+#define SKIN_HI 1.0
+#define SKIN_STEP 2.0
+
+/* The skin of the next lists.  A cycle costs about
+ *
+ *     J(s) = C N / T(s) + n(s)          (in candidate-cycles)
+ *
+ * C = REBUILD_COST_IN_CANDIDATES, N discs, n(s) candidates, T(s) the cycles
+ * between rebuilds.  The lists break when two discs have closed the skin
+ * between them (or a disc and a wall): T(s) = s/u, with u = (the larger of
+ * 2 d_1 and d_1 + the walls' largest displacement) / (cycles since the last
+ * rebuild), measured now.  J'(s) = 0 at
+ *
+ *     s = sqrt(C N u / n'(s)),
+ *
+ * n'(s) the candidates per unit of skin at the edge of the skin, which the
+ * last search measured (its outer half: skin_edge).  The rule uses only
+ * positions and counts, never the clock, so a run is the same on any
+ * machine and thread count; what it changes is when rebuilds happen, never
+ * which contacts the lists hold (bal_grid_due reads the skin they were
+ * built with). */
+static double motion_skin(const struct bal_sim *s)
+{
+    const long cycles = s->step - s->built_step;
+    if (cycles <= 0 || s->skin_edge <= 0)
+        return s->skin;
+    const double d1 = sqrt(s->moved_sq);
+    double wmax = 0;
+    for (int k = 0; k < s->n_walls; k++)
+        wmax = fmax(wmax, s->walls[k].disp);
+    const double u = fmax(2 * d1, d1 + wmax) / (double)cycles;
+    double skin = sqrt(REBUILD_COST_IN_CANDIDATES * s->n * u / s->skin_edge);
+    if (!isfinite(skin))
+        return s->skin;
+    skin = fmin(fmax(skin, s->skin / SKIN_STEP), s->skin * SKIN_STEP);
+    return fmin(fmax(skin, SKIN_LO * s->r_max), SKIN_HI * s->r_max);
+}
+
 enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
 {
     const int n = s->n;
@@ -224,6 +350,8 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
                     return err->code;
     } else {
         struct bal_grid *g = &s->grid;
+        if (s->skin_rule == BAL_SKIN_MOTION)
+            s->skin = motion_skin(s);
         double x0 = s->x[0], x1 = s->x[0], y0 = s->y[0], y1 = s->y[0];
         for (int i = 1; i < n; i++) { /* comparisons: fmin/fmax are libm calls */
             const double xi = s->x[i], yi = s->y[i];
@@ -290,63 +418,14 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
             g->start[c] = g->start[c - 1];
         g->start[0] = 0;
 
-        /* The three cells of a row are adjacent in `list`: one range each.
-         * Every disc of the nine cells is tested and stored, and k moves on
-         * only for a candidate: whether j > i and whether it is near are
-         * both unpredictable, and as branches they cost the rebuild about
-         * half its time.  nb has room for one store past the limit. */
-        int32_t nb[MAX_NEIGHBOURS + 1];
-        int any_fixed = 0;
-        for (int i = 0; i < n; i++)
-            any_fixed |= s->fixed[i];
-        const double *restrict x = s->x, *restrict y = s->y, *restrict r = s->r;
-        const double skin = s->skin;
-        for (int i = 0; i < n; i++) {
-            /* its cell again, rather than two divisions of g->cell[i] */
-            int cx, cy;
-            cell_of(x[i], y[i], g, inv_h, &cx, &cy);
-            const int xlo = cx > 0 ? cx - 1 : 0, xhi = cx + 1 < nx ? cx + 1 : nx - 1;
-            const int ylo = cy > 0 ? cy - 1 : 0, yhi = cy + 1 < ny ? cy + 1 : ny - 1;
-            const double xi = x[i], yi = y[i], ri = r[i];
-            /* Two held discs never move: their contact is no part of the
-             * dynamics (rare: tested as a branch, after the rest). */
-            const int held = any_fixed && s->fixed[i];
-            int k = 0;
-            for (int yy = ylo; yy <= yhi; yy++) {
-                const int a1 = g->start[yy * nx + xhi + 1];
-                for (int a = g->start[yy * nx + xlo]; a < a1; a++) {
-                    const int j = g->list[a];
-                    const double dx = x[j] - xi, dy = y[j] - yi;
-                    const double reach = ri + r[j] + skin;
-                    int keep = (j > i) & (dx * dx + dy * dy < reach * reach);
-                    if (held)
-                        keep &= !s->fixed[j];
-                    nb[k] = j;
-                    k += keep;
-                    if (k == MAX_NEIGHBOURS + 1) {
-                        char name[2 * BAL_NAME_MAX];
-                        bal_specimen_disc_name(s->scene, s->id[i], name, sizeof name);
-                        return bal_error(err, BAL_EUNSTABLE,
-                                         "%s: disc %s has more than %d neighbours within "
-                                         "reach at step %ld (piled up?)",
-                                         s->scene->path, name, MAX_NEIGHBOURS, s->step);
-                    }
-                }
-            }
-            /* Insertion sort: k is small. */
-            for (int a = 1; a < k; a++) {
-                int32_t v = nb[a];
-                int b = a - 1;
-                while (b >= 0 && nb[b] > v) {
-                    nb[b + 1] = nb[b];
-                    b--;
-                }
-                nb[b + 1] = v;
-            }
-            for (int a = 0; a < k; a++)
-                if (push(rs, &count, i, nb[a], err))
-                    return err->code;
-        }
+        if (s->skin_rule == BAL_SKIN_MOTION) {
+            long edge = 0;
+            if (search(s, inv_h, &count, &edge, 1, err))
+                return err->code;
+            /* candidates in the outer half of the skin, per unit of skin */
+            s->skin_edge = (double)(edge > 0 ? edge : 1) / (0.5 * s->skin);
+        } else if (search(s, inv_h, &count, NULL, 0, err))
+            return err->code;
     }
     if (install(s, &s->pp, rs, count, 0, err))
         return err->code;
@@ -384,6 +463,7 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
             s->walls[k].disp = 0;
     }
     s->need_rebuild = 0;
+    s->built_step = s->step;
     s->rebuilds++;
     return BAL_OK;
 }

@@ -379,6 +379,8 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
                    "  \"rebuilds\": %ld,\n  \"candidates\": %ld,\n  \"particle_steps_per_s\": ",
                 s->n, s->n_walls, s->use_grid ? "true" : "false", s->rebuilds, s->pp.n);
         json_number(f, s->wall_seconds > 0 ? (double)s->step * s->n / s->wall_seconds : 0);
+        fputs(",\n  \"skin\": ", f);
+        json_number(f, s->skin);
         fprintf(f, ",\n  \"gravity\": [%.17g, %.17g]", s->g[0], s->g[1]);
         fprintf(f, ",\n  \"threads\": %d", s->par.threads);
         fprintf(f, ",\n  \"timers\": {\"positions\": %.6g, \"neighbours\": %.6g, \"contacts\": %.6g, "

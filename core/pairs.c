@@ -84,6 +84,10 @@ enum bal_status bal_pairs_reserve_chunks(struct bal_sim *s)
     if (!q)
         return BAL_ENOMEM;
     par->chunk_sums = q;
+    int32_t *top = realloc(par->chunk_top, (size_t)need * sizeof *top);
+    if (!top)
+        return BAL_ENOMEM;
+    par->chunk_top = top;
     if (s->pp.rolling) {
         q = realloc(par->chunk_roll, (size_t)need * sizeof *q);
         if (!q)

@@ -72,6 +72,9 @@ const struct bal_key bal_scene_keys[] = {
      "neighbour search: auto = all pairs for few discs, a cell grid for many"},
     {BAL_SEC_SETTINGS, "skin", BAL_KEY_DOUBLE, S(skin), "0", 0, 0, BIG, NULL,
      "Verlet skin of the cell grid, length; 0 = 0.2 x the largest radius"},
+    {BAL_SEC_SETTINGS, "skin_rule", BAL_KEY_ENUM, S(skin_rule), "fixed", 0, 0, 0, "fixed motion",
+     "fixed: the skin above for the whole run; motion: it starts the run, then each rebuild "
+     "chooses the skin from the measured motion (fewest expected cost per cycle)"},
     {BAL_SEC_SETTINGS, "output_every", BAL_KEY_LONG, S(output_every), "1", 0, 1, LBIG, NULL,
      "cycles between rows of series.tsv"},
     {BAL_SEC_SETTINGS, "gamma_n", BAL_KEY_DOUBLE, S(gamma_n), "0", 0, 0, BIG, NULL,

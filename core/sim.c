@@ -162,6 +162,7 @@ static enum bal_status cycle(struct bal_sim *s, struct bal_error *err)
     bal_energy_gravity_before(s);
     /* 1. positions x_N from v_{N-1/2}; walls move; are the lists still whole? */
     const struct bal_moves moved = bal_integrate_positions(s);
+    s->moved_sq = moved.d1_sq;
     bal_walls_move(s);
     if (bal_grid_due(s, moved))
         s->need_rebuild = 1;
@@ -406,6 +407,7 @@ void bal_sim_info(const struct bal_sim *s, struct bal_run_info *info)
     info->dt_fraction = s->dt / s->dt_estimate;
     info->wall_seconds = s->wall_seconds;
     info->rebuilds = s->rebuilds;
+    info->skin = s->skin;
     info->grid_used = s->use_grid;
     info->n_discs = s->n;
     info->n_walls = s->n_walls;
@@ -478,7 +480,7 @@ void bal_sim_memory(const struct bal_sim *s, double *disc_bytes, double *pair_by
          (double)rs->col_cap * sizeof *rs->col;
     /* threads: the chunks' friction sums, the logs of ranges after the
      * first, the blocks' sums */
-    p += (double)s->par.chunk_cap * sizeof *s->par.chunk_sums;
+    p += (double)s->par.chunk_cap * (sizeof *s->par.chunk_sums + sizeof *s->par.chunk_top);
     for (int t = 0; t < BAL_MAX_THREADS; t++)
         p += (double)s->par.log_cap[t] * sizeof *s->par.log[t];
     d += 2.0 * bal_disc_blocks(s->n) * sizeof *s->par.block_sums;

@@ -204,6 +204,7 @@ struct bal_par {
     struct bal_sum_log *log[BAL_MAX_THREADS];
     long log_n[BAL_MAX_THREADS], log_cap[BAL_MAX_THREADS];
     double *chunk_sums;          /* per chunk of candidates: the friction loss */
+    int32_t *chunk_top;          /* per chunk: its highest j (bal_par_plan, once a list) */
     double *chunk_roll;          /* ... and the rolling loss (only with rolling) */
     long chunk_cap;
     double *block_sums;          /* per block of discs, 2 each: a pass's sums (integrate.c) */
@@ -275,7 +276,14 @@ struct bal_sim {
     struct bal_rebuild_scratch rs; /* the new list of a rebuild, one column at a time */
     struct bal_grid grid;
     int use_grid;
-    double skin;
+    double skin;                 /* the Verlet skin of the lists in use */
+    int skin_rule;               /* enum bal_skin_rule: with motion, each rebuild chooses the
+                                  * skin (grid.c, motion_skin) from the next two */
+    double moved_sq;             /* the largest squared displacement of a disc since the lists
+                                  * were built, as of the last position pass */
+    double skin_edge;            /* candidates per unit of skin at the edge of the last
+                                  * search's skin (its outer half); 0: not measured */
+    long built_step;             /* s->step when the lists were built */
     long rebuilds;
     int need_rebuild;
     bal_pair_loop_fn pair_loop;

@@ -85,10 +85,12 @@ def make_scenes(reuse):
     print(f"# dense: N={n} settled frictionless for {stage['cycles']} cycles: "
           f"E_k/E_el = {stage['ke_over_ee']:.2g}", flush=True)
     scenes["dense"].write_text(race.ballast_scene(state, box, dt, STEPS,
-                                                  f"peer race 'dense', {n} discs"))
+                                                  f"peer race 'dense', {n} discs",
+                                                  skin_rule=race.RACE_SKIN_RULE))
     lattice, lbox, ldt = race.initial_lattice(OUT, n, columns)
     scenes["settling"].write_text(race.ballast_scene(lattice, lbox, ldt, STEPS,
-                                                     f"peer race 'settling', {n} discs"))
+                                                     f"peer race 'settling', {n} discs",
+                                                     skin_rule=race.RACE_SKIN_RULE))
     return scenes
 
 

@@ -565,6 +565,129 @@ START_TEST(grid_on_off_agree_on_packing)
 }
 END_TEST
 
+/* skin_rule = motion: the skin follows the motion, and the lists still
+ * hold every contact.  A packing of 300 discs falls from its lattice onto
+ * the floor of its box and piles up.  After every cycle each pair of discs
+ * that touches, and each disc touching a wall, is looked up in the lists
+ * (all pairs, by brute force: nothing of the grid's own arithmetic).  The
+ * skin must have grown past twice its first value while the discs fall,
+ * stay within the rule's bounds (0.05 to 1 r_max), and the rebuilds be
+ * fewer than with the fixed skin of the same scene; after the first 400
+ * cycles the run must also be the all-pairs run to round-off (AGREE_ABS). */
+static const char *const falling_fmt =
+    "[settings]\ngrid = %s\nskin_rule = %s\ngravity = 0 -9.81\n"
+    "dt = 0.00075788534449010318\n"
+    "[material g]\nkn = 1e5\nks = 0.8e5\nfriction = 0.5\ndensity = 1\n"
+    "[material w]\nkn = 1e5\nfriction = 0.3\n"
+    "[fill pack]\nn = 300\ncolumns = 20\nrmin = 0.7\nrmax = 1.0\nvmax = 4.0\nseed = 11\n"
+    "box = 1\nmaterial = g\nwall_material = w\n"
+    "[stage s]\ncycles = 1\n";
+
+/* Every touching pair and disc–wall contact of s is a candidate. */
+static long unlisted_contacts(const struct bal_sim *s, long *touching)
+{
+    long missed = 0;
+    for (int i = 0; i < s->n; i++) {
+        for (int j = i + 1; j < s->n; j++) {
+            const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
+            const double rs = s->r[i] + s->r[j];
+            if (dx * dx + dy * dy >= rs * rs)
+                continue;
+            ++*touching;
+            missed += bal_pairs_find(&s->pp, ((uint64_t)(uint32_t)i << 32) | (uint32_t)j) < 0;
+        }
+        for (int k = 0; k < s->n_walls; k++) {
+            double cx, cy;
+            if (bal_walls_closest(&s->walls[k], s->x[i], s->y[i], &cx, &cy) >= s->r[i] * s->r[i])
+                continue;
+            ++*touching;
+            missed += bal_pairs_find(&s->pw, ((uint64_t)(uint32_t)i << 32) | (uint32_t)k) < 0;
+        }
+    }
+    return missed;
+}
+
+START_TEST(grid_motion_skin_misses_no_contact)
+{
+    struct tfx *on = tfx_newf("motion", falling_fmt, "on", "motion");
+    struct tfx *off = tfx_newf("off", falling_fmt, "off", "fixed");
+    struct tfx *fixed = tfx_newf("fixed", falling_fmt, "on", "fixed");
+    const struct bal_sim *a = on->sim, *b = off->sim;
+    const double first = info_of(on).skin, r_max = a->r_max;
+    ck_assert_double_eq_tol(first, 0.2 * r_max, 1e-15);
+    t_steps(on, 400);
+    t_steps(off, 400);
+    double worst = 0;
+    for (int id = 0; id < a->n; id++) {
+        const int i = a->slot[id], j = b->slot[id];
+        worst = fmax(worst, fabs(a->x[i] - b->x[j]) + fabs(a->y[i] - b->y[j]));
+        worst = fmax(worst, fabs(a->vx[i] - b->vx[j]) + fabs(a->vy[i] - b->vy[j]));
+    }
+    ck_assert_msg(worst < AGREE_ABS, "motion skin and all pairs differ by %g", worst);
+    double widest = first, narrowest = first;
+    long missed = 0, touching = 0;
+    for (int k = 0; k < 3600; k++) {
+        t_steps(on, 1);
+        missed += unlisted_contacts(a, &touching);
+        widest = fmax(widest, a->skin);
+        narrowest = fmin(narrowest, a->skin);
+    }
+    t_steps(fixed, 4000);
+    ck_assert_int_eq(missed, 0);
+    ck_assert_int_gt(touching, 3600 * 150); /* piled up: 0.74 contacts a disc a cycle */
+    ck_assert_msg(widest > 2 * first, "the skin grew to %g only (first %g)", widest, first);
+    ck_assert(widest <= 1.0 * r_max && narrowest >= 0.05 * r_max);
+    ck_assert_int_lt(info_of(on).rebuilds, info_of(fixed).rebuilds);
+    ck_assert_double_eq(info_of(fixed).skin, first);
+}
+END_TEST
+
+/* skin_rule = motion against one projectile: the lists a rebuild makes are
+ * searched with the skin the trigger then waits for.  A row of 50 held
+ * discs (radius 0.5, 1 apart: touching no one) and a disc p of radius 0.5
+ * above disc 10 of the row, gap 0.25, falling at 0.9 (no gravity, dt =
+ * 1e-3).  First skin 0.2 r_max = 0.1: p has moved it at N = ⌈0.1/9e-4⌉ =
+ * 112 (d = 0.1008), the lists are rebuilt, and the rule widens the skin by
+ * its largest step, to 0.2 (nothing lies in the outer half of the old skin,
+ * so the rule sees no cost in a wider one).  The gap is then 0.1492: inside
+ * the new skin, outside the old one.  p touches the row at N = ⌈0.25/9e-4⌉
+ * = 278; the next rebuild would come only at N = 112 + 223 = 335.  So the
+ * pair must be listed by the rebuild at 112 — a search with the old skin
+ * would miss the contact for 57 cycles. */
+START_TEST(grid_motion_skin_lists_a_projectile)
+{
+    char txt[T_TEXT_MAX];
+    int len = snprintf(txt, sizeof txt,
+                       "[settings]\ngrid = on\nskin_rule = motion\ndt = 1e-3\n"
+                       "[material g]\nkn = 1e5\ndensity = 1\n[stage s]\ncycles = 1\n"
+                       "[disc p]\nx = 10 1.25\nr = 0.5\nv = 0 -0.9\nmaterial = g\n");
+    for (int k = 0; k < 50; k++)
+        len += snprintf(txt + len, sizeof txt - (size_t)len,
+                        "[disc row%d]\nx = %d 0\nr = 0.5\nfixed = 1\nmaterial = g\n", k, k);
+    ck_assert_int_lt(len, (int)sizeof txt);
+    struct tfx *f = tfx_new(txt, "projectile");
+    const struct bal_sim *s = f->sim;
+    ck_assert_double_eq_tol(s->skin, 0.1, 1e-15);
+    const long built = info_of(f).rebuilds;
+    long missed = 0, touching = 0, first_touch = -1;
+    for (int k = 1; k <= 400; k++) {
+        t_steps(f, 1);
+        if (k == 111)
+            ck_assert_int_eq(info_of(f).rebuilds, built);
+        if (k == 112) {
+            ck_assert_int_eq(info_of(f).rebuilds, built + 1);
+            ck_assert_double_eq_tol(s->skin, 0.2, 1e-15);
+        }
+        const long before = touching;
+        missed += unlisted_contacts(s, &touching);
+        if (touching > before && first_touch < 0)
+            first_touch = k;
+    }
+    ck_assert_int_eq(first_touch, 278);
+    ck_assert_int_eq(missed, 0);
+}
+END_TEST
+
 /* Rattlers in cages, where the lists outlive d_1 + d_2 >= skin.  Three
  * cages 12 apart, each a ring of 8 held discs (radius 0.5, ring radius
  * 1.8), with a free disc of radius 0.4 flying about inside: gap 0.9 to
@@ -746,6 +869,8 @@ Suite *suite_grid(void)
     tcase_add_test(tc, grid_history_survives_rebuild);
     tcase_add_test(tc, grid_on_off_agree_on_packing);
     tcase_add_test(tc, grid_rattlers_keep_their_lists);
+    tcase_add_test(tc, grid_motion_skin_misses_no_contact);
+    tcase_add_test(tc, grid_motion_skin_lists_a_projectile);
     tcase_add_test(tc, grid_movers_meet_two_cells_apart);
     tcase_add_test(tc, grid_reorder_is_no_physics);
     suite_add_tcase(s, tc);

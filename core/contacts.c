@@ -225,7 +225,7 @@ struct range_state {
  * in the zone (`logged`), or to the end of the range. */
 static inline __attribute__((always_inline)) struct range_state
 range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int mods,
-             const int logged)
+             const int logged, const int linear, const int one)
 {
     /* The list's columns in locals: through p, the compiler reloaded each
      * column's address from the struct after every store to another. */
@@ -249,6 +249,8 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
     /* A constant here: each variant runs one normal law, and a power-law
      * variant without damping or friction never reads a velocity. */
     P.normal_law = mods & MOD_POWER ? BAL_NORMAL_POWER : BAL_NORMAL_INCREMENTAL;
+    if (linear)
+        P.nu = 1; /* (it is: a constant for the compiler) */
     const int n_mat = s->n_mat;
     const struct bal_pair_law *restrict laws = s->law;
     const struct bal_pair_law *restrict one_law = s->disc_law;
@@ -313,7 +315,7 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
             const long c = c0 + tc[q];
             const int i = pi[c], j = pj[c];
             const double rs = r[i] + r[j];
-            const struct bal_pair_law *L = one_law ? one_law : &laws[mat[i] * n_mat + mat[j]];
+            const struct bal_pair_law *L = one ? one_law : &laws[mat[i] * n_mat + mat[j]];
             const double dist = tq[q], ex = tdx[q], ey = tdy[q];
             const double rvx = vx[i] - vx[j], rvy = vy[i] - vy[j];
             struct bal_kin k;
@@ -405,13 +407,14 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
                 }
                 continue;
             }
-            f[3 * i] -= fcx;
-            f[3 * i + 1] -= fcy;
-            f[3 * j] += fcx;
-            f[3 * j + 1] += fcy;
+            double *restrict fi = f + 3 * (size_t)i, *restrict fj = f + 3 * (size_t)j;
+            fi[0] -= fcx;
+            fi[1] -= fcy;
+            fj[0] += fcx;
+            fj[1] += fcy;
             if (shear) {
-                f[3 * i + 2] += tqi;
-                f[3 * j + 2] += tqj;
+                fi[2] += tqi;
+                fj[2] += tqj;
             }
             if (damp) {
                 /* the dashpots' share, for their work at t_N (energy.c) */
@@ -443,7 +446,7 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
 static __attribute__((noinline)) struct range_state
 logged_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int mods)
 {
-    return range_chunks(s, t, st, mods, 1);
+    return range_chunks(s, t, st, mods, 1, 0, 0);
 }
 
 static inline __attribute__((always_inline)) void
@@ -453,7 +456,16 @@ pair_range(struct bal_sim *restrict s, int t, const int mods)
     s->par.log_n[t] = 0;
     if (t > 0)
         st = logged_chunks(s, t, st, mods);
-    st = range_chunks(s, t, st, mods, 0);
+    /* The loop compiled for the common cases too: the linear power law (no
+     * test of ν at each contact, no call of pow in the loop) and one material
+     * (no test for it at each contact). */
+    const int linear = (mods & MOD_POWER) && s->nu == 1.0, one = s->disc_law != NULL;
+    if (linear && one)
+        st = range_chunks(s, t, st, mods, 0, 1, 1);
+    else if (one)
+        st = range_chunks(s, t, st, mods, 0, 0, 1);
+    else
+        st = range_chunks(s, t, st, mods, 0, 0, 0);
     if (t == s->par.ranges - 1)
         clear_sums(s->f, s->dash, st.cleared + 1, s->n - 1, (mods & MOD_DAMP) != 0);
     s->par.over[t] = st.over;

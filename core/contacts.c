@@ -39,7 +39,16 @@
  * normal law and the optional sub-models (MOD_* bits: tangential, damping;
  * PAIR_VARIANT), and one is chosen when the simulation is created, so a
  * scene without friction or damping never runs their code or touches their
- * history.
+ * history.  Within a variant, the linear power law and a scene of one
+ * material get loops of their own (no test of ν or of the material at each
+ * contact).
+ *
+ * The disc–disc loop takes the list in chunks of 256 candidates, in three
+ * passes each: which candidates touch (no branch on the answer), then D and
+ * e of the touching ones two at a time (SSE2: the same IEEE results), then
+ * the chain of kernels at each contact, in the list's order, so the force
+ * sums add the same terms in the same order as one pass would
+ * (docs/benchmarks.md, speed round two).
  */
 #include <math.h>
 #include <stdlib.h>

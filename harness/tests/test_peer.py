@@ -3,6 +3,7 @@ LAMMPS data file and input it writes, the LAMMPS logs and dumps it reads, the fo
 contact conventions of the cross-check, the figures it prints.  No LAMMPS run here; one test
 runs bin/ballast for three steps (skipped when it is not built)."""
 import importlib.util
+import json
 import math
 import pathlib
 import re
@@ -465,6 +466,23 @@ def test_ballast_runs_the_written_scene_and_moves_a_free_disc_by_v_half(tmp_path
     assert final["y"] == pytest.approx(s["y"] + n * dt * s["vy"] - 9.81 * dt * dt * n * (n - 1) / 2,
                                        abs=1e-15)
     assert final["m"] == pytest.approx(math.pi * s["r"] ** 2, rel=1e-15)
+
+
+def test_race_scenes_give_ballast_its_motion_skin_and_the_cross_check_keeps_the_default(tmp_path):
+    """The race writes skin_rule = motion (ballast's own choice of skin, issue 24); the
+    cross-check's scenes write no skin_rule (the core's default, fixed); ballast reads it
+    back into run.json's skin."""
+    s = state_of([1.0, 4.0], [2.0, 2.0], [0.5, 0.6])
+    assert race.RACE_SKIN_RULE == "motion"
+    r = race.Race("settling", tmp_path / "race", s, (0.0, 6.0, 0.0, 6.0), 1e-3, 5, "")
+    secs = dict(sections(r.scene(5).read_text()))
+    assert secs["[settings]"]["skin_rule"] == "motion"
+    assert "skin_rule" not in dict(sections(race.ballast_scene(s, (0, 6, 0, 6), 1e-3, 5, "t")))["[settings]"]
+    out = tmp_path / "out"
+    subprocess.run([str(ROOT / "bin" / "ballast"), "run", str(r.scene(5)), "--out", str(out),
+                    "--set", "settings.grid=on"], check=True, capture_output=True)
+    run = json.loads((out / "run.json").read_text())
+    assert run["skin"] == pytest.approx(0.2 * 0.6, rel=1e-15)  # the first skin: no rebuild yet
 
 
 def test_extend_skin_goes_past_an_end_only_while_the_end_is_fastest():

@@ -39,9 +39,9 @@
  * normal law and the optional sub-models (MOD_* bits: tangential, damping;
  * PAIR_VARIANT), and one is chosen when the simulation is created, so a
  * scene without friction or damping never runs their code or touches their
- * history.  Within a variant, the linear power law and a scene of one
- * material get loops of their own (no test of ν or of the material at each
- * contact).
+ * history.  Within a variant, a scene of one material, and one of one
+ * material with the linear power law, get loops of their own (no test of
+ * the material or of ν at each contact).
  *
  * The disc–disc loop takes the list in chunks of 256 candidates, in three
  * passes each: which candidates touch (no branch on the answer), then D and
@@ -465,9 +465,10 @@ pair_range(struct bal_sim *restrict s, int t, const int mods)
     s->par.log_n[t] = 0;
     if (t > 0)
         st = logged_chunks(s, t, st, mods);
-    /* The loop compiled for the common cases too: the linear power law (no
-     * test of ν at each contact, no call of pow in the loop) and one material
-     * (no test for it at each contact). */
+    /* The loop compiled for the common cases too: one material (no test for
+     * it at each contact), and with it the linear power law (no test of ν at
+     * each contact, no call of pow in the loop).  The logged chunks of the
+     * ranges after the first keep the general loop: they are few. */
     const int linear = (mods & MOD_POWER) && s->nu == 1.0, one = s->disc_law != NULL;
     if (linear && one)
         st = range_chunks(s, t, st, mods, 0, 1, 1);

@@ -288,10 +288,14 @@ search(struct bal_sim *s, double inv_h, long *count, long *edge, const int band,
 /* The skin from the measured motion (skin_rule = motion)              */
 /* ------------------------------------------------------------------ */
 
-/* A rebuild's cost per disc, in units of one candidate's cost in the pair
- * loop for one cycle.  Measured on the settling race scene of bench-peer
- * (20 000 discs falling, skin 0.15, 2026-11-27, docs/benchmarks.md): a
- * rebuild took 69 ns a disc, and the pair loop 7.1 ns a candidate, 9.7. */
+/* A rebuild's cost per disc, in units of the pair loop's cost for one more
+ * candidate in one cycle.  Calibrated on the settling race scene of
+ * bench-peer (20 000 discs falling, 2026-11-27, docs/benchmarks.md): at skin
+ * 0.15 a rebuild took 69 ns a disc and the pair loop 7.1 ns an average
+ * candidate (9.7), but the candidates a wider skin adds do not touch and
+ * cost about a third of the average: with 10 the rule chose half the best
+ * fixed skin (5.15 against 5.5e7 particle-steps/s), with 25 it matched it
+ * (5.48e7; 40 gave 5.49e7). */
 #define REBUILD_COST_IN_CANDIDATES 25.0
 /* The rule's bounds, as shares of the largest radius, and its largest step
  * (a factor) from one rebuild to the next. */

@@ -303,6 +303,18 @@ search(struct bal_sim *s, double inv_h, long *count, long *edge, const int band,
 #define SKIN_HI 1.0
 #define SKIN_STEP 2.0
 
+/* The widest skin the rule may choose: SKIN_HI r_max, and no wider than
+ * keeps the candidates of a disc of the smallest radius within half of
+ * MAX_NEIGHBOURS (discs of radius r_min packed around it out to r_min +
+ * r_max + skin: ((r_min + r_max + skin)/r_min)² <= MAX_NEIGHBOURS/2), so that
+ * a wide grading never meets the rebuild's limit because of the rule; but
+ * never below SKIN_LO r_max. */
+static double motion_skin_max(const struct bal_sim *s)
+{
+    const double crowd = sqrt(0.5 * MAX_NEIGHBOURS) * s->r_min - s->r_min - s->r_max;
+    return fmax(fmin(SKIN_HI * s->r_max, crowd), SKIN_LO * s->r_max);
+}
+
 /* The skin of the next lists.  A cycle costs about
  *
  *     J(s) = C N / T(s) + n(s)          (in candidate-cycles)
@@ -335,7 +347,7 @@ static double motion_skin(const struct bal_sim *s)
     if (!isfinite(skin))
         return s->skin;
     skin = fmin(fmax(skin, s->skin / SKIN_STEP), s->skin * SKIN_STEP);
-    return fmin(fmax(skin, SKIN_LO * s->r_max), SKIN_HI * s->r_max);
+    return fmin(fmax(skin, SKIN_LO * s->r_max), motion_skin_max(s));
 }
 
 enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)

@@ -583,6 +583,16 @@ static const char *const falling_fmt =
     "box = 1\nmaterial = g\nwall_material = w\n"
     "[stage s]\ncycles = 1\n";
 
+/* The same packing with other radii (grid, skin_rule, rmin, rmax). */
+static const char *const falling_fmt_radii =
+    "[settings]\ngrid = %s\nskin_rule = %s\ngravity = 0 -9.81\n"
+    "dt = 0.0001\n"
+    "[material g]\nkn = 1e5\nks = 0.8e5\nfriction = 0.5\ndensity = 1\n"
+    "[material w]\nkn = 1e5\nfriction = 0.3\n"
+    "[fill pack]\nn = 300\ncolumns = 20\nrmin = %g\nrmax = %g\nvmax = 4.0\nseed = 11\n"
+    "box = 1\nmaterial = g\nwall_material = w\n"
+    "[stage s]\ncycles = 1\n";
+
 /* Every touching pair and disc–wall contact of s is a candidate. */
 static long unlisted_contacts(const struct bal_sim *s, long *touching)
 {
@@ -639,6 +649,38 @@ START_TEST(grid_motion_skin_misses_no_contact)
     ck_assert(widest <= 1.0 * r_max && narrowest >= 0.05 * r_max);
     ck_assert_int_lt(info_of(on).rebuilds, info_of(fixed).rebuilds);
     ck_assert_double_eq(info_of(fixed).skin, first);
+}
+END_TEST
+
+/* skin_rule = motion with a wide grading: radii 0.06 to 1, so that a skin of
+ * r_max would let a disc of r_min have ((0.06 + 1 + 1)/0.06)² ≈ 1180 discs
+ * of its size within reach, past the rebuild's limit of 512.  The rule's
+ * widest skin is then 16 r_min − r_min − r_max = −0.1, raised to its floor
+ * 0.05 r_max: over 6000 cycles (134 rebuilds) the skin only shrinks from
+ * its first 0.2 r_max, the run never meets the limit, and every contact is
+ * listed. */
+START_TEST(grid_motion_skin_stays_narrow_for_a_wide_grading)
+{
+    struct tfx *f = tfx_newf("wide", falling_fmt_radii, "on", "motion", 0.06, 1.0);
+    const struct bal_sim *s = f->sim;
+    const double r_max = s->r_max; /* (the fill's largest draw, just under 1) */
+    ck_assert(15 * s->r_min - r_max < 0.05 * r_max);
+    ck_assert_double_eq_tol(s->skin, 0.2 * r_max, 1e-15);
+    double widest = 0, narrowest = 1;
+    long missed = 0, touching = 0;
+    for (int k = 0; k < 6000; k++) {
+        t_steps(f, 1);
+        missed += unlisted_contacts(s, &touching);
+        if (k > 0) {
+            widest = fmax(widest, s->skin);
+            narrowest = fmin(narrowest, s->skin);
+        }
+    }
+    ck_assert_int_gt(info_of(f).rebuilds, 3);
+    ck_assert_double_eq_tol(narrowest, 0.05 * r_max, 1e-15);
+    ck_assert(widest <= 0.2 * r_max);
+    ck_assert_int_eq(missed, 0);
+    ck_assert_int_gt(touching, 10000); /* 17 712 touching pair-cycles: the check is not empty */
 }
 END_TEST
 
@@ -871,6 +913,7 @@ Suite *suite_grid(void)
     tcase_add_test(tc, grid_rattlers_keep_their_lists);
     tcase_add_test(tc, grid_motion_skin_misses_no_contact);
     tcase_add_test(tc, grid_motion_skin_lists_a_projectile);
+    tcase_add_test(tc, grid_motion_skin_stays_narrow_for_a_wide_grading);
     tcase_add_test(tc, grid_movers_meet_two_cells_apart);
     tcase_add_test(tc, grid_reorder_is_no_physics);
     suite_add_tcase(s, tc);

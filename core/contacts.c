@@ -212,6 +212,110 @@ struct range_state {
     int over;    /* an overlap past the sieve */
 };
 
+
+#if defined(__SSE2__)
+/* Pass 3 of the commonest loop (linear power law, tangential spring, no
+ * damping or rolling, one material, no logging) two contacts at a time:
+ * the same operations as the kernels of laws.h, lane by lane, so the same
+ * bits; the force sums are then added contact by contact in the list's
+ * order, and the losses of sliding contacts too.  Returns the contacts done (nt rounded
+ * down to even); the loop below does the last. */
+static inline __attribute__((always_inline)) int
+linear_shear_pairs(struct bal_sim *restrict s, long c0, const int32_t *restrict tc,
+                   const double *restrict tq, const double *restrict tdx,
+                   const double *restrict tdy, int nt, double budget, int *over,
+                   double *lost_fric)
+{
+    const struct bal_pairs *p = &s->pp;
+    const int32_t *restrict pi = p->i, *restrict pj = p->j;
+    double *restrict pfn = p->fn, *restrict pfs = p->fs;
+    uint8_t *restrict pflags = p->flags;
+    const double *restrict r = s->r, *restrict vx = s->vx, *restrict vy = s->vy;
+    const double *restrict w = s->w;
+    double *restrict f = s->f;
+    const struct bal_pair_law *L = s->disc_law;
+    const __m128d kn = _mm_set1_pd(L->kn), ks = _mm_set1_pd(L->ks);
+    const __m128d tanp = _mm_set1_pd(L->tan_phi), coh = _mm_set1_pd(L->cohesion);
+    const __m128d dt = _mm_set1_pd(s->dt), bud = _mm_set1_pd(budget);
+    const __m128d sign = _mm_set1_pd(-0.0);
+    int ov = 0;
+    const int n2 = nt & ~1;
+    for (int q = 0; q < n2; q += 2) {
+        const long ca = c0 + tc[q], cb = c0 + tc[q + 1];
+        const int ia = pi[ca], ja = pj[ca], ib = pi[cb], jb = pj[cb];
+        const __m128d ri = _mm_set_pd(r[ib], r[ia]), rj = _mm_set_pd(r[jb], r[ja]);
+        const __m128d rs = _mm_add_pd(ri, rj);
+        /* D and e here rather than in pass 2 (the same operations) */
+        const __m128d dist = _mm_sqrt_pd(_mm_loadu_pd(tq + q));
+        const __m128d ex = _mm_div_pd(_mm_loadu_pd(tdx + q), dist);
+        const __m128d ey = _mm_div_pd(_mm_loadu_pd(tdy + q), dist);
+        const __m128d rvx = _mm_sub_pd(_mm_set_pd(vx[ib], vx[ia]), _mm_set_pd(vx[jb], vx[ja]));
+        const __m128d rvy = _mm_sub_pd(_mm_set_pd(vy[ib], vy[ia]), _mm_set_pd(vy[jb], vy[ja]));
+        const __m128d delta = _mm_sub_pd(rs, dist);
+        ov |= _mm_movemask_pd(_mm_cmpgt_pd(delta, bud));
+        const __m128d fn = _mm_mul_pd(kn, delta);
+        /* ṡ = (rvx t_x + rvy t_y) − (ω_i r_i + ω_j r_j), t = (e_y, −e_x) */
+        const __m128d ty = _mm_xor_pd(ex, sign);
+        const __m128d wr = _mm_add_pd(_mm_mul_pd(_mm_set_pd(w[ib], w[ia]), ri),
+                                      _mm_mul_pd(_mm_set_pd(w[jb], w[ja]), rj));
+        const __m128d sdot = _mm_sub_pd(_mm_add_pd(_mm_mul_pd(rvx, ey), _mm_mul_pd(rvy, ty)), wr);
+        __m128d fs = _mm_add_pd(_mm_set_pd(pfs[cb], pfs[ca]), _mm_mul_pd(_mm_mul_pd(ks, sdot), dt));
+        const __m128d fmax = _mm_add_pd(_mm_mul_pd(fn, tanp), coh);
+        const int slide = _mm_movemask_pd(_mm_cmpgt_pd(_mm_andnot_pd(sign, fs), fmax));
+        double fsa, fsb, fna = _mm_cvtsd_f64(fn), fnb = _mm_cvtsd_f64(_mm_unpackhi_pd(fn, fn));
+        uint8_t fla = BAL_PAIR_TOUCHING, flb = BAL_PAIR_TOUCHING;
+        if (slide) {
+            /* bal_law_tangential's cap, lane by lane: the loss
+             * F_max (|F_s| − F_max)/k_s of each sliding contact, added in
+             * order, and F_s = copysign(F_max, F_s) */
+            const __m128d afs = _mm_andnot_pd(sign, fs);
+            const __m128d loss = _mm_div_pd(_mm_mul_pd(fmax, _mm_sub_pd(afs, fmax)), ks);
+            const __m128d capped = _mm_or_pd(_mm_andnot_pd(sign, fmax), _mm_and_pd(sign, fs));
+            if (slide & 1) {
+                *lost_fric += _mm_cvtsd_f64(loss);
+                fla |= BAL_PAIR_SLIDING;
+            }
+            if (slide & 2) {
+                *lost_fric += _mm_cvtsd_f64(_mm_unpackhi_pd(loss, loss));
+                flb |= BAL_PAIR_SLIDING;
+            }
+            const __m128d m = _mm_cmpgt_pd(afs, fmax);
+            fs = _mm_or_pd(_mm_and_pd(m, capped), _mm_andnot_pd(m, fs));
+            fsa = _mm_cvtsd_f64(fs);
+            fsb = _mm_cvtsd_f64(_mm_unpackhi_pd(fs, fs));
+        } else {
+            fsa = _mm_cvtsd_f64(fs);
+            fsb = _mm_cvtsd_f64(_mm_unpackhi_pd(fs, fs));
+        }
+        pfn[ca] = fna;
+        pfn[cb] = fnb;
+        pfs[ca] = fsa;
+        pfs[cb] = fsb;
+        pflags[ca] = fla;
+        pflags[cb] = flb;
+        /* moments F_s r, and the force +(F_n e + F_s t) on j */
+        const __m128d tqi = _mm_mul_pd(fs, ri), tqj = _mm_mul_pd(fs, rj);
+        const __m128d fcx = _mm_add_pd(_mm_mul_pd(fn, ex), _mm_mul_pd(fs, ey));
+        const __m128d fcy = _mm_sub_pd(_mm_mul_pd(fn, ey), _mm_mul_pd(fs, ex));
+        /* (F_x, F_y) of each contact as one pair of lanes: the same
+         * additions to the same sums, in the same order */
+        const __m128d fa_ = _mm_unpacklo_pd(fcx, fcy), fb_ = _mm_unpackhi_pd(fcx, fcy);
+        double *restrict fa = f + 3 * (size_t)ia, *restrict fja = f + 3 * (size_t)ja;
+        _mm_storeu_pd(fa, _mm_sub_pd(_mm_loadu_pd(fa), fa_));
+        _mm_storeu_pd(fja, _mm_add_pd(_mm_loadu_pd(fja), fa_));
+        fa[2] += _mm_cvtsd_f64(tqi);
+        fja[2] += _mm_cvtsd_f64(tqj);
+        double *restrict fb = f + 3 * (size_t)ib, *restrict fjb = f + 3 * (size_t)jb;
+        _mm_storeu_pd(fb, _mm_sub_pd(_mm_loadu_pd(fb), fb_));
+        _mm_storeu_pd(fjb, _mm_add_pd(_mm_loadu_pd(fjb), fb_));
+        fb[2] += _mm_cvtsd_f64(_mm_unpackhi_pd(tqi, tqi));
+        fjb[2] += _mm_cvtsd_f64(_mm_unpackhi_pd(tqj, tqj));
+    }
+    *over |= ov != 0;
+    return n2;
+}
+#endif
+
 /* A range of the disc–disc list (all of it on one thread; see struct
  * bal_par in state.h for several).  The loop starts the cycle's force sums.
  * It runs in chunks of CLEAR_CHUNK candidates; before a chunk, the sums of
@@ -317,10 +421,26 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
                     pmr[c] = ptr[c] = 0;
             }
         }
-        /* Pass 2: D and e of the touching ones, several per instruction. */
-        unit_vectors(tq, tdx, tdy, nt);
+        /* Pass 2: D and e of the touching ones, several per instruction
+         * (the pairs of the loop for the commonest law take theirs in
+         * pass 3, and the last one, if odd, here). */
+        int q0 = 0;
+#if defined(__SSE2__)
+        const int pairs = mods == (MOD_POWER | MOD_SHEAR) && linear && one && !logged &&
+                          one_law->shear;
+#else
+        const int pairs = 0;
+#endif
+        if (!pairs)
+            unit_vectors(tq, tdx, tdy, nt);
+        else if (nt & 1)
+            unit_vectors(tq + nt - 1, tdx + nt - 1, tdy + nt - 1, 1);
         /* Pass 3: the law at each touching contact, in the list's order. */
-        for (int q = 0; q < nt; q++) {
+#if defined(__SSE2__)
+        if (pairs)
+            q0 = linear_shear_pairs(s, c0, tc, tq, tdx, tdy, nt, budget, &over, &lost_fric);
+#endif
+        for (int q = q0; q < nt; q++) {
             const long c = c0 + tc[q];
             const int i = pi[c], j = pj[c];
             const double rs = r[i] + r[j];

@@ -919,6 +919,53 @@ START_TEST(contacts_one_material_law)
 }
 END_TEST
 
+/* The same comparison for the loop that runs two contacts at a time with
+ * SSE2 (contacts.c, linear_shear_pairs: power law with nu = 1, tangential
+ * spring, no damping, one material): one material takes it, the twin
+ * materials the general scalar loop, and positions, velocities, force
+ * sums, every contact's F_n, F_s and flags and the friction loss of the
+ * energy audit must agree bit for bit, through contacts that slide. */
+static const char *const one_mat_power_scene =
+    "[settings]\ndt = 5e-4\ngravity = 0 -60\nnormal_law = power\nnu = 1\n"
+    "[material grain]\nkn = 1e5\nks = 7e4\nfriction = 0.4\ncohesion = 3\ndensity = 1\n"
+    "[material twin]\nkn = 1e5\nks = 7e4\nfriction = 0.4\ncohesion = 3\ndensity = 1\n"
+    "[material box]\nkn = 3e5\nks = 1e5\nfriction = 0.2\n"
+    "[fill pack]\nn = 400\ncolumns = 20\nrmin = 0.5\nrmax = 0.75\nseed = 3\nbox = 1\n"
+    "headroom = 2\nvmax = 2\nmaterial = grain\nwall_material = box\n[stage s]\ncycles = 100000\n";
+
+START_TEST(contacts_pairs_of_contacts_match_the_scalar_law)
+{
+    struct tfx *one = tfx_new(one_mat_power_scene, "one");
+    struct tfx *mixed = tfx_new(one_mat_power_scene, "mixed");
+    struct bal_sim *a = one->sim, *b = mixed->sim;
+    const int twin = bal_scene_find(&one->sc, BAL_SEC_MATERIAL, "twin");
+    for (int i = 1; i < b->n; i += 2)
+        b->mat[i] = twin;
+    b->disc_law = NULL;
+    long sliding = 0, contacts = 0;
+    for (int k = 0; k < 1500; k++) {
+        t_steps(one, 1);
+        t_steps(mixed, 1);
+        for (long c = 0; c < a->pp.n; c++) {
+            sliding += (a->pp.flags[c] & BAL_PAIR_SLIDING) != 0;
+            contacts += (a->pp.flags[c] & BAL_PAIR_TOUCHING) != 0;
+        }
+    }
+    ck_assert_int_gt(contacts, 200 * 1000); /* the discs collide and pile up */
+    ck_assert_int_gt(sliding, 1000);        /* and slide: the loss path runs */
+    const size_t n = (size_t)a->n * sizeof(double);
+    ck_assert(memcmp(a->x, b->x, n) == 0 && memcmp(a->y, b->y, n) == 0);
+    ck_assert(memcmp(a->vx, b->vx, n) == 0 && memcmp(a->w, b->w, n) == 0);
+    ck_assert(memcmp(a->f, b->f, 3 * n) == 0);
+    ck_assert_int_eq(a->pp.n, b->pp.n);
+    const size_t m = (size_t)a->pp.n * sizeof(double);
+    ck_assert(memcmp(a->pp.fn, b->pp.fn, m) == 0 && memcmp(a->pp.fs, b->pp.fs, m) == 0);
+    ck_assert(memcmp(a->pp.flags, b->pp.flags, (size_t)a->pp.n) == 0);
+    ck_assert(memcmp(&a->audit.d_friction, &b->audit.d_friction, sizeof(double)) == 0);
+    ck_assert(a->audit.d_friction > 0);
+}
+END_TEST
+
 /* Every cycle starts the force sums from zero: the pair loop zeroes them
  * chunk by chunk, up to each chunk's highest j, and the rest at its end
  * (contacts.c).  Sums poisoned with NaN before a cycle must come out as the
@@ -986,6 +1033,7 @@ Suite *suite_contacts(void)
     tcase_add_test(tc, contacts_no_tension_and_reset);
     tcase_add_test(tc, contacts_sums_restart_each_cycle);
     tcase_add_test(tc, contacts_one_material_law);
+    tcase_add_test(tc, contacts_pairs_of_contacts_match_the_scalar_law);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("friction");

@@ -48,7 +48,10 @@
  * e of the touching ones two at a time (SSE2: the same IEEE results), then
  * the chain of kernels at each contact, in the list's order, so the force
  * sums add the same terms in the same order as one pass would
- * (docs/benchmarks.md, speed round two).
+ * (docs/benchmarks.md, speed round two).  The commonest law (power law with
+ * ν = 1, tangential spring, no damping or rolling, one material) takes its
+ * contacts two at a time in the third pass, D and e included
+ * (linear_shear_pairs: the kernels' operations lane by lane, the same bits).
  */
 #include <math.h>
 #include <stdlib.h>

@@ -303,6 +303,15 @@ search(struct bal_sim *s, double inv_h, long *count, long *edge, const int band,
 #define SKIN_HI 1.0
 #define SKIN_STEP 2.0
 
+/* The largest displacement of a wall since the lists were built. */
+static double walls_moved(const struct bal_sim *s)
+{
+    double wmax = 0;
+    for (int k = 0; k < s->n_walls; k++)
+        wmax = fmax(wmax, s->walls[k].disp);
+    return wmax;
+}
+
 /* The widest skin the rule may choose: SKIN_HI r_max, and no wider than
  * keeps the candidates of a disc of the smallest radius within half of
  * MAX_NEIGHBOURS (discs of radius r_min packed around it out to r_min +
@@ -338,10 +347,7 @@ static double motion_skin(const struct bal_sim *s)
     const long cycles = s->step - s->built_step;
     if (cycles <= 0 || s->skin_edge <= 0)
         return s->skin;
-    const double d1 = sqrt(s->moved_sq);
-    double wmax = 0;
-    for (int k = 0; k < s->n_walls; k++)
-        wmax = fmax(wmax, s->walls[k].disp);
+    const double d1 = sqrt(s->moved_sq), wmax = walls_moved(s);
     const double u = fmax(2 * d1, d1 + wmax) / (double)cycles;
     double skin = sqrt(REBUILD_COST_IN_CANDIDATES * s->n * u / s->skin_edge);
     if (!isfinite(skin))
@@ -684,9 +690,6 @@ int bal_grid_due(const struct bal_sim *s, struct bal_moves moved)
 {
     if (!s->use_grid)
         return 0;
-    const double d1 = sqrt(moved.d1_sq), d2 = sqrt(moved.d2_sq);
-    double wmax = 0;
-    for (int k = 0; k < s->n_walls; k++)
-        wmax = fmax(wmax, s->walls[k].disp);
+    const double d1 = sqrt(moved.d1_sq), d2 = sqrt(moved.d2_sq), wmax = walls_moved(s);
     return d1 + wmax >= s->skin || (d1 + d2 >= s->skin && lists_broken(s, d1));
 }

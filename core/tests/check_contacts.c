@@ -874,8 +874,9 @@ END_TEST
  * material of the same parameters takes the general path (disc_law NULL,
  * as creation sets it for mixed materials) and must give bitwise the same
  * positions, velocities and forces: the one law is the right one. */
-static const char *const one_mat_scene =
-    "[settings]\ndt = 5e-4\ngravity = 0 -60\nbeta = 0.01\n"
+/* (the settings line: the law and its damping) */
+static const char *const one_mat_fmt =
+    "[settings]\ndt = 5e-4\ngravity = 0 -60\n%s\n"
     "[material grain]\nkn = 1e5\nks = 7e4\nfriction = 0.4\ncohesion = 3\ndensity = 1\n"
     "[material twin]\nkn = 1e5\nks = 7e4\nfriction = 0.4\ncohesion = 3\ndensity = 1\n"
     "[material box]\nkn = 3e5\nks = 1e5\nfriction = 0.2\n"
@@ -884,8 +885,8 @@ static const char *const one_mat_scene =
 
 START_TEST(contacts_one_material_law)
 {
-    struct tfx *one = tfx_new(one_mat_scene, "one");
-    struct tfx *mixed = tfx_new(one_mat_scene, "mixed");
+    struct tfx *one = tfx_newf("one", one_mat_fmt, "beta = 0.01");
+    struct tfx *mixed = tfx_newf("mixed", one_mat_fmt, "beta = 0.01");
     struct bal_sim *a = one->sim, *b = mixed->sim;
     const int grain = a->mat[0], twin = bal_scene_find(&one->sc, BAL_SEC_MATERIAL, "twin");
     ck_assert_int_ne(twin, grain);
@@ -924,19 +925,12 @@ END_TEST
  * spring, no damping, one material): one material takes it, the twin
  * materials the general scalar loop, and positions, velocities, force
  * sums, every contact's F_n, F_s and flags and the friction loss of the
- * energy audit must agree bit for bit, through contacts that slide. */
-static const char *const one_mat_power_scene =
-    "[settings]\ndt = 5e-4\ngravity = 0 -60\nnormal_law = power\nnu = 1\n"
-    "[material grain]\nkn = 1e5\nks = 7e4\nfriction = 0.4\ncohesion = 3\ndensity = 1\n"
-    "[material twin]\nkn = 1e5\nks = 7e4\nfriction = 0.4\ncohesion = 3\ndensity = 1\n"
-    "[material box]\nkn = 3e5\nks = 1e5\nfriction = 0.2\n"
-    "[fill pack]\nn = 400\ncolumns = 20\nrmin = 0.5\nrmax = 0.75\nseed = 3\nbox = 1\n"
-    "headroom = 2\nvmax = 2\nmaterial = grain\nwall_material = box\n[stage s]\ncycles = 100000\n";
-
+ * energy audit must agree bit for bit, through contacts that slide (the
+ * scene of the test above, undamped and with the linear power law). */
 START_TEST(contacts_pairs_of_contacts_match_the_scalar_law)
 {
-    struct tfx *one = tfx_new(one_mat_power_scene, "one");
-    struct tfx *mixed = tfx_new(one_mat_power_scene, "mixed");
+    struct tfx *one = tfx_newf("one", one_mat_fmt, "normal_law = power\nnu = 1");
+    struct tfx *mixed = tfx_newf("mixed", one_mat_fmt, "normal_law = power\nnu = 1");
     struct bal_sim *a = one->sim, *b = mixed->sim;
     const int twin = bal_scene_find(&one->sc, BAL_SEC_MATERIAL, "twin");
     for (int i = 1; i < b->n; i += 2)

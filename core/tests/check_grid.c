@@ -574,19 +574,9 @@ END_TEST
  * stay within the rule's bounds (0.05 to 1 r_max), and the rebuilds be
  * fewer than with the fixed skin of the same scene; after the first 400
  * cycles the run must also be the all-pairs run to round-off (AGREE_ABS). */
-static const char *const falling_fmt =
+static const char *const falling_fmt = /* grid, skin_rule, dt, rmin, rmax */
     "[settings]\ngrid = %s\nskin_rule = %s\ngravity = 0 -9.81\n"
-    "dt = 0.00075788534449010318\n"
-    "[material g]\nkn = 1e5\nks = 0.8e5\nfriction = 0.5\ndensity = 1\n"
-    "[material w]\nkn = 1e5\nfriction = 0.3\n"
-    "[fill pack]\nn = 300\ncolumns = 20\nrmin = 0.7\nrmax = 1.0\nvmax = 4.0\nseed = 11\n"
-    "box = 1\nmaterial = g\nwall_material = w\n"
-    "[stage s]\ncycles = 1\n";
-
-/* The same packing with other radii (grid, skin_rule, rmin, rmax). */
-static const char *const falling_fmt_radii =
-    "[settings]\ngrid = %s\nskin_rule = %s\ngravity = 0 -9.81\n"
-    "dt = 0.0001\n"
+    "dt = %.17g\n"
     "[material g]\nkn = 1e5\nks = 0.8e5\nfriction = 0.5\ndensity = 1\n"
     "[material w]\nkn = 1e5\nfriction = 0.3\n"
     "[fill pack]\nn = 300\ncolumns = 20\nrmin = %g\nrmax = %g\nvmax = 4.0\nseed = 11\n"
@@ -619,9 +609,10 @@ static long unlisted_contacts(const struct bal_sim *s, long *touching)
 
 START_TEST(grid_motion_skin_misses_no_contact)
 {
-    struct tfx *on = tfx_newf("motion", falling_fmt, "on", "motion");
-    struct tfx *off = tfx_newf("off", falling_fmt, "off", "fixed");
-    struct tfx *fixed = tfx_newf("fixed", falling_fmt, "on", "fixed");
+    const double dt = 0.00075788534449010318;
+    struct tfx *on = tfx_newf("motion", falling_fmt, "on", "motion", dt, 0.7, 1.0);
+    struct tfx *off = tfx_newf("off", falling_fmt, "off", "fixed", dt, 0.7, 1.0);
+    struct tfx *fixed = tfx_newf("fixed", falling_fmt, "on", "fixed", dt, 0.7, 1.0);
     const struct bal_sim *a = on->sim, *b = off->sim;
     const double first = info_of(on).skin, r_max = a->r_max;
     ck_assert_double_eq_tol(first, 0.2 * r_max, 1e-15);
@@ -661,7 +652,7 @@ END_TEST
  * listed. */
 START_TEST(grid_motion_skin_stays_narrow_for_a_wide_grading)
 {
-    struct tfx *f = tfx_newf("wide", falling_fmt_radii, "on", "motion", 0.06, 1.0);
+    struct tfx *f = tfx_newf("wide", falling_fmt, "on", "motion", 1e-4, 0.06, 1.0);
     const struct bal_sim *s = f->sim;
     const double r_max = s->r_max; /* (the fill's largest draw, just under 1) */
     ck_assert(15 * s->r_min - r_max < 0.05 * r_max);

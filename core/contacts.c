@@ -264,7 +264,7 @@ linear_shear_pairs(struct bal_sim *restrict s, long c0, const int32_t *restrict 
         __m128d fs = _mm_add_pd(_mm_set_pd(pfs[cb], pfs[ca]), _mm_mul_pd(_mm_mul_pd(ks, sdot), dt));
         const __m128d fmax = _mm_add_pd(_mm_mul_pd(fn, tanp), coh);
         const int slide = _mm_movemask_pd(_mm_cmpgt_pd(_mm_andnot_pd(sign, fs), fmax));
-        const double fna = _mm_cvtsd_f64(fn), fnb = _mm_cvtsd_f64(_mm_unpackhi_pd(fn, fn));
+        double fsa, fsb, fna = _mm_cvtsd_f64(fn), fnb = _mm_cvtsd_f64(_mm_unpackhi_pd(fn, fn));
         uint8_t fla = BAL_PAIR_TOUCHING, flb = BAL_PAIR_TOUCHING;
         if (slide) {
             /* bal_law_tangential's cap, lane by lane: the loss
@@ -283,8 +283,12 @@ linear_shear_pairs(struct bal_sim *restrict s, long c0, const int32_t *restrict 
             }
             const __m128d m = _mm_cmpgt_pd(afs, fmax);
             fs = _mm_or_pd(_mm_and_pd(m, capped), _mm_andnot_pd(m, fs));
+            fsa = _mm_cvtsd_f64(fs);
+            fsb = _mm_cvtsd_f64(_mm_unpackhi_pd(fs, fs));
+        } else {
+            fsa = _mm_cvtsd_f64(fs);
+            fsb = _mm_cvtsd_f64(_mm_unpackhi_pd(fs, fs));
         }
-        const double fsa = _mm_cvtsd_f64(fs), fsb = _mm_cvtsd_f64(_mm_unpackhi_pd(fs, fs));
         pfn[ca] = fna;
         pfn[cb] = fnb;
         pfs[ca] = fsa;
@@ -424,15 +428,20 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
          * pass 3, and the last one, if odd, here). */
         int q0 = 0;
 #if defined(__SSE2__)
-        if (mods == (MOD_POWER | MOD_SHEAR) && linear && one && !logged && one_law->shear) {
-            if (nt & 1)
-                unit_vectors(tq + nt - 1, tdx + nt - 1, tdy + nt - 1, 1);
-            /* Pass 3 of these pairs */
-            q0 = linear_shear_pairs(s, c0, tc, tq, tdx, tdy, nt, budget, &over, &lost_fric);
-        } else
+        const int pairs = mods == (MOD_POWER | MOD_SHEAR) && linear && one && !logged &&
+                          one_law->shear;
+#else
+        const int pairs = 0;
 #endif
+        if (!pairs)
             unit_vectors(tq, tdx, tdy, nt);
+        else if (nt & 1)
+            unit_vectors(tq + nt - 1, tdx + nt - 1, tdy + nt - 1, 1);
         /* Pass 3: the law at each touching contact, in the list's order. */
+#if defined(__SSE2__)
+        if (pairs)
+            q0 = linear_shear_pairs(s, c0, tc, tq, tdx, tdy, nt, budget, &over, &lost_fric);
+#endif
         for (int q = q0; q < nt; q++) {
             const long c = c0 + tc[q];
             const int i = pi[c], j = pj[c];

@@ -21,10 +21,8 @@ cost: its status, steps, particle-steps and wall-clock seconds (run.json).  The 
 to reports/sweeps/<case>/sweep_<variant>.tsv, one row per point and check.
 """
 import itertools
-import re
-import subprocess
 
-from . import files
+from . import core_info, files
 from .compare import RunStore, evaluate_all
 from .errors import CatalogueError
 from .gate import fmt_number, fmt_reference
@@ -33,8 +31,6 @@ from .sweep import deviation, run_cost
 
 DT_KEYS = ("settings.dt", "settings.dt_fraction")
 FORCE = "settings.force_dt=1"
-STAGE_LINE = re.compile(r"^stage\s+(\S+) (\d+) cycles (\S+) s \((time|cycles)\)$", re.M)
-DT_LINE = re.compile(r"^dt used\s+(\S+)", re.M)
 TSV_COLUMNS = ("point", "sets", "status", "steps", "particle_steps", "wall_seconds", "check", "value",
                "reference", "error", "result")
 
@@ -64,19 +60,9 @@ def grid(keyed):
 
 
 def stages_of(binary, scene, sets):
-    """(dt, [(stage, cycles, seconds, given_in)]) from `ballast info` of the scene."""
-    cmd = [str(binary), "info", str(scene)] + [a for s in sets for a in ("--set", s)]
-    try:
-        done = subprocess.run(cmd, capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL)
-    except OSError as exc:
-        raise CatalogueError(f"cannot start {binary}: {exc.strerror}") from None
-    if done.returncode != 0:
-        raise CatalogueError(f"{' '.join(cmd)}: exit {done.returncode}: {done.stderr.strip()}")
-    dt = DT_LINE.search(done.stdout)
-    if not dt:
-        raise CatalogueError(f"cannot read 'dt used' from ballast info:\n{done.stdout}")
-    return float(dt.group(1)), [(m.group(1), int(m.group(2)), float(m.group(3)), m.group(4))
-                                for m in STAGE_LINE.finditer(done.stdout)]
+    """(dt, [(stage, cycles, seconds, given_in)]) from `ballast info` of the scene (core_info.py)."""
+    got = core_info.query(binary, scene, sets)
+    return got["dt"], got["stages"]
 
 
 def time_keeping(binary, variant):

@@ -193,6 +193,8 @@ static int cmd_info(const struct args *a)
         printf("stage          %s %ld cycles %.17g s (%s)\n", sc.stages[g].name,
                bal_sim_stage_cycles(sim, g), (double)bal_sim_stage_cycles(sim, g) * in.dt,
                bal_sim_stage_in_time(sim, g) ? "time" : "cycles");
+    /* The keys given that other keys make unused (a sweep over one is refused). */
+    bal_scene_print_unused(&sc, stdout);
     bal_sim_free(sim);
     bal_scene_free(&sc);
     return 0;

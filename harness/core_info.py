@@ -14,7 +14,8 @@ either, and only the core resolves them.  `ballast info` prints, among others:
                                                         that another key's value makes unused
 
 parse() turns that into a dict; stability.py asks through the runner's batch (interruptible),
-sweep_grid.py and sweep.py with query().
+sweep_grid.py with query(); refuse_bad_points() asks about every point of a sweep before any
+of them runs (`harness sweep`, and the declared sweeps of `harness cost`).
 """
 import re
 import subprocess
@@ -49,9 +50,9 @@ def parse(text):
     return values
 
 
-def query(binary, scene, sets):
-    """parse() of `ballast info` of the scene with the overrides; a CatalogueError (exit 2) with
-    the core's own message (FILE:LINE: KEY: ...) when it refuses them."""
+def ask(binary, scene, sets):
+    """(exit code, stdout, stderr) of `ballast info` of the scene with the overrides; a
+    CatalogueError when it cannot be run."""
     cmd = command(binary, scene, sets)
     try:
         done = subprocess.run(cmd, capture_output=True, text=True, timeout=QUERY_TIMEOUT,
@@ -60,6 +61,33 @@ def query(binary, scene, sets):
         raise CatalogueError(f"cannot start {binary}: {exc.strerror}") from None
     except subprocess.TimeoutExpired:
         raise CatalogueError(f"{' '.join(cmd)}: no answer in {QUERY_TIMEOUT} s") from None
-    if done.returncode != 0:
-        raise CatalogueError(f"{' '.join(cmd)}: exit {done.returncode}: {done.stderr.strip()}")
-    return parse(done.stdout)
+    return done.returncode, done.stdout, done.stderr
+
+
+def query(binary, scene, sets):
+    """parse() of `ballast info` of the scene with the overrides; a CatalogueError (exit 2) with
+    the core's own message (FILE:LINE: KEY: ...) when it refuses them."""
+    returncode, stdout, stderr = ask(binary, scene, sets)
+    if returncode != 0:
+        raise CatalogueError(f"{' '.join(command(binary, scene, sets))}: exit {returncode}: {stderr.strip()}")
+    return parse(stdout)
+
+
+def refuse_bad_points(binary, points):
+    """Before any run of a sweep, each point as the core reads it: points are (label, scene,
+    sets, swept keys).  A CatalogueError (exit 2) when the core refuses a point's overrides
+    (an unknown key, a value out of range: its own message), or when a swept key is unused at
+    a point because of another key's value (`unused` lines of `ballast info`): its values
+    would all give the same run, and a curve of them would show a parameter that does
+    nothing.  One `ballast info` per point (it builds the scene: 0.5 s for the largest)."""
+    for label, scene, sets, swept in points:
+        returncode, stdout, stderr = ask(binary, scene, sets)
+        if returncode != 0:
+            raise CatalogueError(f"sweep point {label}: ballast refuses its overrides (exit {returncode}): "
+                                 f"{stderr.strip()}")
+        unused = parse(stdout)["unused"]
+        for key in swept:
+            if key in unused:
+                raise CatalogueError(f"sweep point {label}: {key} is unused there ({unused[key]}): every "
+                                     f"value of it gives the same run; sweep another key, or change the one "
+                                     f"that makes it unused")

@@ -6,6 +6,12 @@ second, ...; the first key varies slowest).  A key given twice is refused, as is
 '/' (it names the point's folder).  A point's label is 'KEY=V' for one key and 'KEY=V,KEY2=W'
 for several; its outputs go to reports/sweeps/<case>/<label>.
 
+Before any run, `ballast info` reads every point with all its overrides: a key the core does
+not know or a value out of its range is refused (exit 2) with the core's message, and so is a
+grid that sweeps a key which another key's value makes unused at some point (settings.dt > 0
+makes settings.dt_fraction unused; `ballast info` lists such keys, from the core's table in
+core/scene_keys.c): its values would all give the same run.
+
 A sweep over the time step (settings.dt or settings.dt_fraction) keeps the SIMULATED time of
 every stage fixed: `ballast info` of the unswept variant gives each stage's cycles and dt, and
 every point runs each stage given in cycles as `stage.NAME.time = cycles x dt` (a stage given
@@ -79,6 +85,14 @@ def jobs(case, variant, keyed, sweeps_root, binary):
                 sweeps_root / case.name / label, case.runtime / max(len(case.variants), 1), variant.command,
                 probe=bool(extra))
             for label, sets in grid(keyed)], extra
+
+
+def refuse_bad_points(jobs_, keyed, binary):
+    """Before any run: every point as the core reads it, with all its overrides (the variant's,
+    the time-keeping ones, the point's); exit 2 for an unknown key, a value out of range or a
+    swept key that another key makes unused at some point (core_info.refuse_bad_points)."""
+    swept = [k for k, _ in keyed]
+    core_info.refuse_bad_points(binary, [(job.variant, job.scene, job.sets, swept) for job in jobs_])
 
 
 def error_of(v):

@@ -398,6 +398,10 @@ enum bal_status bal_scene_validate(const struct bal_scene *s,
 void bal_scene_free(struct bal_scene *s);
 /* Print every key of every section with default, range and doc (docs/scene-format.md). */
 void bal_scene_print_keys(FILE *out);
+/* Print, one line "unused         KEY (WHY)" each, the keys the scene gives (in its file or
+ * by an override) that the values of other keys make unused (`ballast info`; the table
+ * bal_scene_unused of scene_keys.c). */
+void bal_scene_print_unused(const struct bal_scene *s, FILE *out);
 
 /* ------------------------------------------------------------------ */
 /* Simulation life cycle                                               */

@@ -183,6 +183,9 @@ static int cmd_info(const struct args *a)
            dd.contacts, dd.coordination_discs, dd.omega, dd.zeta);
     printf("dt fraction    %.17g\n", in.dt_fraction);
     printf("dt used        %.17g\n", in.dt);
+    /* The cycles between series rows: a trial at another dt keeps the rows'
+     * simulated times by scaling them (harness/stability.py). */
+    printf("output every   %ld cycles\n", sc.settings.output_every);
     printf("stages         %d (%ld cycles)\n", sc.n_stages, cycles);
     /* One line per stage, its cycles and the simulated time they cover at
      * this dt (a sweep over dt keeps the time: harness/sweep_grid.py). */
@@ -190,6 +193,8 @@ static int cmd_info(const struct args *a)
         printf("stage          %s %ld cycles %.17g s (%s)\n", sc.stages[g].name,
                bal_sim_stage_cycles(sim, g), (double)bal_sim_stage_cycles(sim, g) * in.dt,
                bal_sim_stage_in_time(sim, g) ? "time" : "cycles");
+    /* The keys given that other keys make unused (a sweep over one is refused). */
+    bal_scene_print_unused(&sc, stdout);
     bal_sim_free(sim);
     bal_scene_free(&sc);
     return 0;

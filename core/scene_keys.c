@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "scene.h"
 #include "scene_keys.h"
 
 #define BIG DBL_MAX
@@ -301,6 +302,142 @@ const struct bal_control_key bal_scene_controls[] = {
 
 const size_t bal_scene_n_controls = sizeof bal_scene_controls / sizeof bal_scene_controls[0];
 
+/* ------------------------------------------------------------------ */
+/* Keys that other keys make unused                                    */
+/* ------------------------------------------------------------------ */
+
+/* Each condition below is where the core reads the key only on the other
+ * branch; a rule is listed only when that is certain from the keys alone
+ * (not from the discs a generator makes or the contacts a run meets).
+ * harness/tests/test_unused_keys.py runs every rule twice with two values
+ * of its key and requires the same outputs. */
+
+static const struct bal_settings *settings_of(const void *item)
+{
+    return item;
+}
+
+/* build.c: dt = settings.dt if > 0, else dt_fraction × the estimate. */
+static int step_given(const struct bal_scene *s, const void *item)
+{
+    (void)s;
+    return settings_of(item)->dt > 0;
+}
+
+/* nu enters only the power law: laws.h (force, energy), timestep.c (ν k_n),
+ * walls.c, exact.c, each under normal_law = power. */
+static int incremental_law(const struct bal_scene *s, const void *item)
+{
+    (void)s;
+    return settings_of(item)->normal_law == BAL_NORMAL_INCREMENTAL;
+}
+
+/* delta0 enters the power law and MLH's dashpot γ_n (δ/δ0)^ψ, which is
+ * γ_n when ψ = 0 and nothing when γ_n = 0 (laws.h, bal_law_viscous). */
+static int no_delta0_term(const struct bal_scene *s, const void *item)
+{
+    const struct bal_settings *st = settings_of(item);
+    return incremental_law(s, item) && (st->gamma_n == 0 || st->psi == 0);
+}
+
+/* psi: only in γ_n (δ/δ0)^ψ (laws.h). */
+static int no_viscous_dashpot(const struct bal_scene *s, const void *item)
+{
+    (void)s;
+    return settings_of(item)->gamma_n == 0;
+}
+
+/* stress_height and stress_step: only for stress_grid.tsv (output.c). */
+static int no_stress_grid(const struct bal_scene *s, const void *item)
+{
+    (void)s;
+    return settings_of(item)->stress_width == 0;
+}
+
+/* skin and skin_rule: only with the cell grid; grid = off lists every pair
+ * once and never rebuilds (build.c, grid.c). */
+static int no_cell_grid(const struct bal_scene *s, const void *item)
+{
+    (void)s;
+    return settings_of(item)->grid == BAL_GRID_OFF;
+}
+
+/* rolling_model: only for a pair with rolling > 0, whose rolling is the
+ * smaller of its two materials' (build.c, laws.h). */
+static int no_rolling(const struct bal_scene *s, const void *item)
+{
+    (void)item;
+    for (int m = 0; m < s->n_materials; m++)
+        if (s->materials[m].rolling > 0)
+            return 0;
+    return 1;
+}
+
+/* check_every: only for a stage with a stop rule (sim.c, has_stop_rule). */
+static int no_stop_rule(const struct bal_scene *s, const void *item)
+{
+    (void)s;
+    const struct bal_stage_def *g = item;
+    return !(g->stop_ke > 0 || g->stop_stress > 0 || g->stop_servo > 0 || g->stop_unbalanced > 0);
+}
+
+/* A generator's box walls (build.c, bal_build_walls): headroom and
+ * wall_material of [fill], overhang and wall_material of [grains] only
+ * with box = 1; the floor of [pile] only with bottom = smooth, c only with
+ * bottom = bumpy (specimen.c). */
+static int fill_without_box(const struct bal_scene *s, const void *item)
+{
+    (void)s;
+    return !((const struct bal_fill_def *)item)->box;
+}
+
+static int grains_without_box(const struct bal_scene *s, const void *item)
+{
+    (void)s;
+    return !((const struct bal_grains_def *)item)->box;
+}
+
+static int pile_bumpy(const struct bal_scene *s, const void *item)
+{
+    (void)s;
+    return ((const struct bal_pile_def *)item)->bottom == 1;
+}
+
+static int pile_smooth(const struct bal_scene *s, const void *item)
+{
+    return !pile_bumpy(s, item);
+}
+
+const struct bal_unused_rule bal_scene_unused[] = {
+    {BAL_SEC_SETTINGS, "dt_fraction", "settings.dt > 0 sets the step", step_given},
+    {BAL_SEC_SETTINGS, "nu", "settings.normal_law = incremental: nu is the power law's",
+     incremental_law},
+    {BAL_SEC_SETTINGS, "delta0",
+     "settings.normal_law = incremental, and gamma_n = 0 or psi = 0: no (delta/delta0) term",
+     no_delta0_term},
+    {BAL_SEC_SETTINGS, "psi", "settings.gamma_n = 0: no viscous normal dashpot",
+     no_viscous_dashpot},
+    {BAL_SEC_SETTINGS, "stress_height", "settings.stress_width = 0: no stress cells",
+     no_stress_grid},
+    {BAL_SEC_SETTINGS, "stress_step", "settings.stress_width = 0: no stress cells",
+     no_stress_grid},
+    {BAL_SEC_SETTINGS, "skin", "settings.grid = off: every pair, no Verlet list", no_cell_grid},
+    {BAL_SEC_SETTINGS, "skin_rule", "settings.grid = off: every pair, no Verlet list",
+     no_cell_grid},
+    {BAL_SEC_SETTINGS, "rolling_model", "no material has rolling > 0", no_rolling},
+    {BAL_SEC_STAGE, "check_every",
+     "the stage has no stop rule: stop_ke, stop_stress, stop_servo and stop_unbalanced are 0",
+     no_stop_rule},
+    {BAL_SEC_FILL, "headroom", "box = 0: no box walls", fill_without_box},
+    {BAL_SEC_FILL, "wall_material", "box = 0: no box walls", fill_without_box},
+    {BAL_SEC_GRAINS, "overhang", "box = 0: no box walls", grains_without_box},
+    {BAL_SEC_GRAINS, "wall_material", "box = 0: no box walls", grains_without_box},
+    {BAL_SEC_PILE, "wall_material", "bottom = bumpy: no floor wall", pile_bumpy},
+    {BAL_SEC_PILE, "c", "bottom = smooth: c spaces a bumpy row 0", pile_smooth},
+};
+
+const size_t bal_scene_n_unused = sizeof bal_scene_unused / sizeof bal_scene_unused[0];
+
 #define SEC(type) sizeof(struct type), offsetof(struct type, given), \
     offsetof(struct type, key_line)
 
@@ -395,6 +532,29 @@ void bal_scene_print_keys(FILE *out)
             fprintf(out, "| `%s` | %s | %s | %s | %s |\n", key->name, type,
                     key->def ? (*key->def ? key->def : "(none)") : (key->required ? "required" : "(none)"),
                     shown, key->doc);
+        }
+    }
+}
+
+/* `ballast info`'s "unused" lines, in the table's order, each section in file
+ * order; the key as --set names it (settings.KEY, KIND.NAME.KEY). */
+void bal_scene_print_unused(const struct bal_scene *s, FILE *out)
+{
+    for (size_t r = 0; r < bal_scene_n_unused; r++) {
+        const struct bal_unused_rule *u = &bal_scene_unused[r];
+        const struct bal_section_info *sec = &bal_scene_sections[u->section];
+        const int ki = bal_scene_key_index(u->section, u->key);
+        if (ki < 0) /* a rule naming no key (check_scene.c tests the table) */
+            continue;
+        for (int i = 0; i < bal_scene_count(s, u->section); i++) {
+            void *item = bal_scene_section(s, u->section, i);
+            if (!(*bal_scene_item_given(item, u->section) & (1u << ki)) || !u->holds(s, item))
+                continue;
+            if (sec->named)
+                fprintf(out, "unused         %s.%s.%s (%s)\n", sec->name, bal_scene_item_name(item),
+                        u->key, u->why);
+            else
+                fprintf(out, "unused         %s.%s (%s)\n", sec->name, u->key, u->why);
         }
     }
 }

@@ -70,11 +70,25 @@ struct bal_section_info {
     const char *doc;
 };
 
+/* A key that the values of other keys make unused: whatever its value, the run is the
+ * same (only run.json's "sets" and echoed settings say it was given).  `holds` says
+ * whether that is so for one section of kind `section` (`item`, its struct) in scene s;
+ * `why` says it in the scene's words.  `ballast info` lists the given keys a rule holds
+ * for (bal_scene_print_unused), and the harness refuses to sweep them. */
+struct bal_unused_rule {
+    enum bal_section_kind section;
+    const char *key;
+    const char *why;
+    int (*holds)(const struct bal_scene *s, const void *item);
+};
+
 extern const struct bal_key bal_scene_keys[];
 extern const size_t bal_scene_n_keys;
 extern const struct bal_section_info bal_scene_sections[BAL_SEC_COUNT];
 extern const struct bal_control_key bal_scene_controls[];
 extern const size_t bal_scene_n_controls;
+extern const struct bal_unused_rule bal_scene_unused[];
+extern const size_t bal_scene_n_unused;
 
 /* Index of key `name` within its section kind, or -1. */
 int bal_scene_key_index(enum bal_section_kind sec, const char *name);

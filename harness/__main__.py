@@ -162,6 +162,7 @@ def cmd_sweep(args):
     variant = sweep_variant(case, args.variant)
     keyed = sweep_grid.parse_sets(args.set)
     jobs, extra = sweep_grid.jobs(case, variant, keyed, reports_root() / "sweeps", args.bin)
+    sweep_grid.refuse_bad_points(jobs, keyed, args.bin)
     if extra:
         print(f"sweep over the time step: every point keeps the stages' simulated time ({' '.join(extra)})")
     outcomes = run_all(jobs, args.bin, args.jobs, sys.stdout, resume=args.resume)

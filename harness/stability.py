@@ -5,8 +5,12 @@ Limit of one variant.  Every trial runs the variant's scene with its `set =` ove
 `settings.dt = f x estimate` (the estimate that `bin/ballast info` prints for that
 variant; an explicit dt of the case is replaced the same way) and every stage's cycles
 scaled by dt_case / dt_trial, so that each trial covers the same physical time as the
-case, with at most CYCLE_CAP cycles per stage (the bounded run).  A trial is unstable
-when any of these holds:
+case, with at most CYCLE_CAP cycles per stage (the bounded run).  A stage's cycles at
+dt_case are those `ballast info` prints (core_info.py), whether the stage is given in
+cycles or in time (`time = T`), in the scene or by an override; a trial gives each stage
+in cycles (`stage.NAME.cycles`, which replaces a `time`), and writes its series rows at
+the case's simulated times (output_every scaled the same way).  A trial is unstable when
+any of these holds:
 
   - ballast exits non-zero (1 = unstable: today a non-finite state; later also the
     overlap and runaway-energy guards of core/sim.c);
@@ -48,12 +52,12 @@ and read_tsv below keep both tables (stability.tsv, extremes.tsv).
 """
 import json
 import math
-import re
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from . import files
+from . import core_info, files
+from .errors import CatalogueError
 from .runner import Job, run_tasks
 
 ENERGY_GROWTH = 4.0
@@ -98,8 +102,8 @@ def targets_for(cases, one_per_case=False):
 
 def info(batch, scene, sets):
     """`ballast info` of a scene (asked through the runner's batch): estimate (the bound),
-    single (C&S 2 sqrt(m/k)), dt."""
-    cmd = [str(batch.binary), "info", str(scene)] + [a for s in sets for a in ("--set", s)]
+    single (C&S 2 sqrt(m/k)), dt, output_every and stages [(name, cycles)] (core_info.py)."""
+    cmd = core_info.command(batch.binary, scene, sets)
     returncode, stdout, stderr = batch.ask(cmd)
     if returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)}: exit {returncode}: {stderr.strip()}")
@@ -107,49 +111,38 @@ def info(batch, scene, sets):
 
 
 def parse_info(text):
-    values = {}
-    for key, name in (("estimate", "dt estimate"), ("single", "dt single"), ("dt", "dt used")):
-        m = re.search(rf"^{name}\s+(\S+)", text, re.M)
-        if m:
-            values[key] = float(m.group(1))
-    if "estimate" not in values or "dt" not in values:
-        raise RuntimeError(f"cannot read the estimate from ballast info:\n{text}")
-    values.setdefault("single", float("nan"))
-    return values
-
-
-def stage_cycles(scene, sets):
-    """[(stage name, cycles)] of the scene in file order, after the overrides."""
-    stages, current = [], None
-    for raw in Path(scene).read_text(encoding="utf-8").splitlines():
-        line = raw.split("#", 1)[0].strip()
-        m = re.match(r"^\[\s*(\w+)\s*([^\]]*?)\s*\]$", line)
-        if m:
-            current = m.group(2) if m.group(1) == "stage" else None
-            if current is not None:
-                stages.append([current, 0])
-            continue
-        if current is not None and "=" in line:
-            key, value = (x.strip() for x in line.split("=", 1))
-            if key == "cycles":
-                stages[-1][1] = int(float(value))
-    for s in sets:
-        m = re.match(r"^stage\.([^.]+)\.cycles=(.+)$", s.strip())
-        if m:
-            for st in stages:
-                if st[0] == m.group(1):
-                    st[1] = int(float(m.group(2)))
-    return [tuple(s) for s in stages]
+    """The numbers of `ballast info` the bisection needs, and each stage's cycles at the
+    scene's own dt as the core resolves them: a stage given in cycles or in time (`time =
+    T`), in the file or by an override, alike.  Never read from the scene text, which
+    knows neither the dt a stage in time is divided by nor what an override replaced."""
+    try:
+        got = core_info.parse(text)
+    except CatalogueError as exc:
+        raise RuntimeError(str(exc)) from None
+    if math.isnan(got["estimate"]) or got["output_every"] is None:
+        raise RuntimeError(f"cannot read the estimate and the output interval from ballast info:\n{text}")
+    return {"estimate": got["estimate"], "single": got["single"], "dt": got["dt"],
+            "output_every": got["output_every"],
+            "stages": [(name, cycles) for name, cycles, _, _ in got["stages"]]}
 
 
 def scaled_cycles(stages, dt_case, dt_trial, cap=CYCLE_CAP):
     """Overrides giving each stage the same physical time at dt_trial (at least one cycle
-    for a stage that had any; at most cap)."""
+    for a stage that had any; at most cap); stages: [(name, cycles at dt_case)] from info()."""
     out = []
     for name, cycles in stages:
         n = 0 if cycles == 0 else max(1, min(cap, int(round(cycles * dt_case / dt_trial))))
         out.append(f"stage.{name}.cycles={n}")
     return out
+
+
+def scaled_output(output_every, dt_case, dt_trial):
+    """The override giving a trial's series rows the simulated times of the case's (every
+    output_every cycles at dt_case; at least every cycle).  The energy and envelope criteria
+    read the rows: a trial at 10 x the case's dt with the case's output_every = 500 would
+    write a row every 0.5 s where the case wrote one every 0.05 s, miss an impact's peak
+    between two rows, and be called unstable for energy lost that it never lost."""
+    return f"settings.output_every={max(1, int(round(output_every * dt_case / dt_trial)))}"
 
 
 @dataclass
@@ -359,7 +352,7 @@ def measure(batch, target, folder, cap=CYCLE_CAP, tolerance=TOLERANCE):
     the same names in the same order at every attempt, which is what lets --resume keep them)."""
     est = info(batch, target.scene, target.sets)
     lim = Limit(target.case, target.variant, est["estimate"], est["single"], est["dt"])
-    stages = stage_cycles(target.scene, target.sets)
+    stages = est["stages"]
     folder = Path(folder)
     base_sets = target.sets + scaled_cycles(stages, 1, 1, cap)
     base = run(batch, target, base_sets, folder / "base")
@@ -371,7 +364,8 @@ def measure(batch, target, folder, cap=CYCLE_CAP, tolerance=TOLERANCE):
         dt = f * lim.estimate
         # force_dt: a trial above the estimate is the point of the bisection (ballast refuses
         # such a step otherwise)
-        sets = target.sets + [f"settings.dt={dt!r}", "settings.force_dt=1"] + \
+        sets = target.sets + [f"settings.dt={dt!r}", "settings.force_dt=1",
+                              scaled_output(est["output_every"], lim.dt_case, dt)] + \
             scaled_cycles(stages, lim.dt_case, dt, cap)
         t = run(batch, target, sets, folder / f"trial{lim.trials + 1:02d}")
         why = verdict(t, base)

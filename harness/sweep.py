@@ -38,7 +38,7 @@ Cost is particle-steps = steps x n_discs from run.json (wall-clock seconds are r
 import json
 from pathlib import Path
 
-from . import files
+from . import core_info, files
 from .compare import RunStore, quantity_in
 from .errors import EvalError, IniError, RunProblem
 from .runner import Job
@@ -251,6 +251,15 @@ def jobs(case, sweeps_root):
     return out
 
 
+def core_points(case, sweeps_root):
+    """(label, scene, sets, swept keys) of every declared point, for core_info.refuse_bad_points:
+    a key the core does not know, a value out of range, or a swept key that another key makes
+    unused is refused before any point runs."""
+    swept = {s.name: [k for k, _ in s.keys + s.scale] for s in case.sweeps}
+    labels = {s.label(f): s.name for s in case.sweeps for f in s.run_factors()}
+    return [(f"{case.name}/{j.variant}", j.scene, j.sets, swept[labels[j.variant]]) for j in jobs(case, sweeps_root)]
+
+
 def points(case, checks, runs_root, sweeps_root):
     """Rows of cost.tsv: per sweep the default run (factor 1; with `set =`, its own run) and every
     swept point."""
@@ -379,6 +388,7 @@ def run_declared(cases, checks, binary, workers, runs_root, sweeps_root, out, ru
         if not case.sweeps:
             print(f"{case.name}: no [sweep] declared", file=out)
     all_jobs = [j for c in swept for j in jobs(c, sweeps_root)]
+    core_info.refuse_bad_points(binary, [p for c in swept for p in core_points(c, sweeps_root)])
     if all_jobs:
         run_all(all_jobs, binary, workers, out)
     done = []

@@ -6,6 +6,12 @@ second, ...; the first key varies slowest).  A key given twice is refused, as is
 '/' (it names the point's folder).  A point's label is 'KEY=V' for one key and 'KEY=V,KEY2=W'
 for several; its outputs go to reports/sweeps/<case>/<label>.
 
+Before any run, `ballast info` reads every point with all its overrides: a key the core does
+not know or a value out of its range is refused (exit 2) with the core's message, and so is a
+grid that sweeps a key which another key's value makes unused at some point (settings.dt > 0
+makes settings.dt_fraction unused; `ballast info` lists such keys, from the core's table in
+core/scene_keys.c): its values would all give the same run.
+
 A sweep over the time step (settings.dt or settings.dt_fraction) keeps the SIMULATED time of
 every stage fixed: `ballast info` of the unswept variant gives each stage's cycles and dt, and
 every point runs each stage given in cycles as `stage.NAME.time = cycles x dt` (a stage given
@@ -21,10 +27,8 @@ cost: its status, steps, particle-steps and wall-clock seconds (run.json).  The 
 to reports/sweeps/<case>/sweep_<variant>.tsv, one row per point and check.
 """
 import itertools
-import re
-import subprocess
 
-from . import files
+from . import core_info, files
 from .compare import RunStore, evaluate_all
 from .errors import CatalogueError
 from .gate import fmt_number, fmt_reference
@@ -33,8 +37,6 @@ from .sweep import deviation, run_cost
 
 DT_KEYS = ("settings.dt", "settings.dt_fraction")
 FORCE = "settings.force_dt=1"
-STAGE_LINE = re.compile(r"^stage\s+(\S+) (\d+) cycles (\S+) s \((time|cycles)\)$", re.M)
-DT_LINE = re.compile(r"^dt used\s+(\S+)", re.M)
 TSV_COLUMNS = ("point", "sets", "status", "steps", "particle_steps", "wall_seconds", "check", "value",
                "reference", "error", "result")
 
@@ -64,19 +66,9 @@ def grid(keyed):
 
 
 def stages_of(binary, scene, sets):
-    """(dt, [(stage, cycles, seconds, given_in)]) from `ballast info` of the scene."""
-    cmd = [str(binary), "info", str(scene)] + [a for s in sets for a in ("--set", s)]
-    try:
-        done = subprocess.run(cmd, capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL)
-    except OSError as exc:
-        raise CatalogueError(f"cannot start {binary}: {exc.strerror}") from None
-    if done.returncode != 0:
-        raise CatalogueError(f"{' '.join(cmd)}: exit {done.returncode}: {done.stderr.strip()}")
-    dt = DT_LINE.search(done.stdout)
-    if not dt:
-        raise CatalogueError(f"cannot read 'dt used' from ballast info:\n{done.stdout}")
-    return float(dt.group(1)), [(m.group(1), int(m.group(2)), float(m.group(3)), m.group(4))
-                                for m in STAGE_LINE.finditer(done.stdout)]
+    """(dt, [(stage, cycles, seconds, given_in)]) from `ballast info` of the scene (core_info.py)."""
+    got = core_info.query(binary, scene, sets)
+    return got["dt"], got["stages"]
 
 
 def time_keeping(binary, variant):
@@ -93,6 +85,14 @@ def jobs(case, variant, keyed, sweeps_root, binary):
                 sweeps_root / case.name / label, case.runtime / max(len(case.variants), 1), variant.command,
                 probe=bool(extra))
             for label, sets in grid(keyed)], extra
+
+
+def refuse_bad_points(jobs_, keyed, binary):
+    """Before any run: every point as the core reads it, with all its overrides (the variant's,
+    the time-keeping ones, the point's); exit 2 for an unknown key, a value out of range or a
+    swept key that another key makes unused at some point (core_info.refuse_bad_points)."""
+    swept = [k for k, _ in keyed]
+    core_info.refuse_bad_points(binary, [(job.variant, job.scene, job.sets, swept) for job in jobs_])
 
 
 def error_of(v):

@@ -277,6 +277,46 @@ START_TEST(scene_print_keys_lists_every_key)
 }
 END_TEST
 
+/* The keys other keys make unused (`ballast info`): every rule names a key
+ * of its section kind (bal_scene_print_unused skips one that does not;
+ * harness/tests/test_unused_keys.py runs each rule). */
+START_TEST(scene_unused_rules_name_keys)
+{
+    ck_assert_uint_gt(bal_scene_n_unused, 0);
+    for (size_t r = 0; r < bal_scene_n_unused; r++) {
+        const struct bal_unused_rule *u = &bal_scene_unused[r];
+        ck_assert_msg(bal_scene_key_index(u->section, u->key) >= 0, "rule %zu: no key '%s' in [%s]", r,
+                      u->key, bal_scene_sections[u->section].name);
+        ck_assert_ptr_nonnull(u->holds);
+        ck_assert_ptr_nonnull(u->why);
+    }
+    /* Listed: a key given (in the file or by --set) that a rule holds for,
+     * named as --set names it; not listed: a default, or a rule that does
+     * not hold. */
+    struct tfx *f = tfx_parse("[settings]\ndt = 0.01\ndt_fraction = 0.2\nnu = 1.5\n"
+                              "[material m]\nkn = 1\ndensity = 1\n"
+                              "[disc a]\nx = 0 0\nr = 1\nmaterial = m\n"
+                              "[stage load]\ncycles = 3\ncheck_every = 7\n"
+                              "[stage rest]\ncycles = 3\ncheck_every = 7\nstop_ke = 1\n",
+                              "unused");
+    ck_assert_int_eq(bal_scene_set(&f->sc, "settings.psi=1", &f->err), BAL_OK);
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *out = open_memstream(&buf, &len);
+    ck_assert_ptr_nonnull(out);
+    bal_scene_print_unused(&f->sc, out);
+    fclose(out);
+    ck_assert_str_eq(buf, "unused         settings.dt_fraction (settings.dt > 0 sets the step)\n"
+                          "unused         settings.nu (settings.normal_law = incremental: nu is the "
+                          "power law's)\n"
+                          "unused         settings.psi (settings.gamma_n = 0: no viscous normal "
+                          "dashpot)\n"
+                          "unused         stage.load.check_every (the stage has no stop rule: stop_ke, "
+                          "stop_stress, stop_servo and stop_unbalanced are 0)\n");
+    free(buf);
+}
+END_TEST
+
 /* ------------------------------------------------------------------ */
 /* Bad scenes                                                          */
 /* ------------------------------------------------------------------ */
@@ -1403,6 +1443,7 @@ Suite *suite_scene(void)
     tcase_add_test(tc, scene_set_overrides);
     tcase_add_test(tc, scene_load_file);
     tcase_add_test(tc, scene_print_keys_lists_every_key);
+    tcase_add_test(tc, scene_unused_rules_name_keys);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("errors");

@@ -11,9 +11,11 @@ import stat
 from pathlib import Path
 
 FAKE_BIN = '''#!/usr/bin/python3
-"""Fake ballast: run SCENE --out DIR [--set KEY=VALUE ...]."""
+"""Fake ballast: run SCENE --out DIR [--set KEY=VALUE ...]; info SCENE [--set ...] (every key known)."""
 import json, math, os, sys, time
 args = sys.argv[1:]
+if args and args[0] == "info":
+    print("dt used        0.1\\noutput every   1 cycles\\nstage          run 10 cycles 1 s (cycles)"); sys.exit(0)
 if not args or args[0] != "run":
     print("ballast: usage: run SCENE --out DIR", file=sys.stderr); sys.exit(2)
 scene, out, sets = args[1], None, []

@@ -209,9 +209,9 @@ bench-modules-count: deps $(BUILD)/bench $(BUILD)/bench-bare $(BUILD)/modules-$(
 
 # ballast against LAMMPS (installed with apt-get when missing; not a build or test
 # dependency): a cross-check of the same physics, then 5 alternating repeats per
-# scene (harness/peer/race.py).
+# scene (harness/peer/race.py, run as a module: python3 -m harness.peer.race).
 bench-peer: deps bin/ballast
-	$(PYTHON) harness/peer/race.py
+	$(PYTHON) -m harness.peer.race --ballast bin/ballast
 
 # Particle-steps per second from 1 000 to 1 000 000 discs (about 40 minutes).
 bench-scaling: deps $(BUILD)/bench

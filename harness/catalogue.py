@@ -86,7 +86,7 @@ class Variant:
     scene: Path
     sets: list
     command: str = "run"     # run: the DEM; exact: the exact static solver (ballast exact);
-                             # peer: the cross-check against LAMMPS (harness/peer/race.py);
+                             # peer: the cross-check against LAMMPS (harness/peer/check.py);
                              # peer_rolling: JYH's rolling against LAMMPS (harness/peer/rolling.py)
     ensemble: str = ""       # a realisation of [ensemble NAME]: NAME (and its seed); '' otherwise
     seed: int = None

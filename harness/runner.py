@@ -54,11 +54,12 @@ STOP_GRACE = 10.0    # seconds a terminated run has to write run.json and exit b
 INTERRUPTED = (130, -signal.SIGINT, -signal.SIGTERM)   # how a run that was interrupted ends
 POLL = 0.1           # seconds between the main thread's looks at the runs (see run_all)
 PEER = Path(__file__).resolve().parent / "peer"
-# The cross-checks against LAMMPS (scripts, not the core): command -> (its command line
-# before --out, the files besides bin/ballast that decide its outputs).
+# The cross-checks against LAMMPS (modules of harness/peer, not the core): command -> (the
+# module run with python3 -m, the files of harness/peer besides bin/ballast that decide its
+# outputs).
 PEER_COMMANDS = {
-    "peer": (["race.py", "--check-only"], ("race.py", "in.peer")),
-    "peer_rolling": (["rolling.py"], ("rolling.py", "race.py", "in.peer_rolling")),
+    "peer": ("harness.peer.check", ("check.py", "common.py", "in.peer")),
+    "peer_rolling": ("harness.peer.rolling", ("rolling.py", "common.py", "in.peer_rolling")),
 }
 
 
@@ -103,9 +104,12 @@ def jobs_for(cases, runs_root):
 def command(job, binary):
     """The core's command line for a job."""
     if job.command in PEER_COMMANDS:
-        # A cross-code check against LAMMPS: a Python script, not the core.
-        script, *args = PEER_COMMANDS[job.command][0]
-        return ["/usr/bin/python3", str(PEER / script)] + args + ["--out", str(job.out)]
+        # A cross-code check against LAMMPS: a module of harness/peer, not the core, run from
+        # the run's folder (hence PYTHONPATH) on the repository's bin/ballast, as identity() says.
+        root = PEER.parent.parent
+        return ["/usr/bin/env", f"PYTHONPATH={root}", "/usr/bin/python3", "-m",
+                PEER_COMMANDS[job.command][0], "--ballast", str(root / "bin" / "ballast"),
+                "--out", str(job.out)]
     cmd = [str(binary), job.command, str(job.scene), "--out", str(job.out)]
     for kv in job.sets:
         cmd += ["--set", kv]

@@ -89,7 +89,7 @@ def read_harness_record(folder):
 
 def skip_reason(info):
     """Why the run could not be made, when its run.json says so (status 'skipped'), else
-    None.  Only the cross-checks against LAMMPS skip (harness/peer/race.py skip_outputs)."""
+    None.  Only the cross-checks against LAMMPS skip (harness/peer/common.py skip_outputs)."""
     if info.get("status") != "skipped":
         return None
     return info.get("message") or "no reason given"
@@ -108,7 +108,7 @@ def run_failure(folder, info):
 
 
 # The files a complete run leaves, by the core's command (main.c, output.c, and for the
-# cross-checks against LAMMPS harness/peer/race.py and rolling.py).
+# cross-checks against LAMMPS harness/peer/check.py and rolling.py).
 EXPECTED_OUTPUTS = {"run": ("series.tsv", "stress.tsv", "contacts.tsv", "discs.tsv", "walls.tsv", "run.json"),
                     "exact": ("series.tsv", "contacts.tsv", "discs.tsv", "walls.tsv", "run.json"),
                     "peer": ("series.tsv", "run.json"),

@@ -48,8 +48,9 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "harness" / "peer"))
-import race  # noqa: E402  (the scenes of bench-peer, written the same way)
+sys.path.insert(0, str(ROOT))    # the repository root, whose harness package this script uses
+from harness.peer import race  # noqa: E402  (the scenes of bench-peer, written the same way)
+from harness.peer.common import Codes  # noqa: E402
 
 OUT = ROOT / "build" / "cost"
 BENCH = ROOT / "build" / "bench"
@@ -79,18 +80,14 @@ def make_scenes(reuse):
     scenes = {"dense": OUT / f"dense_{STEPS}.scene", "settling": OUT / f"settling_{STEPS}.scene"}
     if reuse and all(p.exists() for p in scenes.values()):
         return scenes
-    race.BALLAST_RUN = BALLAST
+    codes = Codes(BALLAST)
     n, columns = N, int(round(math.sqrt(2 * N)))
-    state, box, dt, stage = race.settle_dense(OUT, n, columns)
+    state, box, dt, stage = race.settle_dense(codes, OUT, n, columns)
     print(f"# dense: N={n} settled frictionless for {stage['cycles']} cycles: "
           f"E_k/E_el = {stage['ke_over_ee']:.2g}", flush=True)
-    scenes["dense"].write_text(race.ballast_scene(state, box, dt, STEPS,
-                                                  f"peer race 'dense', {n} discs",
-                                                  skin_rule=race.RACE_SKIN_RULE))
-    lattice, lbox, ldt = race.initial_lattice(OUT, n, columns)
-    scenes["settling"].write_text(race.ballast_scene(lattice, lbox, ldt, STEPS,
-                                                     f"peer race 'settling', {n} discs",
-                                                     skin_rule=race.RACE_SKIN_RULE))
+    scenes["dense"].write_text(race.race_scene("dense", state, box, dt, STEPS))
+    lattice, lbox, ldt = race.initial_lattice(codes, OUT, n, columns)
+    scenes["settling"].write_text(race.race_scene("settling", lattice, lbox, ldt, STEPS))
     return scenes
 
 

@@ -1,11 +1,11 @@
 #!/usr/bin/python3
 """harness/peer/rolling.py -- JYH rolling resistance (Model 1) against LAMMPS's pair granular.
 
-    /usr/bin/python3 harness/peer/rolling.py --out DIR
+    /usr/bin/python3 -m harness.peer.rolling --out DIR [--ballast BIN] [--lmp LMP]
 
 ballast's Model 1 (Jiang, Yu & Harris 2005, core/laws.h) against LAMMPS's pair
 granular `rolling sds k_roll gamma_roll mu_roll` (Debian's lammps, 29 Sep 2021
-update 2), both written from the same discs by the helpers of race.py.  The
+update 2), both written from the same discs by harness/peer/common.py.  The
 catalogue's full-tier case `peer_rolling` (cases/peer/case.txt) runs this and
 holds its figures to reference/peer_rolling.ref; docs/benchmarks.md has the
 mapping table, its sources and the figures measured.
@@ -43,7 +43,7 @@ run.json, one column per figure):
    would otherwise have nothing to resist), fall and collide in the box for
    PACK_STEPS steps with rolling at every contact, walls included.  Positions,
    velocities, spins, forces, torques and every contact's f_n and rolling
-   couple at the end, as race.py compares them.
+   couple at the end, as common.compare() compares them.
 3. collision: friction 0.5 as well.  LAMMPS's pair granular applies the
    tangential force at the middle of the overlap (r - overlap/2), ballast (C&S)
    at r: the codes differ by F_s overlap / 2 per contact.  Two discs collide
@@ -57,28 +57,26 @@ run.json, one column per figure):
 LAMMPS's neighbour lists are all-pairs without sorting (in.peer_rolling: in
 this LAMMPS a pair that changes sides at a rebuild has its rolling history
 negated).  Where LAMMPS is absent and cannot be installed, --out writes a
-skipped run (race.skip_outputs) and the case's checks are SKIP.
+skipped run (common.skip_outputs) and the case's checks are SKIP.
 
 Model 2 (elasto-brittle, JYH eq. 36) has no counterpart in LAMMPS.
 """
 import argparse
 import math
-import shutil
 import sys
 from pathlib import Path
 
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
-if str(HERE) not in sys.path:
-    sys.path.insert(0, str(HERE))
-import race  # noqa: E402 -- race.py, beside this file: the shared helpers
+from .. import files
+from ..final_state import Table
+from ..tables import read_series
+from . import common
+from .common import DENSITY, FIGURES, KN, MU, fmt
 
-TEMPLATE = HERE / "in.peer_rolling"
+TEMPLATE = common.HERE / "in.peer_rolling"
 DELTA = 0.8            # JYH's shape parameter of every test
-KN = race.KN
-MU = race.MU
-# Where the physics is the same in both codes (tests 1 and 2): round-off, as race.py's
+# Where the physics is the same in both codes (tests 1 and 2): round-off, as check.py's
 # frictionless check (collisions amplify it about e-fold per 50 steps; measured 1e-11 at
 # most after the 500 steps of the packing, 2e-14 over the two discs' 1200).
 TOL_EXACT = 1e-10
@@ -107,7 +105,7 @@ dump            atoms all custom @steps@ atoms.dump id radius mass x y vx vy ome
 dump_modify     atoms sort id format float %.17g
 dump            pairs all local @steps@ pairs.dump c_ids[1] c_ids[2] c_pairs[1] c_pairs[2] c_pairs[3] c_pairs[4] c_pairs[5] c_pairs[6] c_pairs[7]
 dump_modify     pairs format float %.17g"""
-PACK_FIGURES = race.FIGURES + ("max_dM",)
+PACK_FIGURES = FIGURES + ("max_dM",)
 
 # ---- test 3: a collision with friction ------------------------------------------------------
 COLL_STIFFNESS = (1, 4, 16)   # k_n / KN; dt and the steps scale with sqrt of it
@@ -153,44 +151,42 @@ def lammps_text(template, data, box, dt, steps, output, mu, g, kn=KN, delta=DELT
     damping beta: eta_n = beta k_n, the tangential dashpot x_gamma eta_n = beta k_t
     (x_gamma = 1: k_t = k_n here), gamma_roll from mu_n = eta_n."""
     roll = lammps_rolling(delta, kn, beta * kn)
-    rolling = (f"rolling sds {race.fmt(roll['k_roll'])} {race.fmt(roll['gamma_roll'])} "
-               f"{race.fmt(roll['mu_roll'])}")
-    return race.lammps_input(template, data=data, density=race.DENSITY, kn=kn, kt=kn,
-                             eta_n=beta * kn, xgamma=1.0 if beta else 0.0, mu=mu,
-                             wall_mu=mu if wall_mu is None else wall_mu,
-                             k_roll=roll["k_roll"], gamma_roll=roll["gamma_roll"],
-                             mu_roll=roll["mu_roll"], wall_rolling=rolling if wall_rolling else "",
-                             g=g, dt=dt, steps=steps, output=output, skin=0.25,
-                             xlo=box[0], xhi=box[1], ylo=box[2], yhi=box[3])
+    rolling = f"rolling sds {fmt(roll['k_roll'])} {fmt(roll['gamma_roll'])} {fmt(roll['mu_roll'])}"
+    return common.lammps_input(template, data=data, density=DENSITY, kn=kn, kt=kn,
+                               eta_n=beta * kn, xgamma=1.0 if beta else 0.0, mu=mu,
+                               wall_mu=mu if wall_mu is None else wall_mu,
+                               k_roll=roll["k_roll"], gamma_roll=roll["gamma_roll"],
+                               mu_roll=roll["mu_roll"], wall_rolling=rolling if wall_rolling else "",
+                               g=g, dt=dt, steps=steps, output=output, skin=0.25,
+                               xlo=box[0], xhi=box[1], ylo=box[2], yhi=box[3])
 
 
 def state_of(x, y, r, vx, vy, omega):
-    """A state of race.py's form (m = density pi r^2) from lists."""
+    """A state of common.disc_state()'s form (m = density pi r^2) from lists."""
     out = {k: np.array(v, dtype=float) for k, v in
            (("x", x), ("y", y), ("r", r), ("vx", vx), ("vy", vy), ("omega", omega))}
-    out["m"] = race.DENSITY * math.pi * out["r"] ** 2
+    out["m"] = DENSITY * math.pi * out["r"] ** 2
     return out
 
 
-def run_both(work, label, state, box, dt, steps, template, output, mu, g=race.G, kn=KN,
+def run_both(codes, work, label, state, box, dt, steps, template, output, mu, g=common.G, kn=KN,
              delta=DELTA, wall_rolling=True, beta=0.0, probes=(), output_every=None,
              lammps_state=None):
     """Write and run one test in both codes under work/label_ballast and work/label_lammps.
     lammps_state: LAMMPS's initial state when it is not the ballast one (see two_discs)."""
-    work = Path(work)
-    work.mkdir(parents=True, exist_ok=True)
+    work = files.make_dirs(work)
     scene = work / f"{label}.scene"
-    scene.write_text(race.ballast_scene(state, box, dt, steps, f"peer rolling {label}",
-                                        kn=kn, kt=kn, mu=mu, g=g, rolling=delta,
-                                        wall_rolling=delta if wall_rolling else 0.0,
-                                        output_every=output_every, probes=probes, beta=beta))
-    race.run_ballast(["run", scene], work / f"{label}_ballast")
-    lw = work / f"{label}_lammps"
-    lw.mkdir(parents=True, exist_ok=True)
-    (lw / "data.lmp").write_text(race.lammps_data(lammps_state or state, box, dt, g=g))
-    race.run_lammps(lw, lammps_text(template, "data.lmp", box, dt, steps,
-                                    output.replace("@steps@", str(steps)), mu=mu, g=g, kn=kn,
-                                    delta=delta, wall_rolling=wall_rolling, beta=beta))
+    files.write_text(scene, common.ballast_scene(state, box, dt, steps, f"peer rolling {label}",
+                                                 kn=kn, kt=kn, mu=mu, g=g, rolling=delta,
+                                                 wall_rolling=delta if wall_rolling else 0.0,
+                                                 output_every=output_every, probes=probes, beta=beta))
+    common.run_ballast(codes, ["run", scene], work / f"{label}_ballast")
+    lw = files.make_dirs(work / f"{label}_lammps")
+    files.write_text(lw / "data.lmp", common.lammps_data(lammps_state or state, box, dt, g=g))
+    common.run_lammps(codes, lw, lammps_text(template, "data.lmp", box, dt, steps,
+                                             output.replace("@steps@", str(steps)), mu=mu, g=g,
+                                             kn=kn, delta=delta, wall_rolling=wall_rolling,
+                                             beta=beta))
     return work / f"{label}_ballast", lw
 
 
@@ -212,7 +208,7 @@ def two_disc_state(omega0):
 def lammps_spins(state, mu_m, dt):
     """LAMMPS's initial spins for ballast's omega_{1/2} of two discs whose only couple at
     t = 0 is the rolling dashpot's -mu_m (omega_0 - omega_1) on disc 0: velocity Verlet
-    adds dt/2 of it before the first step (race.py's half kick, for a couple)."""
+    adds dt/2 of it before the first step (common.lammps_data's half kick, for a couple)."""
     inertia = 0.5 * state["m"] * state["r"] ** 2
     ca, cb = 0.5 * dt * mu_m / inertia
     wa, wb = state["omega"]
@@ -222,7 +218,7 @@ def lammps_spins(state, mu_m, dt):
     return out
 
 
-def two_discs(work, template, damped=False):
+def two_discs(codes, work, template, damped=False):
     """Test 1 in both codes (undamped through the cap, or damped below it); its figures:
     max_dM (the couple on disc 0 at every step, relative to M_0), max_dw (both spins, to
     the initial spin), peak (largest |M| / M_0 in ballast: 1 at the cap), capped (steps
@@ -231,12 +227,12 @@ def two_discs(work, template, damped=False):
     label = "two_damped" if damped else "two"
     state, box = two_disc_state(omega0)
     const = contact_constants(DELTA, KN, *TWO_R, mu_n=beta * KN)
-    bw, lw = run_both(work, label, state, box, TWO_DT, TWO_STEPS, template, TWO_OUTPUT, mu=0.0,
-                      g=0.0, wall_rolling=False, beta=beta, probes=TWO_PROBES, output_every=1,
-                      lammps_state=lammps_spins(state, const["mu_m"], TWO_DT))
-    cols = race.read_tsv((bw / "series.tsv").read_text())
-    cycle, m, capped, w0, w1 = race.numeric(cols, "cycle", "m", "capped", "w0", "w1")
-    frames = {f["_step"]: f for f in race.parse_frames((lw / "spins.dump").read_text())}
+    bw, lw = run_both(codes, work, label, state, box, TWO_DT, TWO_STEPS, template, TWO_OUTPUT,
+                      mu=0.0, g=0.0, wall_rolling=False, beta=beta, probes=TWO_PROBES,
+                      output_every=1, lammps_state=lammps_spins(state, const["mu_m"], TWO_DT))
+    series = read_series(bw / "series.tsv")
+    cycle, m, capped, w0, w1 = (series[k] for k in ("cycle", "m", "capped", "w0", "w1"))
+    frames = {f["_step"]: f for f in common.parse_frames((lw / "spins.dump").read_text())}
     inertia = 0.5 * state["m"] * state["r"] ** 2
     return two_disc_figures(cycle, m, capped, w0, w1, frames, KN * TWO_OVERLAP * const["M0_per_Fn"],
                             omega0, const["mu_m"], inertia, TWO_DT)
@@ -302,18 +298,19 @@ def spun(state, spin=SPIN, seed=SPIN_SEED):
     return out
 
 
-def ballast_couples(contacts_tsv):
-    """The rolling couple of every disc-disc contact on its lower id, from contacts.tsv:
-    {(lower id, higher id): couple}; body a of a row gets -(mr + md)."""
-    cols = race.read_tsv(contacts_tsv)
+def ballast_couples(contacts):
+    """The rolling couple of every disc-disc contact on its lower id, from contacts.tsv (a
+    path): {(lower id, higher id): couple}; body a of a row gets -(mr + md)."""
+    table = Table(contacts, common.CONTACT_COLUMNS)
     out = {}
-    if "mr" not in cols:
+    if not table.has("mr"):
         return out
-    mr, md = race.numeric(cols, "mr", "md")
-    for k, kind in enumerate(cols["kind"]):
+    mr, md = table.numbers("mr"), table.numbers("md")
+    a_, b_ = table.text("a"), table.text("b")
+    for k, kind in enumerate(table.text("kind")):
         if kind != "disc":
             continue
-        a, b = int(cols["a"][k][1:]), int(cols["b"][k][1:])
+        a, b = int(a_[k][1:]), int(b_[k][1:])
         couple = -(mr[k] + md[k])
         out[(min(a, b), max(a, b))] = couple if a < b else -couple
     return out
@@ -344,32 +341,32 @@ def lammps_couples(local, atoms):
     return out
 
 
-def packing(work, template, state, box, dt, steps, friction, label):
-    """Test 2 on `state` in both codes: race.compare()'s figures, the tangential force
-    taken at LAMMPS's arm (race.ballast_forces), and max_dM: every disc-disc contact's
+def packing(codes, work, template, state, box, dt, steps, friction, label):
+    """Test 2 on `state` in both codes: common.compare()'s figures, the tangential force
+    taken at LAMMPS's arm (common.ballast_forces), and max_dM: every disc-disc contact's
     rolling couple, relative to the largest contact f_n times the mean radius; with
     rolling_contacts (those with a couple) and at_cap (those at the cap) in ballast."""
-    bw, lw = run_both(work, label, state, box, dt, steps, template, PACK_OUTPUT, mu=friction)
-    atoms = race.parse_dump((lw / "atoms.dump").read_text())
+    bw, lw = run_both(codes, work, label, state, box, dt, steps, template, PACK_OUTPUT,
+                      mu=friction)
+    atoms = common.parse_dump((lw / "atoms.dump").read_text())
     if atoms["_step"] != steps:
         raise ValueError(f"the LAMMPS dump is of step {atoms['_step']}, not {steps}")
-    local = race.parse_dump((lw / "pairs.dump").read_text())
-    contacts = (bw / "contacts.tsv").read_text()
-    c = race.compare(state, contacts, (bw / "discs.tsv").read_text(), atoms, local, dt,
-                     arm="contact")
-    bm, lm = ballast_couples(contacts), lammps_couples(local, atoms)
-    common = set(bm) & set(lm)
-    c["max_dM"] = max([abs(bm[k] - lm[k]) for k in common] + [0.0]) / (
+    local = common.parse_dump((lw / "pairs.dump").read_text())
+    c = common.compare(state, bw, atoms, local, dt, arm="contact")
+    bm, lm = ballast_couples(bw / "contacts.tsv"), lammps_couples(local, atoms)
+    both = set(bm) & set(lm)
+    c["max_dM"] = max([abs(bm[k] - lm[k]) for k in both] + [0.0]) / (
         c["fscale"] * float(np.mean(state["r"])))
     c["rolling_contacts"] = sum(1 for v in bm.values() if v != 0)
-    c["at_cap"] = sum(int(v == "1") for v in race.read_tsv(contacts).get("rolling", []))
+    contacts = Table(bw / "contacts.tsv", common.CONTACT_COLUMNS)
+    c["at_cap"] = sum(int(v == "1") for v in contacts.text("rolling")) if contacts.has("rolling") else 0
     return c
 
 
 def packing_verdict(c):
-    """race.py's verdict at TOL_EXACT for every figure, with couples to compare, some of
-    them at the cap."""
-    return (race.check_verdict(c, dict.fromkeys(race.FIGURES, TOL_EXACT))
+    """common.check_verdict() at TOL_EXACT for every figure, with couples to compare, some
+    of them at the cap."""
+    return (common.check_verdict(c, dict.fromkeys(FIGURES, TOL_EXACT))
             and c["max_dM"] <= TOL_EXACT and c["rolling_contacts"] > 0 and c["at_cap"] > 0)
 
 
@@ -393,7 +390,7 @@ def collision_state():
             (0.0, 12.0, 0.0, 10.0))
 
 
-def collision(work, template, stiffness):
+def collision(codes, work, template, stiffness):
     """Test 3 at k_n = stiffness KN: the largest relative difference of the final spins and
     velocities (to the largest of each), with overlap (the largest f_n / k_n over the
     run), capped and sliding (steps at the rolling cap and sliding) in ballast."""
@@ -404,13 +401,13 @@ def collision(work, template, stiffness):
               ("sliding", "contact_sliding", "d0", "d1"))
     out = ("dump            end all custom @steps@ end.dump id vx vy omegaz\n"
            "dump_modify     end sort id format float %.17g")
-    bw, lw = run_both(work, f"collision_k{stiffness}", state, box, dt, steps, template, out,
-                      mu=MU, g=0.0, kn=stiffness * KN, wall_rolling=False, probes=probes,
+    bw, lw = run_both(codes, work, f"collision_k{stiffness}", state, box, dt, steps, template,
+                      out, mu=MU, g=0.0, kn=stiffness * KN, wall_rolling=False, probes=probes,
                       output_every=1)
-    b = race.disc_state((bw / "discs.tsv").read_text())
-    lmp = race.parse_dump((lw / "end.dump").read_text())
-    cols = race.read_tsv((bw / "series.tsv").read_text())
-    fn, capped, sliding = race.numeric(cols, "fn", "capped", "sliding")
+    b = common.disc_state(bw / "discs.tsv")
+    lmp = common.parse_dump((lw / "end.dump").read_text())
+    series = read_series(bw / "series.tsv")
+    fn, capped, sliding = series["fn"], series["capped"], series["sliding"]
     dw = np.max(np.abs(b["omega"] - lmp["omegaz"])) / np.max(np.abs(b["omega"]))
     dv = (np.max(np.hypot(b["vx"] - lmp["vx"], b["vy"] - lmp["vy"]))
           / np.max(np.hypot(b["vx"], b["vy"])))
@@ -448,26 +445,26 @@ def collision_line(c, ok):
 # All of it, and the run's outputs
 # ---------------------------------------------------------------------------------------------
 
-def cross_check(work, template):
+def cross_check(codes, work, template):
     """Every test, a line each; (all passed, {test: figures})."""
     work = Path(work)
     results, verdicts = {}, []
     for damped in (False, True):
         label = "two_damped" if damped else "two_discs"
-        c = two_discs(work, template, damped)
+        c = two_discs(codes, work, template, damped)
         ok = two_disc_verdict(c, damped)
         print(two_disc_line(c, ok, label), flush=True)
         results[label], verdicts = c, verdicts + [ok]
-    state, box, dt = race.check_state(work / "fill")
-    c = packing(work, template, spun(state), box, dt, PACK_STEPS, 0.0, "packing")
+    state, box, dt = common.check_state(codes, work / "fill")
+    c = packing(codes, work, template, spun(state), box, dt, PACK_STEPS, 0.0, "packing")
     ok = packing_verdict(c)
     print(packing_line(c, ok, "packing"), flush=True)
     results["packing"], verdicts = c, verdicts + [ok]
-    c = collision_figures({s: collision(work, template, s) for s in COLL_STIFFNESS})
+    c = collision_figures({s: collision(codes, work, template, s) for s in COLL_STIFFNESS})
     ok = collision_verdict(c)
     print(collision_line(c, ok), flush=True)
     results["collision"], verdicts = c, verdicts + [ok]
-    c = packing(work, template, state, box, dt, FRICTION_STEPS, MU, "friction_packing")
+    c = packing(codes, work, template, state, box, dt, FRICTION_STEPS, MU, "friction_packing")
     print(packing_line(c, None, "friction_packing") + " (for the record)", flush=True)
     results["friction_packing"] = c
     return all(verdicts), results
@@ -494,26 +491,27 @@ def check_outputs(results, ok):
     return series, info
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", required=True,
-                    help="folder for the run's outputs (series.tsv, run.json, work/)")
-    a = ap.parse_args(argv)
-    out = Path(a.out)
-    out.mkdir(parents=True, exist_ok=True)
-    if not race.BALLAST.exists():
-        sys.exit("peer: build the core first (make bin/ballast)")
-    problem = race.lammps_problem(("granular", "wall/gran"))
+def run(out, codes):
+    """Every test written like a run into out (exit status 0 when all passed); a skipped
+    run when LAMMPS cannot run them (common.lammps_problem())."""
+    out = files.make_dirs(out)
+    problem = common.lammps_problem(codes, ("granular", "wall/gran"))
     if problem:
         print(f"peer rolling: skipped: {problem}", flush=True)
-        race.write_outputs(out, *race.skip_outputs(problem))
+        common.write_outputs(out, *common.skip_outputs(problem))
         return 0
-    # Every run uses one binary, even if bin/ballast is rebuilt meanwhile.
-    race.BALLAST_RUN = out / "ballast"
-    shutil.copy2(race.BALLAST, race.BALLAST_RUN)
-    ok, results = cross_check(out / "work", TEMPLATE.read_text())
-    race.write_outputs(out, *check_outputs(results, ok))
+    ok, results = cross_check(codes.pinned(out), out / "work", TEMPLATE.read_text())
+    common.write_outputs(out, *check_outputs(results, ok))
     return 0 if ok else 1
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out", required=True, type=Path,
+                    help="folder for the run's outputs (series.tsv, run.json, work/)")
+    common.code_arguments(ap)
+    a = ap.parse_args(argv)
+    return run(a.out, common.codes_of(a))
 
 
 if __name__ == "__main__":

@@ -1,8 +1,8 @@
-"""harness/peer/race.py (`make bench-peer`): its pure functions -- the ballast scene and the
-LAMMPS data file and input it writes, the LAMMPS logs and dumps it reads, the force and
-contact conventions of the cross-check, the figures it prints.  No LAMMPS run here; one test
-runs bin/ballast for three steps (skipped when it is not built)."""
-import importlib.util
+"""harness/peer (`make bench-peer`, the case peer_check): the pure functions of common.py,
+check.py and race.py -- the ballast scene and the LAMMPS data file and input they write, the
+ballast tables and LAMMPS logs and dumps they read, the force and contact conventions of the
+cross-check, the figures they print.  No LAMMPS run here; two tests run bin/ballast for a
+few steps (skipped when it is not built)."""
 import json
 import math
 import pathlib
@@ -12,10 +12,10 @@ import subprocess
 import numpy as np
 import pytest
 
+from harness.errors import EvalError
+from harness.peer import check, common, race
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-_spec = importlib.util.spec_from_file_location("peer_race", ROOT / "harness" / "peer" / "race.py")
-race = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(race)
 
 
 DISCS_TSV = """id\tname\tx\ty\tr\ttheta\tvx\tvy\tomega\tm\tfixed\trow
@@ -85,6 +85,16 @@ ITEM: ENTRIES c_ids[1] c_ids[2] c_pairs[1] c_pairs[2] c_pairs[3] c_pairs[4] c_pa
 """
 
 
+@pytest.fixture
+def tsv(tmp_path):
+    """write(text, name): the text as the file tmp_path/name (a ballast table); its path."""
+    def write(text, name="table.tsv"):
+        path = tmp_path / name
+        path.write_text(text)
+        return path
+    return write
+
+
 def state_of(x, y, r, vx=None, vy=None, omega=None, density=1.0):
     x, y, r = (np.asarray(a, dtype=float) for a in (x, y, r))
     zero = np.zeros_like(x)
@@ -97,43 +107,46 @@ def state_of(x, y, r, vx=None, vy=None, omega=None, density=1.0):
 
 # ---- reading ballast's outputs ---------------------------------------------------------
 
-def test_disc_state_reads_discs_tsv_to_full_precision():
-    s = race.disc_state(DISCS_TSV)
+def test_disc_state_reads_discs_tsv_to_full_precision(tsv):
+    s = common.disc_state(tsv(DISCS_TSV))
     assert s["r"][0] == 0.71446355575280451 and s["vy"][1] == -1.5658418684568731
     assert s["omega"].tolist() == [0.0, 0.5] and s["x"].tolist() == [0.75, 2.25]
 
 
-def test_disc_state_refuses_held_discs():
+def test_disc_state_refuses_held_discs(tsv):
     with pytest.raises(ValueError, match="held"):
-        race.disc_state(DISCS_TSV.replace("\t0\t-1\n", "\t1\t-1\n", 1))
+        common.disc_state(tsv(DISCS_TSV.replace("\t0\t-1\n", "\t1\t-1\n", 1)))
 
 
-def test_read_tsv_refuses_ragged_rows():
-    with pytest.raises(ValueError, match="cells"):
-        race.read_tsv("a\tb\n1\t2\t3\n")
+def test_ballast_tables_refuse_ragged_rows_and_missing_columns(tsv):
+    ragged = tsv(DISCS_TSV + "2\tpack.2\t1\t1\n", "discs.tsv")
+    with pytest.raises(EvalError, match=r"discs.tsv:4: 4 fields, header has 12"):
+        common.disc_state(ragged)
+    with pytest.raises(EvalError, match="column.*missing.*omega"):
+        common.disc_state(tsv(DISCS_TSV.replace("\tomega\t", "\tw\t"), "discs.tsv"))
 
 
-def test_box_of_walls_snaps_the_vertical_walls_and_orders_the_sides():
-    assert race.box_of_walls(WALLS_TSV) == (0.0, 36.0, 0.0, 21.5)
+def test_box_of_walls_snaps_the_vertical_walls_and_orders_the_sides(tsv):
+    assert common.box_of_walls(tsv(WALLS_TSV)) == (0.0, 36.0, 0.0, 21.5)
 
 
-def test_box_of_walls_refuses_a_tilted_wall_a_short_wall_and_a_fifth_wall():
+def test_box_of_walls_refuses_a_tilted_wall_a_short_wall_and_a_fifth_wall(tsv):
     with pytest.raises(ValueError, match="neither"):
-        race.box_of_walls(WALLS_TSV.replace("pack_top\t0\t21.5\t36\t21.5", "pack_top\t0\t21\t36\t21.5"))
+        common.box_of_walls(tsv(WALLS_TSV.replace("pack_top\t0\t21.5\t36\t21.5", "pack_top\t0\t21\t36\t21.5")))
     with pytest.raises(ValueError, match="span"):
-        race.box_of_walls(WALLS_TSV.replace("pack_top\t0\t21.5\t36", "pack_top\t1\t21.5\t36"))
+        common.box_of_walls(tsv(WALLS_TSV.replace("pack_top\t0\t21.5\t36", "pack_top\t1\t21.5\t36")))
     with pytest.raises(ValueError, match="box of 4 walls"):
-        race.box_of_walls(WALLS_TSV + "extra\t0\t10\t36\t10\t0\t0\t0\t0\n")
+        common.box_of_walls(tsv(WALLS_TSV + "extra\t0\t10\t36\t10\t0\t0\t0\t0\n"))
 
 
 def test_min_gaps_finds_the_closest_pair_and_the_closest_wall():
     s = state_of([1.0, 2.1, 5.0], [1.0, 1.0, 5.0], [0.5, 0.5, 0.5])
-    gap, wall = race.min_gaps(s, (0.0, 10.0, 0.0, 10.0))
+    gap, wall = common.min_gaps(s, (0.0, 10.0, 0.0, 10.0))
     assert gap == pytest.approx(0.1) and wall == pytest.approx(0.5)
     s["x"][1] = 1.9                                            # now they overlap
-    assert race.min_gaps(s, (0.0, 10.0, 0.0, 10.0))[0] == pytest.approx(-0.1)
+    assert common.min_gaps(s, (0.0, 10.0, 0.0, 10.0))[0] == pytest.approx(-0.1)
     s["x"][0] = 0.4                                            # and one crosses the left wall
-    assert race.min_gaps(s, (0.0, 10.0, 0.0, 10.0))[1] == pytest.approx(-0.1)
+    assert common.min_gaps(s, (0.0, 10.0, 0.0, 10.0))[1] == pytest.approx(-0.1)
 
 
 # ---- writing the two codes' inputs ----------------------------------------------------
@@ -153,9 +166,9 @@ def sections(text):
     return out
 
 
-def test_ballast_scene_lists_every_disc_exactly_with_the_race_physics():
-    s = race.disc_state(DISCS_TSV)
-    text = race.ballast_scene(s, (0.0, 36.0, 0.0, 21.5), 7.9e-4, 300, "t")
+def test_ballast_scene_lists_every_disc_exactly_with_the_race_physics(tsv):
+    s = common.disc_state(tsv(DISCS_TSV))
+    text = common.ballast_scene(s, (0.0, 36.0, 0.0, 21.5), 7.9e-4, 300, "t")
     secs = sections(text)
     settings = dict(secs)["[settings]"]
     assert settings["normal_law"] == "power" and settings["nu"] == "1" and settings["delta0"] == "1"
@@ -179,16 +192,16 @@ def test_ballast_scene_lists_every_disc_exactly_with_the_race_physics():
     assert secs[-1] == ("[stage race]", {"cycles": "300"})
 
 
-def test_ballast_scene_friction_can_be_switched_off():
-    s = race.disc_state(DISCS_TSV)
-    secs = dict(sections(race.ballast_scene(s, (0, 1, 0, 1), 1e-3, 5, "t", mu=0.0)))
+def test_ballast_scene_friction_can_be_switched_off(tsv):
+    s = common.disc_state(tsv(DISCS_TSV))
+    secs = dict(sections(common.ballast_scene(s, (0, 1, 0, 1), 1e-3, 5, "t", mu=0.0)))
     assert secs["[material grain]"]["friction"] == secs["[material box]"]["friction"] == "0.0"
 
 
-def test_lammps_data_has_the_same_discs_and_the_half_kick_shift():
-    s = race.disc_state(DISCS_TSV)
+def test_lammps_data_has_the_same_discs_and_the_half_kick_shift(tsv):
+    s = common.disc_state(tsv(DISCS_TSV))
     dt = 8e-4
-    text = race.lammps_data(s, (0.0, 36.0, 0.0, 21.5), dt)
+    text = common.lammps_data(s, (0.0, 36.0, 0.0, 21.5), dt)
     lines = text.splitlines()
     assert "2 atoms" in lines and "1 atom types" in lines
     assert "-2.0 38.0 xlo xhi" in lines and "-2.0 23.5 ylo yhi" in lines
@@ -201,18 +214,18 @@ def test_lammps_data_has_the_same_discs_and_the_half_kick_shift():
         assert float(d) / 2 == s["r"][k] and (float(x), float(y)) == (s["x"][k], s["y"][k])
         i, vx, vy, vz, wx, wy, wz = vels[k].split()
         assert float(vx) == s["vx"][k] and float(wz) == s["omega"][k]
-        assert float(vy) == s["vy"][k] + 0.5 * dt * race.G      # LAMMPS's first half kick takes it back
+        assert float(vy) == s["vy"][k] + 0.5 * dt * common.G      # LAMMPS's first half kick takes it back
         assert float(vz) == float(wx) == float(wy) == 0.0
-    still = race.lammps_data(s, (0.0, 36.0, 0.0, 21.5), dt, half_kick=False)
+    still = common.lammps_data(s, (0.0, 36.0, 0.0, 21.5), dt, half_kick=False)
     assert f"2 {s['vx'][1]!r} {s['vy'][1]!r} 0 0 0 0.5" in still.splitlines()
 
 
 def test_lammps_input_fills_the_template_and_refuses_a_missing_value():
-    template = race.TEMPLATE.read_text()
+    template = common.TEMPLATE.read_text()
     values = dict(data="data.lmp", density=1.0, kn=1e5, kt=1e5, mu=0.5, g=9.81, dt=7.9e-4,
                   steps=300, output="", skin=0.25, binsize=0, sort_every=1000, sort_binsize=0,
                   xlo=0.0, xhi=36.0, ylo=0.0, yhi=21.5)
-    text = race.lammps_input(template, **values)
+    text = common.lammps_input(template, **values)
     assert "@" not in text
     cmds = [l.split("#")[0].split() for l in text.splitlines() if l.split("#")[0].strip()]
     first = {c[0] + (" " + c[3] if c[0] == "fix" else ""): c for c in cmds}
@@ -235,11 +248,11 @@ def test_lammps_input_fills_the_template_and_refuses_a_missing_value():
     assert order[-1] == "enforce2d"
     del values["skin"]
     with pytest.raises(KeyError, match="skin"):
-        race.lammps_input(template, **values)
+        common.lammps_input(template, **values)
 
 
 def test_check_output_dumps_forces_torques_and_contacts_to_full_precision():
-    text = race.CHECK_OUTPUT.replace("@steps@", "400")
+    text = check.CHECK_OUTPUT.replace("@steps@", "400")
     assert "%.17g" in text and "tqz" in text and "pair/local dist force p1 p2 p4" in text
     assert "property/local patom1 patom2" in text
 
@@ -247,7 +260,7 @@ def test_check_output_dumps_forces_torques_and_contacts_to_full_precision():
 # ---- reading LAMMPS ---------------------------------------------------------------------
 
 def test_parse_lammps_log_reads_the_loop_time_and_the_neighbour_statistics():
-    log = race.parse_lammps_log(LOG)
+    log = common.parse_lammps_log(LOG)
     assert log == {"version": "29 Sep 2021 - Update 2", "loop_seconds": 6.61234, "procs": 1,
                    "steps": 3000, "atoms": 20000, "builds": 486, "dangerous": 0}
 
@@ -256,21 +269,21 @@ def test_parse_lammps_log_takes_the_last_run_and_refuses_a_log_without_one():
     two = LOG.replace("Loop time of 6.61234 on 1 procs for 3000 steps",
                       "Loop time of 1.5 on 1 procs for 10 steps with 20000 atoms\n"
                       "Loop time of 6.61234 on 1 procs for 3000 steps")
-    assert race.parse_lammps_log(two)["loop_seconds"] == 6.61234
+    assert common.parse_lammps_log(two)["loop_seconds"] == 6.61234
     with pytest.raises(ValueError, match="Loop time"):
-        race.parse_lammps_log(LOG.replace("Loop time", "Loop"))
+        common.parse_lammps_log(LOG.replace("Loop time", "Loop"))
 
 
 def test_parse_dump_takes_the_last_frame_of_custom_and_local_dumps():
-    d = race.parse_dump(DUMP)
+    d = common.parse_dump(DUMP)
     assert d["_step"] == 400 and d["id"].tolist() == [2, 1]
     assert d["x"][1] == 1.0000000000000002 and d["fx"].tolist() == [-1.5, 1.5]
-    l = race.parse_dump(LOCAL)
+    l = common.parse_dump(LOCAL)
     assert l["c_ids[1]"].tolist() == [2, 1] and l["c_pairs[4]"].tolist() == [-2, 0]
     with pytest.raises(ValueError, match="no frame"):
-        race.parse_dump("")
+        common.parse_dump("")
     with pytest.raises(ValueError, match="rows"):
-        race.parse_dump(DUMP.rsplit("\n", 2)[0] + "\n")
+        common.parse_dump(DUMP.rsplit("\n", 2)[0] + "\n")
 
 
 # ---- the cross-check's conventions --------------------------------------------------------
@@ -280,14 +293,14 @@ def contacts_tsv(*rows):
     return head + "".join("\t".join(str(c) for c in row) + "\n" for row in rows)
 
 
-def test_ballast_forces_follow_contacts_tsv_conventions():
+def test_ballast_forces_follow_contacts_tsv_conventions(tsv):
     # d1 at (1, 0) touches d0 at the origin: a = d1, b = d0, e = (-1, 0) from a to b,
     # t_ab = (ny, -nx) = (0, 1).  Force on a = -fn e - fs t_ab = (10, -2); on b the opposite.
     # d0 also rests on a wall below it: e = (0, -1), t = (-1, 0): force on d0 = (3, 5).
     s = state_of([0.0, 1.0], [0.0, 0.0], [0.6, 0.6], density=0.0)
     text = contacts_tsv(("d1", "d0", "disc", 0.5, 0, -1, 0, 10, 2, 0, 0, 0),
                         ("d0", "bottom", "wall", 0, -0.55, 0, -1, 5, 3, 0, 0, 1))
-    fx, fy, tq, pairs = race.ballast_forces(s, text, g=9.81)
+    fx, fy, tq, pairs = common.ballast_forces(s, tsv(text), g=9.81)
     assert fx.tolist() == [-10 + 3, 10] and fy.tolist() == [2 + 5, -2]
     assert tq.tolist() == [2 * 0.6 + 3 * 0.6, 2 * 0.6]
     # f_t is the tangential force on the lower id along t = (e_y, -e_x), e from lower to
@@ -295,14 +308,14 @@ def test_ballast_forces_follow_contacts_tsv_conventions():
     assert pairs == {(0, 1): (10.0, -2.0)}
 
 
-def test_ballast_forces_add_gravity_and_dashpots():
+def test_ballast_forces_add_gravity_and_dashpots(tsv):
     s = state_of([0.0, 1.0], [0.0, 0.0], [0.5, 0.5], density=2.0)
-    fx, fy, tq, pairs = race.ballast_forces(s, contacts_tsv(
-        ("d0", "d1", "disc", 0.5, 0, 1, 0, 4, 0, 1, 0.5, 0)), g=10.0)
+    fx, fy, tq, pairs = common.ballast_forces(s, tsv(contacts_tsv(
+        ("d0", "d1", "disc", 0.5, 0, 1, 0, 4, 0, 1, 0.5, 0))), g=10.0)
     assert fx.tolist() == [-5, 5] and tq.tolist() == [0.25, 0.25]
     assert fy.tolist() == pytest.approx([0.5 - 10 * s["m"][0], -0.5 - 10 * s["m"][1]])
     assert pairs == {(0, 1): (4.0, -0.0)}
-    assert race.ballast_forces(s, contacts_tsv(), g=1.0)[3] == {}
+    assert common.ballast_forces(s, tsv(contacts_tsv(), "none.tsv"), g=1.0)[3] == {}
 
 
 def test_lammps_pairs_use_the_same_convention_as_ballast():
@@ -312,11 +325,11 @@ def test_lammps_pairs_use_the_same_convention_as_ballast():
     local = {"c_ids[1]": np.array([2.0, 1.0]), "c_ids[2]": np.array([1.0, 2.0]),
              "c_pairs[2]": np.array([10.0, 0.0]), "c_pairs[3]": np.array([0.0, 0.0]),
              "c_pairs[4]": np.array([-2.0, 0.0])}
-    assert race.lammps_pairs(local, atoms) == {(0, 1): (10.0, -2.0)}
+    assert common.lammps_pairs(local, atoms) == {(0, 1): (10.0, -2.0)}
     local["c_ids[1]"], local["c_ids[2]"] = local["c_ids[2]"].copy(), local["c_ids[1]"].copy()
     local["c_pairs[4]"] = np.array([2.0, 0.0])                # i = atom 1 now
-    assert race.lammps_pairs(local, atoms) == {(0, 1): (10.0, -2.0)}
-    assert race.lammps_pairs({}, atoms) == {}
+    assert common.lammps_pairs(local, atoms) == {(0, 1): (10.0, -2.0)}
+    assert common.lammps_pairs({}, atoms) == {}
 
 
 def discs_tsv(s):
@@ -328,14 +341,17 @@ def discs_tsv(s):
     return "\n".join(rows) + "\n"
 
 
-def agreeing_runs():
-    """Two touching discs and a free one; ballast's and LAMMPS's outputs agree."""
+def agreeing_runs(folder):
+    """Two touching discs and a free one; ballast's outputs (discs.tsv, contacts.tsv in
+    folder) and LAMMPS's agree."""
     init = state_of([0.0, 1.0, 5.0], [0.0, 0.0, 0.0], [0.6, 0.6, 0.5], vx=[0, 0, 1.0])
     final = {k: v.copy() for k, v in init.items()}
     final["omega"] = np.array([0.1, 0.1, 0.0])
-    final["vy"][2] = -race.G * 1e-3 / 2                          # free flight for one step of 1e-3
+    final["vy"][2] = -common.G * 1e-3 / 2                          # free flight for one step of 1e-3
     ctext = contacts_tsv(("d0", "d1", "disc", 0.5, 0, 1, 0, 10, 2, 0, 0, 0))
-    fx, fy, tq, _ = race.ballast_forces(final, ctext)
+    (folder / "contacts.tsv").write_text(ctext)
+    (folder / "discs.tsv").write_text(discs_tsv(final))
+    fx, fy, tq, _ = common.ballast_forces(final, folder / "contacts.tsv")
     atoms = {"id": np.array([3.0, 1.0, 2.0]), "_step": 1}
     perm = [2, 0, 1]                                           # LAMMPS's dump order
     for name, col in (("x", "x"), ("y", "y"), ("vx", "vx"), ("vy", "vy"), ("omegaz", "omega"),
@@ -345,68 +361,68 @@ def agreeing_runs():
     local = {"c_ids[1]": np.array([1.0]), "c_ids[2]": np.array([2.0]),
              "c_pairs[2]": np.array([10.0]), "c_pairs[3]": np.array([0.0]),
              "c_pairs[4]": np.array([2.0])}
-    return init, ctext, discs_tsv(final), atoms, local
+    return init, folder, atoms, local
 
 
-def test_compare_finds_agreement_and_passes():
-    init, ctext, dtext, atoms, local = agreeing_runs()
-    c = race.compare(init, ctext, dtext, atoms, local, dt=1e-3)
-    assert all(c[k] == 0 for k in race.FIGURES)
+def test_compare_finds_agreement_and_passes(tmp_path):
+    init, run, atoms, local = agreeing_runs(tmp_path)
+    c = common.compare(init, run, atoms, local, dt=1e-3)
+    assert all(c[k] == 0 for k in common.FIGURES)
     assert (c["contacts_ballast"], c["contacts_lammps"], c["contacts_only_one"]) == (1, 1, 0)
     assert c["touched"] == 2 and c["fscale"] == 10 and c["n"] == 3
-    assert race.check_verdict(c, race.TOL_EXACT)
+    assert common.check_verdict(c, check.TOL_EXACT)
 
 
-def test_compare_measures_differences_in_the_stated_units():
-    init, ctext, dtext, atoms, local = agreeing_runs()
+def test_compare_measures_differences_in_the_stated_units(tmp_path):
+    init, run, atoms, local = agreeing_runs(tmp_path)
     mean_d = 2 * np.mean(init["r"])
     atoms["x"][1] += 1e-6                                      # atom 1 = d0 moved
     atoms["tqz"][2] += 0.5                                     # atom 2 = d1's torque
     local["c_pairs[4]"] = np.array([2.01])                    # its shear force
-    c = race.compare(init, ctext, dtext, atoms, local, dt=1e-3)
+    c = common.compare(init, run, atoms, local, dt=1e-3)
     assert c["max_dx"] == pytest.approx(1e-6 / mean_d)
     assert c["max_dT"] == pytest.approx(0.5 / (10 * np.mean(init["r"])))
     assert c["max_dfs"] == pytest.approx(0.001) and c["max_dfn"] == 0
-    assert not race.check_verdict(c, race.TOL_FRICTION)
+    assert not common.check_verdict(c, check.TOL_FRICTION)
 
 
-def test_compare_fails_when_a_contact_is_in_one_code_only_or_lammps_lost_an_atom():
-    init, ctext, dtext, atoms, local = agreeing_runs()
+def test_compare_fails_when_a_contact_is_in_one_code_only_or_lammps_lost_an_atom(tmp_path):
+    init, run, atoms, local = agreeing_runs(tmp_path)
     local["c_pairs[2]"] = np.array([0.0])                     # LAMMPS: not touching
-    c = race.compare(init, ctext, dtext, atoms, local, dt=1e-3)
-    assert c["contacts_only_one"] == 1 and not race.check_verdict(c, race.TOL_FRICTION)
-    init, ctext, dtext, atoms, local = agreeing_runs()
+    c = common.compare(init, run, atoms, local, dt=1e-3)
+    assert c["contacts_only_one"] == 1 and not common.check_verdict(c, check.TOL_FRICTION)
+    init, run, atoms, local = agreeing_runs(tmp_path)
     atoms = {k: (v[:2] if k != "_step" else v) for k, v in atoms.items()}
     with pytest.raises(ValueError, match="lost"):
-        race.compare(init, ctext, dtext, atoms, local, dt=1e-3)
+        common.compare(init, run, atoms, local, dt=1e-3)
 
 
 def test_check_verdict_needs_contacts_and_finite_figures():
-    c = dict.fromkeys(race.FIGURES, 0.0)
+    c = dict.fromkeys(common.FIGURES, 0.0)
     c.update(contacts_ballast=3, contacts_only_one=0, mass_rel=0.0)
-    assert race.check_verdict(c, race.TOL_EXACT)
-    assert not race.check_verdict(dict(c, contacts_ballast=0), race.TOL_EXACT)
-    assert not race.check_verdict(dict(c, max_dv=float("nan")), race.TOL_FRICTION)
-    assert not race.check_verdict(dict(c, max_dx=2e-10), race.TOL_EXACT)
-    assert race.check_verdict(dict(c, max_dx=2e-10), race.TOL_FRICTION)
-    assert not race.check_verdict(dict(c, mass_rel=1e-12), race.TOL_EXACT)
+    assert common.check_verdict(c, check.TOL_EXACT)
+    assert not common.check_verdict(dict(c, contacts_ballast=0), check.TOL_EXACT)
+    assert not common.check_verdict(dict(c, max_dv=float("nan")), check.TOL_FRICTION)
+    assert not common.check_verdict(dict(c, max_dx=2e-10), check.TOL_EXACT)
+    assert common.check_verdict(dict(c, max_dx=2e-10), check.TOL_FRICTION)
+    assert not common.check_verdict(dict(c, mass_rel=1e-12), check.TOL_EXACT)
 
 
 def test_tolerances_are_ordered_round_off_below_friction():
-    assert all(race.TOL_EXACT[k] < race.TOL_FRICTION[k] for k in race.FIGURES)
-    assert 0.5 < race.TOL_RATIO < 1                            # first order: 0.5 expected
+    assert all(check.TOL_EXACT[k] < check.TOL_FRICTION[k] for k in common.FIGURES)
+    assert 0.5 < check.TOL_RATIO < 1                            # first order: 0.5 expected
 
 
 def test_convergence_and_the_check_line():
-    full = dict.fromkeys(race.FIGURES, 1e-7)
+    full = dict.fromkeys(common.FIGURES, 1e-7)
     half = dict(full, max_dx=4.5e-8, max_dF=6e-8)
-    assert race.convergence(full, half) == pytest.approx((0.45, 0.6))
+    assert check.convergence(full, half) == pytest.approx((0.45, 0.6))
     c = dict(full, n=300, step=400, contacts_ballast=11, contacts_lammps=11, sliding=7, touched=233)
-    line = race.check_line(c, True, "friction=0.5", " ratio_dx=0.45")
+    line = check.check_line(c, True, "friction=0.5", " ratio_dx=0.45")
     assert line == ("peer check friction=0.5 N=300 steps=400 max_dx=1e-07 max_dv=1e-07 "
                     "max_dF=1e-07 max_dT=1e-07 max_dfn=1e-07 max_dfs=1e-07 contacts=11/11 "
                     "sliding=7 touched=233 ratio_dx=0.45 PASS")
-    assert race.check_line(c, False, "x").endswith(" FAIL")
+    assert check.check_line(c, False, "x").endswith(" FAIL")
 
 
 # ---- timing figures -------------------------------------------------------------------------
@@ -443,9 +459,9 @@ def test_sweep_plan_skins_binsizes_and_sorts():
 
 def test_docstring_and_constants_agree_on_the_race():
     doc = race.__doc__
-    assert "race.py [--quick]" in doc and "peer dense N=20000" in doc
-    assert race.RACE_N == 20000 and race.REPEATS == 5 and race.CHECK_N == 300
-    assert re.search(r"density/disc", race.TEMPLATE.read_text())
+    assert "python3 -m harness.peer.race [--quick]" in doc and "peer dense N=20000" in doc
+    assert race.RACE_N == 20000 and race.REPEATS == 5 and common.CHECK_N == 300
+    assert re.search(r"density/disc", common.TEMPLATE.read_text())
 
 
 # ---- the integrator convention the half-kick shift relies on ---------------------------
@@ -457,11 +473,11 @@ def test_ballast_runs_the_written_scene_and_moves_a_free_disc_by_v_half(tmp_path
     s = state_of([1.0, 4.0], [2.0, 2.0], [0.5, 0.6], vx=[0.3, -0.2], vy=[1.0, 0.0])
     dt, n = 1e-3, 3
     scene = tmp_path / "t.scene"
-    scene.write_text(race.ballast_scene(s, (0.0, 6.0, 0.0, 6.0), dt, n, "test"))
+    scene.write_text(common.ballast_scene(s, (0.0, 6.0, 0.0, 6.0), dt, n, "test"))
     out = tmp_path / "out"
     subprocess.run([str(ROOT / "bin" / "ballast"), "run", str(scene), "--out", str(out)],
                    check=True, capture_output=True)
-    final = race.disc_state((out / "discs.tsv").read_text())
+    final = common.disc_state(out / "discs.tsv")
     assert final["x"] == pytest.approx(s["x"] + n * dt * s["vx"], abs=1e-15)
     assert final["y"] == pytest.approx(s["y"] + n * dt * s["vy"] - 9.81 * dt * dt * n * (n - 1) / 2,
                                        abs=1e-15)
@@ -474,10 +490,11 @@ def test_race_scenes_give_ballast_its_motion_skin_and_the_cross_check_keeps_the_
     back into run.json's skin."""
     s = state_of([1.0, 4.0], [2.0, 2.0], [0.5, 0.6])
     assert race.RACE_SKIN_RULE == "motion"
-    r = race.Race("settling", tmp_path / "race", s, (0.0, 6.0, 0.0, 6.0), 1e-3, 5, "")
+    r = race.Race("settling", tmp_path / "race", s, (0.0, 6.0, 0.0, 6.0), 1e-3, 5, "",
+                  common.Codes(ROOT / "bin" / "ballast"))
     secs = dict(sections(r.scene(5).read_text()))
     assert secs["[settings]"]["skin_rule"] == "motion"
-    assert "skin_rule" not in dict(sections(race.ballast_scene(s, (0, 6, 0, 6), 1e-3, 5, "t")))["[settings]"]
+    assert "skin_rule" not in dict(sections(common.ballast_scene(s, (0, 6, 0, 6), 1e-3, 5, "t")))["[settings]"]
     out = tmp_path / "out"
     subprocess.run([str(ROOT / "bin" / "ballast"), "run", str(r.scene(5)), "--out", str(out),
                     "--set", "settings.grid=on"], check=True, capture_output=True)
@@ -533,16 +550,16 @@ def test_sweep_never_keeps_settings_with_dangerous_builds(tmp_path, capsys):
 
 
 def test_check_outputs_one_row_per_figure():
-    """--check-only writes the cross-check as a run: one series row, a column per figure
+    """check.py writes the cross-check as a run: one series row, a column per figure
     of each run, the ratios, and run.json saying whether it passed."""
-    fig = {k: 0.5 * (i + 1) for i, k in enumerate(race.FIGURES)}
+    fig = {k: 0.5 * (i + 1) for i, k in enumerate(common.FIGURES)}
     res = {"friction0": dict(fig, n=300, step=400), "friction": dict(fig, n=300, step=400),
            "half_dt": dict(fig, n=300, step=800), "ratio_dx": 0.455, "ratio_dF": 0.404}
-    series, info = race.check_outputs(res, True)
+    series, info = check.check_outputs(res, True)
     head, row = series.splitlines()
     names, values = head.split("\t"), [float(v) for v in row.split("\t")]
     assert names[:2] == ["cycle", "time"] and len(names) == len(values)
     assert values[names.index("friction_max_dx")] == fig["max_dx"]
     assert values[names.index("ratio_dF")] == 0.404
     assert info["status"] == "ok" and info["steps"] == 400
-    assert race.check_outputs(res, False)[1]["status"] == "failed"
+    assert check.check_outputs(res, False)[1]["status"] == "failed"

@@ -1,12 +1,14 @@
 """harness/peer/rolling.py (the case peer_rolling): the mapping of JYH's Model 1 onto LAMMPS's
 pair granular `rolling sds` with hand values, the inputs it writes to both codes, the
 conventions by which it reads their outputs, its figures and verdicts, and the skip path
-when LAMMPS is absent.  No LAMMPS run here; the skip path runs nothing either."""
-import importlib.util
+when LAMMPS is absent (for peer_check too); harness/peer as a package run with python3 -m.
+No LAMMPS run here; the skip path runs nothing either."""
+import ast
 import json
 import math
 import pathlib
 import re
+import subprocess
 import sys
 
 import numpy as np
@@ -14,22 +16,13 @@ import pytest
 
 from harness.compare import RunStore, evaluate_check
 from harness.errors import RunSkipped
+from harness.peer import check, common, rolling
 from harness.references import load_file
+from harness.runner import Job, command
 from harness.tables import load_run
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 PEER = ROOT / "harness" / "peer"
-
-
-def load(name):
-    spec = importlib.util.spec_from_file_location(f"peer_{name}", PEER / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-rolling = load("rolling")
-race = rolling.race          # the race.py rolling.py imports (harness/peer on sys.path)
 
 
 # ---- the mapping ------------------------------------------------------------------------
@@ -124,7 +117,7 @@ def sections(text):
 
 def test_ballast_scene_with_rolling_damping_and_probes():
     state, box = rolling.two_disc_state(20.0)
-    secs = sections(race.ballast_scene(state, box, 1e-4, 1200, "t", mu=0.0, g=0.0, rolling=0.8,
+    secs = sections(common.ballast_scene(state, box, 1e-4, 1200, "t", mu=0.0, g=0.0, rolling=0.8,
                                        wall_rolling=0.0, output_every=1, probes=rolling.TWO_PROBES,
                                        beta=1e-3))
     d = dict(secs)
@@ -134,7 +127,7 @@ def test_ballast_scene_with_rolling_damping_and_probes():
     assert d["[probe m]"] == {"quantity": "contact_mr", "a": "d0", "b": "d1"}
     assert d["[probe w1]"] == {"quantity": "disc_omega", "a": "d1"}
     assert [h for h, _ in secs].index("[stage race]") < [h for h, _ in secs].index("[probe m]")
-    plain = dict(sections(race.ballast_scene(state, box, 1e-4, 5, "t")))   # the race's: no rolling
+    plain = dict(sections(common.ballast_scene(state, box, 1e-4, 5, "t")))   # the race's: no rolling
     assert "rolling_model" not in plain["[settings]"] and "rolling" not in plain["[material grain]"]
     assert plain["[settings]"]["beta"] == "0"
 
@@ -166,17 +159,19 @@ d0\tbottom\twall\t0\t-0.5\t0\t-1\t5\t0\t0\t0\t0\t-1\t0\t-0.002\t0
 """
 
 
-def test_ballast_forces_add_the_rolling_couples_and_take_lammps_arm():
+def test_ballast_forces_add_the_rolling_couples_and_take_lammps_arm(tmp_path):
     # d0 at the origin, d1 at (0.9, 0): overlap 0.6 + 0.6 - 0.9 = 0.3.  Row 1: a = d1 gets
     # fs r - (mr + md) = 2 * 0.6 - 3.5, b = d0 gets 2 * 0.6 + 3.5; at LAMMPS's arm each r is
     # r - 0.15.  Row 2: the wall couple -(mr + md) = +1 on d0.
     s = {"x": np.array([0.0, 0.9]), "y": np.zeros(2), "r": np.array([0.6, 0.6]), "m": np.zeros(2)}
-    _, _, tq, pairs = race.ballast_forces(s, CONTACTS, g=0.0)
+    contacts = tmp_path / "contacts.tsv"
+    contacts.write_text(CONTACTS)
+    _, _, tq, pairs = common.ballast_forces(s, contacts, g=0.0)
     assert tq.tolist() == pytest.approx([1.2 + 3.5 + 1, 1.2 - 3.5])
-    _, _, tq, _ = race.ballast_forces(s, CONTACTS, g=0.0, arm="contact")
+    _, _, tq, _ = common.ballast_forces(s, contacts, g=0.0, arm="contact")
     assert tq.tolist() == pytest.approx([2 * 0.45 + 3.5 + 1, 2 * 0.45 - 3.5])
     assert pairs == {(0, 1): (10.0, -2.0)}
-    assert rolling.ballast_couples(CONTACTS) == {(0, 1): 3.5}     # on d0, the lower id
+    assert rolling.ballast_couples(contacts) == {(0, 1): 3.5}     # on d0, the lower id
 
 
 def test_lammps_couples_from_the_rolling_pseudo_force():
@@ -195,10 +190,10 @@ def test_lammps_couples_from_the_rolling_pseudo_force():
 def test_parse_frames_reads_every_frame_in_order():
     frame = "ITEM: TIMESTEP\n{s}\nITEM: NUMBER OF ATOMS\n1\nITEM: BOX BOUNDS ff ff pp\n0 1\n0 1\n0 1\n" \
             "ITEM: ATOMS id omegaz\n1 {w}\n"
-    frames = race.parse_frames(frame.format(s=0, w=1.5) + frame.format(s=1, w=2.5))
+    frames = common.parse_frames(frame.format(s=0, w=1.5) + frame.format(s=1, w=2.5))
     assert [(f["_step"], f["omegaz"].tolist()) for f in frames] == [(0, [1.5]), (1, [2.5])]
     with pytest.raises(ValueError, match="cut short"):
-        race.parse_frames(frame.format(s=0, w=1) + frame.format(s=1, w=2).rsplit("\n", 2)[0])
+        common.parse_frames(frame.format(s=0, w=1) + frame.format(s=1, w=2).rsplit("\n", 2)[0])
 
 
 # ---- figures and verdicts --------------------------------------------------------------------
@@ -265,32 +260,31 @@ def test_every_column_the_references_read_is_written():
 # ---- the skip path: no LAMMPS -------------------------------------------------------------
 
 @pytest.fixture
-def no_lammps(monkeypatch, tmp_path):
-    """No lmp on PATH, and an install that fails."""
-    monkeypatch.setattr(race, "LMP", "lmp-that-is-not-installed")
-    monkeypatch.setattr(race, "INSTALL", (str(tmp_path / "no-apt-get"), "install", "lammps"))
-    return tmp_path
+def no_lammps(tmp_path):
+    """Codes with no lmp on PATH and an install that fails."""
+    return common.Codes(ROOT / "bin" / "ballast", "lmp-that-is-not-installed",
+                        (str(tmp_path / "no-apt-get"), "install", "lammps"))
 
 
 def test_lammps_problem_says_why(no_lammps, capsys):
-    problem = race.lammps_problem()
+    problem = common.lammps_problem(no_lammps)
     assert "LAMMPS is not installed (no `lmp-that-is-not-installed` on PATH)" in problem
     assert "no-apt-get install lammps` failed" in problem
 
 
-def test_a_lammps_without_the_styles_is_a_problem(monkeypatch, tmp_path):
+def test_a_lammps_without_the_styles_is_a_problem(tmp_path):
     fake = tmp_path / "lmp"
     fake.write_text("#!/bin/sh\necho 'Installed packages:'\necho 'GRANULAR'\necho 'gran/hooke'\n")
     fake.chmod(0o755)
-    monkeypatch.setattr(race, "LMP", str(fake))
-    assert "lacks the GRANULAR package's granular" in race.lammps_problem(("granular",))
-    assert "gran/hooke/history" in race.lammps_problem()
+    codes = common.Codes(ROOT / "bin" / "ballast", str(fake))
+    assert "lacks the GRANULAR package's granular" in common.lammps_problem(codes, ("granular",))
+    assert "gran/hooke/history" in common.lammps_problem(codes)
 
 
 @pytest.mark.skipif(not (ROOT / "bin" / "ballast").exists(), reason="bin/ballast not built")
-def test_without_lammps_the_case_is_skipped_not_failed(no_lammps, capsys):
-    out = no_lammps / "run"
-    assert rolling.main(["--out", str(out)]) == 0
+def test_without_lammps_the_case_is_skipped_not_failed(no_lammps, tmp_path, capsys):
+    out = tmp_path / "run"
+    assert rolling.run(out, no_lammps) == 0
     assert "peer rolling: skipped: LAMMPS is not installed" in capsys.readouterr().out
     info = json.loads((out / "run.json").read_text())
     assert info["status"] == "skipped" and "LAMMPS is not installed" in info["message"]
@@ -303,21 +297,52 @@ def test_without_lammps_the_case_is_skipped_not_failed(no_lammps, capsys):
 def test_a_skipped_run_makes_its_checks_skip(tmp_path):
     folder = tmp_path / "peer_rolling" / "check"
     folder.mkdir(parents=True)
-    series, info = race.skip_outputs("LAMMPS is not installed")
-    race.write_outputs(folder, series, info)
-    check = load_file(ROOT / "reference" / "peer_rolling.ref")[0]
-    verdict = evaluate_check(check, RunStore(lambda case, variant: tmp_path / case / variant))
+    series, info = common.skip_outputs("LAMMPS is not installed")
+    common.write_outputs(folder, series, info)
+    first = load_file(ROOT / "reference" / "peer_rolling.ref")[0]
+    verdict = evaluate_check(first, RunStore(lambda case, variant: tmp_path / case / variant))
     assert verdict.skipped and verdict.result == "SKIP" and not verdict.passed
     assert "LAMMPS is not installed" in verdict.message
 
 
-def test_race_check_only_skips_too(no_lammps):
-    out = no_lammps / "race"
-    assert race.check_only(out, race.TEMPLATE.read_text()) == 0
+def test_the_cross_check_skips_too(no_lammps, tmp_path):
+    out = tmp_path / "check"
+    assert check.run(out, no_lammps) == 0
     assert json.loads((out / "run.json").read_text())["status"] == "skipped"
+    assert not (out / "ballast").exists() and not (out / "work").exists()   # nothing ran
 
 
-def test_rolling_imports_the_race_beside_it():
-    assert pathlib.Path(race.__file__).resolve() == PEER / "race.py"
-    assert str(PEER) in sys.path
-    assert math.isclose(rolling.KN, race.KN) and rolling.MU == race.MU
+# ---- harness/peer as a package ----------------------------------------------------------------
+
+def test_the_package_edits_no_sys_path_and_reassigns_no_global():
+    """The modules share common.py by import: none edits sys.path, declares a global or sets
+    an attribute of another module (the binary is an argument, Codes)."""
+    imported = subprocess.run(
+        [sys.executable, "-c", "import sys; before = list(sys.path); "
+         "import harness.peer.race, harness.peer.rolling, harness.peer.check; "
+         "print(sys.path == before)"], cwd=ROOT, capture_output=True, text=True, check=True)
+    assert imported.stdout.strip() == "True"
+    for path in PEER.glob("*.py"):
+        tree = ast.parse(path.read_text())
+        modules = {alias.asname or alias.name for node in ast.walk(tree)
+                   if isinstance(node, (ast.Import, ast.ImportFrom)) for alias in node.names}
+        assert not [n for n in ast.walk(tree) if isinstance(n, ast.Global)], path.name
+        for node in ast.walk(tree):
+            targets = node.targets if isinstance(node, ast.Assign) else []
+            for t in targets:
+                assert not (isinstance(t, ast.Attribute) and isinstance(t.value, ast.Name)
+                            and t.value.id in modules), f"{path.name}:{node.lineno}"
+
+
+def test_the_runners_command_line_runs_the_modules_from_the_run_folder(tmp_path):
+    """The case commands run `python3 -m harness.peer.MODULE` with the run's folder as the
+    working directory (runner._execute): the module must be found from there, and get
+    the repository's bin/ballast."""
+    for kind, module in (("peer", "check"), ("peer_rolling", "rolling")):
+        job = Job(kind, "check", tmp_path / "x.scene", [], tmp_path / kind, command=kind)
+        cmd = command(job, "some/other/ballast")
+        assert cmd[cmd.index("-m") + 1] == f"harness.peer.{module}"
+        assert cmd[cmd.index("--ballast") + 1] == str(ROOT / "bin" / "ballast")
+        done = subprocess.run(cmd + ["--help"], cwd=tmp_path, capture_output=True, text=True)
+        assert done.returncode == 0 and "--lmp" in done.stdout, done.stderr
+    assert math.isclose(rolling.KN, common.KN) and rolling.MU == common.MU

@@ -153,14 +153,15 @@ def test_a_run_that_says_it_was_skipped_is_ok_is_reported_and_is_tried_again(pro
 
 
 def test_the_cross_checks_run_their_scripts(project, runs):
-    """command = peer and peer_rolling run harness/peer's scripts, not the core."""
+    """command = peer and peer_rolling run harness/peer's modules, not the core."""
     job = Job("peer_rolling", "check", project / "x.scene", [], runs / "peer_rolling" / "check",
               command="peer_rolling")
     cmd = command(job, "bin/ballast")
-    assert cmd[0] == "/usr/bin/python3" and cmd[1].endswith("harness/peer/rolling.py")
-    assert cmd[2:] == ["--out", str(job.out)]
+    assert cmd[2:5] == ["/usr/bin/python3", "-m", "harness.peer.rolling"]
+    assert cmd[0] == "/usr/bin/env" and cmd[1].startswith("PYTHONPATH=")
+    assert cmd[-2:] == ["--out", str(job.out)]
     job.command = "peer"
-    assert command(job, "bin/ballast")[1:3][1] == "--check-only"
+    assert command(job, "bin/ballast")[4] == "harness.peer.check"
 
 
 # ---------------------------------------------------------------- progress of long batches

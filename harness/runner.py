@@ -596,6 +596,7 @@ class Batch:
         self.running = Running()
         self.inputs = Inputs(self.running)     # the files the runs read, listed and hashed once
         self.outcomes = []          # every launch's Outcome, in the order they ended
+        self.refused = 0            # queries (ask) not started because the batch was stopping
         self._lock = threading.Lock()
 
     def launch(self, job):
@@ -612,6 +613,8 @@ class Batch:
         """A short query of the core that writes no folder (`ballast info`): (exit code, stdout,
         stderr).  Its process is one of the batch's, so an interrupt stops it as it stops a run."""
         if self.running.stopping:
+            with self._lock:
+                self.refused += 1
             raise Stopped(" ".join(map(str, cmd)))
         return _execute(cmd, None, self.running)
 
@@ -632,7 +635,11 @@ def _stop(futures, pool, batch, out):
         batch.running.kill()
         wait(live)
     stopped = sum(not o.ok and o.cause.startswith("interrupted:") for o in batch.outcomes)
-    dropped = len(futures) - len(live) + sum(o.cause == "interrupted before it started" for o in batch.outcomes)
+    # Not started: the tasks cancelled before a thread took them, and those a thread took once
+    # the batch was stopping (an interrupt seen late by the main thread, under load), whose
+    # first run or first query (a bisection's `ballast info`) was refused.
+    dropped = len(futures) - len(live) + batch.refused + \
+        sum(o.cause == "interrupted before it started" for o in batch.outcomes)
     print(f"\ninterrupted: {stopped} run(s) stopped, {dropped} not started; their folders hold no result "
           "(--resume redoes only these)", file=out, flush=True)
 

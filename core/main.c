@@ -212,28 +212,12 @@ static void input_path(const struct bal_scene *sc, const char *value, char *out,
         snprintf(out, size, "%.*s/%s", (int)(slash - sc->path), sc->path, value);
 }
 
-/* Print path once (paths[0..*n) are those printed so far); 0, or -1 for a
- * path that one line cannot hold. */
-static int list_input(const char *path, const char **paths, int *n)
-{
-    if (strchr(path, '\n')) {
-        fprintf(stderr, "ballast inputs: %s: a path with a line break cannot be listed one per line\n",
-                path);
-        return -1;
-    }
-    for (int k = 0; k < *n; k++)
-        if (strcmp(paths[k], path) == 0)
-            return 0;
-    paths[(*n)++] = path;
-    printf("%s\n", path);
-    return 0;
-}
-
 /* Every file a run of the scene (with its --set lines) reads, one per line,
  * as the run opens it: the scene, then the file of every file key of every
  * [import], each once.  The harness hashes them into a run's identity
  * (harness/runner.py), so a resumed or gathered run is stale once a file it
- * read has changed.  Bad input: the message and exit code of `info`. */
+ * read has changed.  Bad input: the message and exit code of `info`; a path
+ * that one line cannot hold is refused (exit 2) before anything is printed. */
 static int cmd_inputs(const struct args *a)
 {
     struct bal_scene sc;
@@ -257,33 +241,39 @@ static int cmd_inputs(const struct args *a)
         n_keys++;
     }
     const int most = 1 + sc.n_imports * n_keys;
-    const char **paths = calloc((size_t)most, sizeof *paths);
-    char(*resolved)[2 * BAL_PATH_MAX + 1] = calloc((size_t)most, sizeof *resolved);
-    int n = 0, rc = 0;
-    if (!paths || !resolved) {
+    char(*paths)[2 * BAL_PATH_MAX + 1] = calloc((size_t)most, sizeof *paths);
+    if (!paths) {
         fprintf(stderr, "ballast inputs: out of memory\n");
-        rc = 4;
+        bal_scene_free(&sc);
+        return 4;
     }
-    else
-        rc = list_input(a->scene, paths, &n) ? 2 : 0;
-    for (int i = 0; i < sc.n_imports && rc == 0; i++)
-        for (size_t k = 0; k < bal_scene_n_keys && rc == 0; k++) {
+    int n = 0;
+    snprintf(paths[n++], sizeof *paths, "%s", a->scene);
+    for (int i = 0; i < sc.n_imports; i++)
+        for (size_t k = 0; k < bal_scene_n_keys; k++) {
             const struct bal_key *key = &bal_scene_keys[k];
-            if (key->type != BAL_KEY_FILE)
-                continue;
             const char *value = (const char *)&sc.imports[i] + key->offset;
-            if (!*value)
-                continue; /* not given: no file */
-            char *path = resolved[n];
-            input_path(&sc, value, path, sizeof *resolved);
-            if (list_input(path, paths, &n))
-                rc = 2;
+            if (key->type == BAL_KEY_FILE && *value) /* "": not given, no file */
+                input_path(&sc, value, paths[n++], sizeof *paths);
         }
-    if (fflush(stdout) != 0 && rc == 0) {
+    int rc = 0;
+    for (int k = 0; k < n && rc == 0; k++)
+        if (strchr(paths[k], '\n')) {
+            fprintf(stderr, "ballast inputs: %s: a path with a line break cannot be listed one per "
+                            "line\n", paths[k]);
+            rc = 2;
+        }
+    for (int k = 0; k < n && rc == 0; k++) {
+        int seen = 0;
+        for (int j = 0; j < k; j++)
+            seen |= strcmp(paths[j], paths[k]) == 0;
+        if (!seen)
+            printf("%s\n", paths[k]);
+    }
+    if (rc == 0 && fflush(stdout) != 0) {
         fprintf(stderr, "ballast inputs: cannot write: %s\n", strerror(errno));
         rc = 3;
     }
-    free(resolved);
     free(paths);
     bal_scene_free(&sc);
     return rc;

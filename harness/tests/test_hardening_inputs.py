@@ -257,6 +257,9 @@ def test_inputs_lists_every_file_a_run_opens_as_the_run_opens_it(tmp_path):
     assert missing.returncode == info.returncode == 2 and missing.stdout == ""
     assert missing.stderr == info.stderr and "nothing.tsv" in missing.stderr
     assert core("inputs", "drop.scene", "--set", "settings.nokey=1", cwd=tmp_path / "s").returncode == 2
+    (tmp_path / "s" / "two\nlines.tsv").write_text(DISCS)          # a path one line cannot hold
+    split = core("inputs", "drop.scene", "--set", "import.pair.discs=two\nlines.tsv", cwd=tmp_path / "s")
+    assert (split.returncode, split.stdout) == (2, "") and "a path with a line break" in split.stderr
 
 
 @needs_ballast

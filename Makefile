@@ -126,10 +126,18 @@ test-browser:
 	$(PYTHON) -m pytest -q harness/tests/test_browser.py
 
 # ---- validation -----------------------------------------------------------
-# RESUME=1 keeps the runs an interrupted validate finished (--resume); CASES="a b" validates
+# RESUME=1 (or yes) keeps the runs an interrupted validate finished (--resume); RESUME=0, no
+# or empty runs everything; any other value is refused (RESUME=maybe, true, off: a switch
+# must not read "0" as "on", as a bare $(if $(RESUME),...) would).  CASES="a b" validates
 # those cases only and updates their part of the report.
+RESUME_FLAG := $(if $(filter 1 yes,$(RESUME)),--resume)
+ifneq ($(filter validate,$(MAKECMDGOALS)),)
+ifneq ($(or $(filter-out 0 1 no yes,$(RESUME)),$(word 2,$(RESUME))),)
+$(error RESUME=$(RESUME): give RESUME=1 or yes to resume, RESUME=0 or no (or nothing) to run everything)
+endif
+endif
 validate: all
-	$(PYTHON) -m harness validate --tier $(TIER) -j $(JOBS) $(if $(RESUME),--resume) $(CASES)
+	$(PYTHON) -m harness validate --tier $(TIER) -j $(JOBS) $(RESUME_FLAG) $(CASES)
 
 # Error against cost: every [sweep] of the tier's cases -> reports/sweeps/<case>/cost.tsv
 # (validate runs them too, between the gate and the report; `harness report` draws them).

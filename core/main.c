@@ -5,6 +5,7 @@
  *   ballast run SCENE --out DIR [--set KEY=VALUE ...] [--threads N]
  *   ballast exact SCENE --out DIR [--set KEY=VALUE ...]
  *   ballast info SCENE [--set KEY=VALUE ...]
+ *   ballast inputs SCENE [--set KEY=VALUE ...]
  *   ballast keys          (every scene key, as Markdown tables)
  *   ballast --version
  *
@@ -27,6 +28,7 @@
 
 #include "ballast.h"
 #include "exact.h"
+#include "scene_keys.h"
 
 static volatile sig_atomic_t stop_requested;
 
@@ -72,6 +74,7 @@ static int usage(void)
     fputs("usage: ballast run SCENE --out DIR [--set KEY=VALUE ...] [--threads N]\n"
           "       ballast exact SCENE --out DIR [--set KEY=VALUE ...]\n"
           "       ballast info SCENE [--set KEY=VALUE ...]\n"
+          "       ballast inputs SCENE [--set KEY=VALUE ...]\n"
           "       ballast keys\n"
           "       ballast --version\n",
           stderr);
@@ -198,6 +201,87 @@ static int cmd_info(const struct args *a)
     bal_sim_free(sim);
     bal_scene_free(&sc);
     return 0;
+}
+
+/* The path a run opens for the value of a file key (BAL_KEY_FILE): the rule
+ * of scene.c's BAL_KEY_FILE case, relative to the directory of the scene's
+ * path (sc->path, which --set lines resolve against too), an absolute value
+ * as written.  harness/tests/test_hardening_inputs.py checks that each path
+ * printed here is the one the core opens (its error names it). */
+static void input_path(const struct bal_scene *sc, const char *value, char *out, size_t size)
+{
+    const char *slash = strrchr(sc->path, '/');
+    if (value[0] == '/' || !slash)
+        snprintf(out, size, "%s", value);
+    else
+        snprintf(out, size, "%.*s/%s", (int)(slash - sc->path), sc->path, value);
+}
+
+/* Every file a run of the scene (with its --set lines) reads, one per line,
+ * as the run opens it: the scene, then the file of every file key of every
+ * [import], each once.  The harness hashes them into a run's identity
+ * (harness/runner.py), so a resumed or gathered run is stale once a file it
+ * read has changed.  Bad input: the message and exit code of `info`; a path
+ * that one line cannot hold is refused (exit 2) before anything is printed. */
+static int cmd_inputs(const struct args *a)
+{
+    struct bal_scene sc;
+    struct bal_error err = {0};
+    if (load(&sc, a, &err)) {
+        fprintf(stderr, "%s\n", err.msg);
+        bal_scene_free(&sc);
+        return exit_code(err.code);
+    }
+    int n_keys = 0;
+    for (size_t k = 0; k < bal_scene_n_keys; k++) {
+        if (bal_scene_keys[k].type != BAL_KEY_FILE)
+            continue;
+        if (bal_scene_keys[k].section != BAL_SEC_IMPORT) {
+            /* a file key of another section: this command must learn to list it */
+            fprintf(stderr, "ballast inputs: the file key '%s' of [%s] is not listed (core/main.c)\n",
+                    bal_scene_keys[k].name, bal_scene_sections[bal_scene_keys[k].section].name);
+            bal_scene_free(&sc);
+            return 1;
+        }
+        n_keys++;
+    }
+    const int most = 1 + sc.n_imports * n_keys;
+    char(*paths)[2 * BAL_PATH_MAX + 1] = calloc((size_t)most, sizeof *paths);
+    if (!paths) {
+        fprintf(stderr, "ballast inputs: out of memory\n");
+        bal_scene_free(&sc);
+        return 4;
+    }
+    int n = 0;
+    snprintf(paths[n++], sizeof *paths, "%s", a->scene);
+    for (int i = 0; i < sc.n_imports; i++)
+        for (size_t k = 0; k < bal_scene_n_keys; k++) {
+            const struct bal_key *key = &bal_scene_keys[k];
+            const char *value = (const char *)&sc.imports[i] + key->offset;
+            if (key->type == BAL_KEY_FILE && *value) /* "": not given, no file */
+                input_path(&sc, value, paths[n++], sizeof *paths);
+        }
+    int rc = 0;
+    for (int k = 0; k < n && rc == 0; k++)
+        if (strchr(paths[k], '\n')) {
+            fprintf(stderr, "ballast inputs: %s: a path with a line break cannot be listed one per "
+                            "line\n", paths[k]);
+            rc = 2;
+        }
+    for (int k = 0; k < n && rc == 0; k++) {
+        int seen = 0;
+        for (int j = 0; j < k; j++)
+            seen |= strcmp(paths[j], paths[k]) == 0;
+        if (!seen)
+            printf("%s\n", paths[k]);
+    }
+    if (rc == 0 && fflush(stdout) != 0) {
+        fprintf(stderr, "ballast inputs: cannot write: %s\n", strerror(errno));
+        rc = 3;
+    }
+    free(paths);
+    bal_scene_free(&sc);
+    return rc;
 }
 
 /* Remove an earlier run's outputs from dir (with_json: run.json too, and
@@ -433,6 +517,8 @@ int main(int argc, char **argv)
         rc = cmd_exact(&a);
     else if (strcmp(a.cmd, "info") == 0)
         rc = cmd_info(&a);
+    else if (strcmp(a.cmd, "inputs") == 0)
+        rc = cmd_inputs(&a);
     else
         rc = usage();
     free(a.sets);

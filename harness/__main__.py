@@ -353,7 +353,8 @@ def _runs(p):
     p.add_argument("--bin", type=Path, default=None, help="the core executable (default $BALLAST_BIN or bin/ballast)")
     p.add_argument("--resume", action="store_true",
                    help="keep every run whose folder holds a complete successful run of the same command line, "
-                        "scene text and executable; run the rest (after an interrupt)")
+                        "scene text, executable and files read (the scene's imports); run the rest (after an "
+                        "interrupt)")
     return p
 
 

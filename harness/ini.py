@@ -13,7 +13,11 @@ from dataclasses import dataclass, field
 
 from .errors import IniError
 
-HEADER = re.compile(r"^\[\s*([A-Za-z_]\w*)\s+([A-Za-z0-9_][A-Za-z0-9_.\-]*)\s*\]$")
+# A section's name.  Case, variant, ensemble and probe names are folder names too
+# (reports/runs/<case>/<variant>), so a name holds no '/' and cannot start with '.': never
+# '..' or a path (export.py holds a manifest's names to the same rule).
+NAME = r"[A-Za-z0-9_][A-Za-z0-9_.\-]*"
+HEADER = re.compile(rf"^\[\s*([A-Za-z_]\w*)\s+({NAME})\s*\]$")
 KEY = re.compile(r"^[A-Za-z_][A-Za-z0-9_.]*$")
 
 

@@ -2,9 +2,9 @@
 of a grid of overrides, and a table of its checks with their error and the cost of each point.
 
 Several --set options combine as a GRID (every value of the first key with every value of the
-second, ...; the first key varies slowest).  A key given twice is refused, as is a value with
-'/' (it names the point's folder).  A point's label is 'KEY=V' for one key and 'KEY=V,KEY2=W'
-for several; its outputs go to reports/sweeps/<case>/<label>.
+second, ...; the first key varies slowest).  A key given twice is refused, as are a value with
+'/' and a key with '/' or '..' (they name the point's folder).  A point's label is 'KEY=V' for
+one key and 'KEY=V,KEY2=W' for several; its outputs go to reports/sweeps/<case>/<label>.
 
 Before any run, `ballast info` reads every point with all its overrides: a key the core does
 not know or a value out of its range is refused (exit 2) with the core's message, and so is a
@@ -50,6 +50,11 @@ def parse_sets(texts):
         values = [v.strip() for v in values.split(",") if v.strip()]
         if not sep or not key or not values or any("/" in v for v in values):
             raise CatalogueError(f"--set needs KEY=V1,V2,... (no '/' in values), got '{text}'")
+        if "/" in key or ".." in key:
+            # the key starts each point's folder name (reports/sweeps/<case>/KEY=V): a path in it
+            # would put the folder elsewhere, and no scene key holds '/' or '..'
+            raise CatalogueError(f"--set {key}: a key holds no '/' or '..' (it names the point's folder "
+                                 f"under reports/sweeps), got '{text}'")
         if key in [k for k, _ in out]:
             raise CatalogueError(f"--set {key} given twice: give its values once, KEY=V1,V2,... "
                                  "(several --set keys combine as a grid)")

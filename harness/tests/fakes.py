@@ -3,7 +3,8 @@
 The fake project has one family 'springs' with case 'spring' (variants soft, stiff,
 stiffer: a linear spring F = k * cycle, Ek = k * cycle**2 / 2) and one family 'slow'
 with case 'slow' (tier full).  Its reference file exercises every tolerance kind.
-The fake core (FAKE_BIN) reads 'key = value' scenes and --set KEY=VALUE overrides.
+The fake core (FAKE_BIN) reads 'key = value' scenes and --set KEY=VALUE overrides; its
+`inputs` lists the scene and the file of each `reads = FILE` line (as an [import]'s).
 """
 import json
 import os
@@ -11,11 +12,19 @@ import stat
 from pathlib import Path
 
 FAKE_BIN = '''#!/usr/bin/python3
-"""Fake ballast: run SCENE --out DIR [--set KEY=VALUE ...]; info SCENE [--set ...] (every key known)."""
+"""Fake ballast: run SCENE --out DIR [--set KEY=VALUE ...]; info SCENE [--set ...] (every key known);
+inputs SCENE [--set ...]."""
 import json, math, os, sys, time
 args = sys.argv[1:]
 if args and args[0] == "info":
     print("dt used        0.1\\noutput every   1 cycles\\nstage          run 10 cycles 1 s (cycles)"); sys.exit(0)
+if args[:1] == ["inputs"] and len(args) > 1:    # the scene, and each `reads = FILE` (beside it)
+    print(args[1])
+    for line in open(args[1]):
+        key, _, value = line.partition("=")
+        if key.strip() == "reads":
+            print(os.path.join(os.path.dirname(args[1]), value.strip()))
+    sys.exit(0)
 if not args or args[0] != "run":
     print("ballast: usage: run SCENE --out DIR", file=sys.stderr); sys.exit(2)
 scene, out, sets = args[1], None, []

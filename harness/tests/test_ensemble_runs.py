@@ -101,34 +101,80 @@ def test_realisations_are_the_same_bytes_whatever_jobs_and_order_and_carry_their
         assert not same, f"{a} and {b} share {same}"
 
 
+HOLD_WRAPPER = """#!/bin/sh
+# bin/ballast; while $BALLAST_TEST_HOLD is set, the run whose --out ends in it goes on for
+# 4e8 cycles (minutes) without series rows: a realisation still running when the harness dies.
+if [ -n "$BALLAST_TEST_HOLD" ]; then
+  case "$4" in *"$BALLAST_TEST_HOLD")
+    exec "{bin}" "$@" --set settings.output_every=1000000000 --set stage.settle.cycles=400000000;;
+  esac
+fi
+exec "{bin}" "$@"
+"""
+HELD = "pack_s2"      # -j 2 in seed order: the other thread finishes s1, s3, s4, ... meanwhile
+
+
+def alive_in_group(pgid):
+    """pids of the live processes (zombies aside: no subreaper may reap them here) of the
+    process group pgid."""
+    alive = []
+    for entry in Path("/proc").iterdir():
+        try:
+            if entry.name.isdigit():
+                fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+                if int(fields[2]) == pgid and fields[0] not in "ZX":
+                    alive.append(int(entry.name))
+        except (OSError, IndexError, ValueError):
+            pass
+    return alive
+
+
+def wait_for(condition, what, proc=None, limit=300):
+    """Poll condition() until it holds: an event, not a time, ends the wait; limit only
+    bounds a test that would otherwise hang, and proc (the harness) must not end first."""
+    deadline = time.monotonic() + limit
+    while not condition():
+        assert proc is None or proc.poll() is None, proc.communicate()[0]
+        assert time.monotonic() < deadline, f"{what}: not after {limit} s"
+        time.sleep(0.01)
+
+
 @needs_ballast
 def test_an_ensemble_killed_outright_resumes_without_redoing_finished_realisations(tmp_path):
     """The harness gets SIGKILL once 3 of the 8 realisations (about half a second each) are
-    recorded; its runs die with it.  What read as finished then is kept by --resume, byte for
-    byte and mtime for mtime; the rest is run again; the end equals an uninterrupted run."""
+    recorded while a fourth, held by a wrapper of the core, is in its time-step loop; its runs
+    die with it.  What read as finished then is kept by --resume, byte for byte and mtime for
+    mtime; the rest is run again; the end equals an uninterrupted run.  Every wait is on an
+    event (issue 29, item 16: the kill used to come at a time, then a 0.3 s sleep stood for
+    the runs' death; under load 7-9 the test once failed)."""
     env = catalogue_with_ensemble(tmp_path, settle=100000)
+    wrapper = tmp_path / "bin" / "ballast"
+    wrapper.parent.mkdir()
+    wrapper.write_text(HOLD_WRAPPER.replace("{bin}", str(BALLAST)))
+    wrapper.chmod(0o755)
+    env["BALLAST_BIN"] = str(wrapper)
     expected = tmp_path / "expected"
     status, out = finish(harness({**env, "BALLAST_REPORTS": str(expected)}, "run", "-j", "2"))
     assert status == 0, out
 
     reports = tmp_path / "reports"
     runs = reports / "runs" / "packing"
-    proc = harness(env, "run", "-j", "2")
-    deadline = time.monotonic() + 120
-    while sum((runs / n / "harness.json").exists() for n in NAMES) < 3:
-        assert proc.poll() is None, proc.communicate()[0]
-        assert time.monotonic() < deadline, "the ensemble did not get going"
-        time.sleep(0.01)
-    os.killpg(proc.pid, 0)                           # the harness and its runs are alive
-    proc.send_signal(signal.SIGKILL)
-    proc.communicate()
-    time.sleep(0.3)                                  # its runs die with it (PDEATHSIG)
+    proc = harness({**env, "BALLAST_TEST_HOLD": HELD}, "run", "-j", "2")
+    try:
+        wait_for(lambda: sum((runs / n / "harness.json").exists() for n in NAMES) >= 3 and
+                 (runs / HELD / "series.tsv.tmp").exists(), "3 realisations recorded, the held one running", proc)
+        assert alive_in_group(proc.pid)                  # the harness and its runs are alive
+        proc.send_signal(signal.SIGKILL)
+        proc.communicate()
+        wait_for(lambda: not alive_in_group(proc.pid), "its runs die with it (PDEATHSIG)")
+    finally:
+        if alive_in_group(proc.pid):
+            os.killpg(proc.pid, signal.SIGKILL)
     finished = [n for n in NAMES if (runs / n / "harness.json").exists()
                 and json.loads((runs / n / "harness.json").read_text())["ok"]]
     unfinished = [n for n in NAMES if n not in finished]
-    assert 3 <= len(finished) < len(NAMES), finished
-    started = [n for n in unfinished if (runs / n).exists()]
-    assert started, "the kill found no realisation running: the test tested nothing"
+    assert 3 <= len(finished) < len(NAMES) and HELD in unfinished, finished
+    assert (runs / HELD).exists() and not (runs / HELD / "run.json").exists()   # killed in its loop
     before = {n: tree_snapshot(runs / n) for n in finished}
 
     status, out = finish(harness(env, "run", "-j", "2", "--resume"))

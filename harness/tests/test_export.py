@@ -188,7 +188,7 @@ def test_bad_export_folders_and_indices_are_refused(springs, tmp_path, capsys):
     assert "no job 7 (it has jobs 0 to 6)" in capsys.readouterr().err
     (folder / "manifest.json").write_text('{"format": "something else"}')
     assert main(["gather", str(folder)]) == 2
-    assert "not a manifest of format 'ballast-export 1'" in capsys.readouterr().err
+    assert f"not a manifest of format '{export.FORMAT}'" in capsys.readouterr().err
     (folder / "manifest.json").write_text('{"jobs": [')
     assert main(["job", str(folder), "0"]) == 2
     assert "manifest.json: cannot read it" in capsys.readouterr().err

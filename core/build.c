@@ -35,6 +35,7 @@
 #include "pairs.h"
 #include "scene.h"
 #include "specimen.h"
+#include "status.h"
 #include "timestep.h"
 #include "walls.h"
 
@@ -461,10 +462,11 @@ enum bal_status bal_build_timestep(struct bal_sim *s, struct bal_error *err)
          * velocity (the centred update's factor 1 - alpha dt/2 <= 0) and the
          * velocity at t_N can no longer be recovered (a division by it). */
         return bal_error(err, BAL_EINVAL,
-                         "%s:%d: alpha: global damping alpha = %g with the time step %g gives "
-                         "alpha dt = %g; expected alpha dt < 2 (alpha < %g)",
+                         "%s:%d: alpha: global damping alpha = %s with the time step %s gives "
+                         "alpha dt = %s; expected alpha dt < 2 (alpha < %s)",
                          sc->path, st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "alpha")],
-                         st->alpha, s->dt, s->alpha * s->dt, 2 / s->dt);
+                         BAL_NUM(st->alpha), BAL_NUM(s->dt), BAL_NUM(s->alpha * s->dt),
+                         BAL_NUM(2 / s->dt));
     if (s->dt >= s->dt_estimate && !st->force_dt) {
         const char *key = st->dt > 0 ? "dt" : "dt_fraction";
         const int line = st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, key)];
@@ -472,9 +474,10 @@ enum bal_status bal_build_timestep(struct bal_sim *s, struct bal_error *err)
         if (line > 0)
             snprintf(where, sizeof where, ":%d", line);
         return bal_error(err, BAL_EINVAL,
-                         "%s%s: %s: the time step %.6g is at or above the stability estimate "
-                         "%.6g (bin/ballast info); expected a smaller one, or settings.force_dt "
-                         "= 1 to run it anyway", sc->path, where, key, s->dt, s->dt_estimate);
+                         "%s%s: %s: the time step %s is at or above the stability estimate "
+                         "%s (bin/ballast info); expected a smaller one, or settings.force_dt "
+                         "= 1 to run it anyway", sc->path, where, key, BAL_NUM(s->dt),
+                         BAL_NUM(s->dt_estimate));
     }
     return BAL_OK;
 }
@@ -588,10 +591,10 @@ enum bal_status bal_build_stages(struct bal_sim *s, struct bal_error *err)
             const int ki = bal_scene_key_index(BAL_SEC_STAGE, "time");
             if (!(n <= 1e15))
                 return bal_error(err, BAL_EINVAL,
-                                 "%s:%d: time: [stage %s]: time %g with the time step %g is %g "
+                                 "%s:%d: time: [stage %s]: time %s with the time step %s is %s "
                                  "cycles; expected at most 1e15", sc->path,
                                  st->key_line[ki] > 0 ? st->key_line[ki] : st->line, st->name,
-                                 st->time, s->dt, st->time / s->dt);
+                                 BAL_NUM(st->time), BAL_NUM(s->dt), BAL_NUM(st->time / s->dt));
             s->log[g].max_cycles = n > 0 ? (long)n : 0;
             s->log[g].in_time = 1;
         }
@@ -601,10 +604,10 @@ enum bal_status bal_build_stages(struct bal_sim *s, struct bal_error *err)
             const struct bal_move_def *mv = &sc->stages[g].moves[m];
             if (mv->control == BAL_CONTROL_STRAIN_RATE && !(mv->rate * s->dt < 1))
                 return bal_error(err, BAL_EINVAL,
-                                 "%s:%d: strain_rate: rate %g with the time step %g gives rate "
-                                 "dt = %g; expected rate dt < 1 (the gap shrinks by 1 - rate dt "
+                                 "%s:%d: strain_rate: rate %s with the time step %s gives rate "
+                                 "dt = %s; expected rate dt < 1 (the gap shrinks by 1 - rate dt "
                                  "a cycle)", sc->path, mv->line > 0 ? mv->line : sc->stages[g].line,
-                                 mv->rate, s->dt, mv->rate * s->dt);
+                                 BAL_NUM(mv->rate), BAL_NUM(s->dt), BAL_NUM(mv->rate * s->dt));
         }
     }
     s->stage = -1; /* none yet: bal_sim_run or bal_sim_step selects the first */

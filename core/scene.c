@@ -22,6 +22,7 @@
  */
 #include <ctype.h>
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -29,6 +30,7 @@
 
 #include "import.h"
 #include "scene.h"
+#include "status.h"
 
 /* Longest line a scene file may hold; longer lines are refused, not cut. */
 #define LINE_MAX_CHARS 4096
@@ -179,9 +181,17 @@ static enum bal_status check_range(const struct bal_key *key, double v,
                                    struct where w, struct bal_error *err)
 {
     if (v < key->min || v > key->max) {
-        char range[160];
-        snprintf(range, sizeof range, "%.6g is out of range: expected %.6g <= value <= %.6g",
-                 v, key->min, key->max);
+        /* Each number in its shortest exact text (status.h): with %.6g,
+         * rolling = 2.0000001 was "2 is out of range: expected 0 <= value
+         * <= 2".  A bound at the end of the doubles (BIG) is no bound. */
+        char range[3 * BAL_NUM_CHARS + 64], a[BAL_NUM_CHARS], lo[BAL_NUM_CHARS + 8] = "",
+             hi[BAL_NUM_CHARS + 8] = "";
+        if (key->min > -DBL_MAX)
+            snprintf(lo, sizeof lo, "%s <= ", bal_num_text(a, key->min));
+        if (key->max < DBL_MAX)
+            snprintf(hi, sizeof hi, " <= %s", bal_num_text(a, key->max));
+        snprintf(range, sizeof range, "%s is out of range: expected %svalue%s",
+                 bal_num_text(a, v), lo, hi);
         return where_error(err, w, key->name, "%s", range);
     }
     return BAL_OK;

@@ -15,6 +15,8 @@
 
 #include "import.h"
 #include "scene.h"
+#include "specimen.h"
+#include "status.h"
 #include "walls.h"
 
 static int line_of(void *item, enum bal_section_kind k, const char *key)
@@ -215,15 +217,15 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
         struct bal_wall_def *w = &s->walls[i];
         if (!(w->h2 > w->h1))
             return FAIL_AT(w, BAL_SEC_WALL, "h2", "expected h2 > h1 (a wall of positive length), "
-                                                  "got h1 = %g, h2 = %g", w->h1, w->h2);
+                                                  "got h1 = %s, h2 = %s", BAL_NUM(w->h1), BAL_NUM(w->h2));
         if (check_material_ref(s, w, BAL_SEC_WALL, "material", w->material, 0, err))
             return err->code;
     }
     for (int i = 0; i < s->n_fills; i++) {
         struct bal_fill_def *f = &s->fills[i];
         if (!(f->rmax >= f->rmin))
-            return FAIL_AT(f, BAL_SEC_FILL, "rmax", "expected rmax >= rmin, got %g < %g",
-                           f->rmax, f->rmin);
+            return FAIL_AT(f, BAL_SEC_FILL, "rmax", "expected rmax >= rmin, got %s < %s",
+                           BAL_NUM(f->rmax), BAL_NUM(f->rmin));
         if (check_material_ref(s, f, BAL_SEC_FILL, "material", f->material, 1, err))
             return err->code;
         if (f->box) {
@@ -239,7 +241,7 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
             return err->code;
         if (!(p->size_spread < 1))
             return FAIL_AT(p, BAL_SEC_PILE, "size_spread", "expected 0 <= size_spread < 1 "
-                           "(diameters d (1 + r), |r| <= size_spread/2), got %g", p->size_spread);
+                           "(diameters d (1 + r), |r| <= size_spread/2), got %s", BAL_NUM(p->size_spread));
         if (p->bottom == 0) {
             if (!*p->wall_material)
                 return FAIL_AT(p, BAL_SEC_PILE, "wall_material", "%s",
@@ -260,12 +262,12 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
             if (!(d[k] >= d[k - 1]))
                 return FAIL_AT(g, BAL_SEC_GRAINS, names[k],
                                "expected dmin <= d10 <= d50 <= d60 <= dmax (the share finer "
-                               "by area rises with d), got %s = %g < %s = %g",
-                               names[k], d[k], names[k - 1], d[k - 1]);
+                               "by area rises with d), got %s = %s < %s = %s",
+                               names[k], BAL_NUM(d[k]), names[k - 1], BAL_NUM(d[k - 1]));
         if (!(g->size[0] >= g->dmax && g->size[1] >= g->dmax))
             return FAIL_AT(g, BAL_SEC_GRAINS, "size",
-                           "the region %g x %g must be at least dmax = %g wide and high",
-                           g->size[0], g->size[1], g->dmax);
+                           "the region %s x %s must be at least dmax = %s wide and high",
+                           BAL_NUM(g->size[0]), BAL_NUM(g->size[1]), BAL_NUM(g->dmax));
         if (check_material_ref(s, g, BAL_SEC_GRAINS, "material", g->material, 1, err))
             return err->code;
         if (g->box) {
@@ -294,7 +296,7 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
         struct bal_material_def *m = &s->materials[i];
         if (!(m->ks >= 1e-150 || m->ks == -1))
             return FAIL_AT(m, BAL_SEC_MATERIAL, "ks", "expected ks >= 1e-150, like kn (or omit it "
-                                                      "for ks = kn), got %g", m->ks);
+                                                      "for ks = kn), got %s", BAL_NUM(m->ks));
     }
     if (check_body_names(s, err))
         return err->code;

@@ -594,6 +594,22 @@ static const struct bad_scene bad_scenes[] = {
      "bad:34: stop_servo: -0.01 is out of range"},
     {"stop_unbalanced out of range", BOX_STAGE "stop_unbalanced = -1\n", 'p',
      "bad:34: stop_unbalanced: -1 is out of range"},
+    /* Item 15: a refused value and its bound print differently (%.6g
+     * printed "2 is out of range: expected 0 <= value <= 2"). */
+    {"rolling just past its bound", "[material m]\nkn = 1e5\nrolling = 2.0000001\n", 'p',
+     "bad:3: rolling: 2.0000001 is out of range: expected 0 <= value <= 2"},
+    {"cycles one beyond the largest count", HEAD "[stage s]\ncycles = 1000000000000001\n", 'p',
+     "bad:9: cycles: 1000000000000001 is out of range: expected 0 <= value <= 1e+15"},
+    {"fill with rmax a hair below rmin",
+     "[material m]\nkn = 1e5\ndensity = 2\n[fill f]\nn = 4\ncolumns = 2\nrmin = 0.5\n"
+     "rmax = 0.4999999\nmaterial = m\n" STAGE,
+     'v', "bad:8: rmax: expected rmax >= rmin, got 0.4999999 < 0.5"},
+    {"wall with h2 a hair below h1",
+     HEAD "[wall w]\np = 0 -1\nangle = 30\nh1 = 1.0000001\nh2 = 1\nmaterial = m\n" STAGE, 'v',
+     "bad:12: h2: expected h2 > h1 (a wall of positive length), got h1 = 1.0000001, h2 = 1"},
+    {"grains with d50 a hair below d10", GRAINS(D5("1", "2", "1.9999999", "3", "4"), "40 40", "")
+     STAGE, 'v', "bad:10: d50: expected dmin <= d10 <= d50 <= d60 <= dmax (the share finer by "
+     "area rises with d), got d50 = 1.9999999 < d10 = 2"},
 };
 
 /* What the refusals let through: touching bodies, two held discs that
@@ -1011,7 +1027,7 @@ static const struct bad_scene bad_piles[] = {
     {"seed 0 (GSL's mt19937 would take 4357)", PILE_HEAD "[pile p]\nseed = 0\n", 'p',
      "bad:7: seed: 0 is out of range"},
     {"seed beyond 32 bits", PILE_HEAD "[pile p]\nseed = 4294967296\n", 'p',
-     "bad:7: seed: 4.29497e+09 is out of range"},
+     "bad:7: seed: 4294967296 is out of range: expected 1 <= value <= 4294967295"},
     {"seed not whole", PILE_HEAD "[pile p]\nseed = 2.5\n", 'p',
      "bad:7: seed: expected an integer, got '2.5'"},
     {"size_spread not a number", PILE_HEAD "[pile p]\nsize_spread = 1/30\n", 'p',

@@ -182,3 +182,22 @@ def test_a_sweep_over_the_time_step_keeps_the_simulated_time(tmp_path):
     assert runs[1]["time"] == pytest.approx(runs[0]["time"], rel=1e-12)
     for run in runs:
         assert [st["cycles"] * run["dt"] for st in run["stages"]] == pytest.approx([0.4, 6.0], rel=1e-12)
+
+
+# ---- issue 29: inputs refused badly, slowly or not at all (items 9-13, 15) ----------------
+
+# A refusal that takes longer than this was not "at once": each of these took from minutes to
+# forever before (a FIFO blocked in fopen; 1e8 grains took 56 s and 1.9 GB before the refusal).
+AT_ONCE_S = 10
+IMPORT_HEAD = "[material m]\nkn = 1e5\ndensity = 2\n[import p]\n"
+
+
+@needs_ballast
+def test_a_value_just_out_of_range_prints_why(tmp_path):
+    """Item 15: `rolling = 2.0000001` was "2 is out of range: expected 0 <= value <= 2"."""
+    scene = tmp_path / "r.scene"
+    scene.write_text("[material m]\nkn = 1e5\nrolling = 2.0000001\n")
+    done = ballast("run", scene, "--out", tmp_path / "o")
+    assert done.returncode == 2
+    assert done.stderr.strip() == (f"{scene}:3: rolling: 2.0000001 is out of range: "
+                                   "expected 0 <= value <= 2")

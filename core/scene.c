@@ -34,6 +34,11 @@
 
 /* Longest line a scene file may hold; longer lines are refused, not cut. */
 #define LINE_MAX_CHARS 4096
+/* Largest scene file read: a million discs written one [disc] section each
+ * (harness/peer/race.py writes about 150 bytes a disc) with room to spare;
+ * the largest scene of the catalogue is 34 kB.  A larger state belongs in
+ * the data file of an [import] (import.c: up to 4 GB). */
+#define SCENE_MAX_BYTES (256L << 20)
 
 /* ------------------------------------------------------------------ */
 /* Section storage                                                     */
@@ -612,42 +617,20 @@ enum bal_status bal_scene_parse(struct bal_scene *s, const char *text,
 enum bal_status bal_scene_load(struct bal_scene *s, const char *path,
                                struct bal_error *err)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return bal_error(err, BAL_EIO, "%s: cannot open: %s", path, strerror(errno));
-    size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap);
-    if (!buf) {
-        fclose(f);
-        return bal_error(err, BAL_ENOMEM, "%s: out of memory", path);
-    }
-    for (;;) {
-        if (n + 1 >= cap) {
-            char *nb = realloc(buf, cap *= 2);
-            if (!nb) {
-                free(buf);
-                fclose(f);
-                return bal_error(err, BAL_ENOMEM, "%s: out of memory", path);
-            }
-            buf = nb;
-        }
-        size_t got = fread(buf + n, 1, cap - n - 1, f);
-        n += got;
-        if (got == 0)
-            break;
-    }
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        free(buf);
-        return bal_error(err, BAL_EIO, "%s: read error", path);
-    }
-    if (memchr(buf, '\0', n)) {
+    /* Only a regular file, never a FIFO or a device (import.c): an fopen
+     * of a FIFO waited for a writer forever, and /dev/zero was read until
+     * memory ran out. */
+    char msg[BAL_MSG_MAX];
+    enum bal_status st = BAL_OK;
+    long n = 0;
+    char *buf = bal_read_text_file(path, SCENE_MAX_BYTES, BAL_EIO, &n, &st, msg, sizeof msg);
+    if (!buf)
+        return bal_error(err, st, "%s", msg);
+    if (memchr(buf, '\0', (size_t)n)) {
         free(buf);
         return bal_error(err, BAL_EINVAL, "%s: contains a NUL byte; not a scene file", path);
     }
-    buf[n] = '\0';
-    enum bal_status st = bal_scene_parse(s, buf, path, err);
+    st = bal_scene_parse(s, buf, path, err);
     free(buf);
     return st;
 }

@@ -12,6 +12,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "check_main.h"
 
@@ -233,6 +235,51 @@ START_TEST(scene_missing_file_is_eio)
     ck_assert_int_eq(err.code, BAL_EIO);
     ck_assert_msg(t_contains(err.msg, "scenes/no_such_file.scene: cannot open"), "%s", err.msg);
     ck_assert_str_eq(bal_strerror(BAL_EIO), "input/output error");
+}
+END_TEST
+
+/* Issue 29, item 9: a FIFO as the scene or as an [import] data file
+ * blocked in fopen until a writer came (forever, for a run); /dev/zero as
+ * the scene was read until memory ran out.  Each is refused at once as not
+ * a regular file (a hang fails the test by Check's timeout). */
+START_TEST(scene_fifo_and_devices_refused)
+{
+    char dir[] = "/tmp/ballast_fifo_XXXXXX", fifo[64], text[256];
+    ck_assert_ptr_nonnull(mkdtemp(dir));
+    snprintf(fifo, sizeof fifo, "%s/pipe", dir);
+    ck_assert_int_eq(mkfifo(fifo, 0600), 0);
+    static const char *const data_files[] = {"discs", "walls"};
+    for (int k = 0; k < 2; k++)
+        for (int dev = 0; dev < 2; dev++) {
+            const char *path = dev ? "/dev/zero" : fifo;
+            snprintf(text, sizeof text, "[material m]\nkn = 1e5\ndensity = 2\n[import p]\n%s = %s\n",
+                     data_files[k], path);
+            struct bal_scene sc;
+            struct bal_error err = {0};
+            bal_scene_default(&sc);
+            const enum bal_status st = bal_scene_parse(&sc, text, "bad", &err);
+            bal_scene_free(&sc);
+            char expect[160];
+            snprintf(expect, sizeof expect, "bad:5: %s: %s: not a regular file: %s", data_files[k],
+                     path, dev ? "a character device" : "a FIFO (named pipe)");
+            ck_assert_int_eq(st, BAL_EINVAL);
+            ck_assert_msg(t_contains(err.msg, expect), "'%s' lacks '%s'", err.msg, expect);
+        }
+    for (int dev = 0; dev < 3; dev++) {
+        const char *path = dev == 0 ? fifo : dev == 1 ? "/dev/zero" : dir;
+        struct bal_scene sc;
+        struct bal_error err = {0};
+        bal_scene_default(&sc);
+        const enum bal_status st = bal_scene_load(&sc, path, &err);
+        bal_scene_free(&sc);
+        char expect[160];
+        snprintf(expect, sizeof expect, "%s: not a regular file: %s", path,
+                 dev == 0 ? "a FIFO (named pipe)" : dev == 1 ? "a character device" : "a directory");
+        ck_assert_int_eq(st, BAL_EINVAL);
+        ck_assert_msg(t_contains(err.msg, expect), "'%s' lacks '%s'", err.msg, expect);
+    }
+    unlink(fifo);
+    rmdir(dir);
 }
 END_TEST
 
@@ -1431,6 +1478,7 @@ Suite *suite_scene(void)
     tcase_add_test(tc, scene_long_line_refused);
     tcase_add_test(tc, scene_allowed_overlaps_and_forced_steps);
     tcase_add_test(tc, scene_missing_file_is_eio);
+    tcase_add_test(tc, scene_fifo_and_devices_refused);
     tcase_add_test(tc, scene_strerror_names_every_status);
     suite_add_tcase(s, tc);
 

@@ -193,6 +193,29 @@ IMPORT_HEAD = "[material m]\nkn = 1e5\ndensity = 2\n[import p]\n"
 
 
 @needs_ballast
+@pytest.mark.parametrize("where", ["scene", "discs", "walls"])
+def test_a_fifo_is_refused_at_once(tmp_path, where):
+    """Item 9: a FIFO as the scene, or as an [import]'s data file, is not a regular file:
+    exit 2 at once, nothing written (it blocked forever in fopen, waiting for a writer)."""
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    if where == "scene":
+        scene, line = fifo, ""
+    else:
+        (tmp_path / "d.tsv").write_text("x\ty\tr\ttheta\n0\t0\t0.5\t0\n")
+        scene = tmp_path / "imp.scene"
+        files = "discs = pipe\n" if where == "discs" else "discs = d.tsv\nwalls = pipe\n"
+        scene.write_text(IMPORT_HEAD + files + "material = m\nwall_material = m\n"
+                         "[stage s]\ncycles = 1\n")
+        line = ":5: discs: " if where == "discs" else ":6: walls: "
+    done = ballast("run", scene, "--out", tmp_path / "o", timeout=AT_ONCE_S)
+    assert done.returncode == 2, done.stderr
+    head = f"{fifo}" if where == "scene" else f"{scene}{line}{fifo}"
+    assert done.stderr.startswith(f"{head}: not a regular file: a FIFO (named pipe)")
+    assert not (tmp_path / "o").exists()
+
+
+@needs_ballast
 def test_a_value_just_out_of_range_prints_why(tmp_path):
     """Item 15: `rolling = 2.0000001` was "2 is out of range: expected 0 <= value <= 2"."""
     scene = tmp_path / "r.scene"

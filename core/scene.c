@@ -434,8 +434,74 @@ void bal_scene_free(struct bal_scene *s)
     memset(s, 0, sizeof *s);
 }
 
+/* The named sections of a scene being parsed, hashed by kind and name, so
+ * that "name used twice" is one lookup a section: a pass over the sections
+ * of its kind made a scene of 100 000 [disc] sections (4.5 MB) take 54 s to
+ * parse, growing with the square of the count.  Open addressing, at most
+ * half full. */
+struct name_slot {
+    int kind; /* -1: empty */
+    int item; /* index within its kind */
+};
+
+struct name_index {
+    struct name_slot *slot;
+    size_t cap; /* a power of two */
+    size_t used;
+};
+
+static uint64_t name_hash(enum bal_section_kind k, const char *name)
+{
+    uint64_t h = 1469598103934665603ULL ^ (uint64_t)k; /* FNV-1a */
+    for (const unsigned char *c = (const unsigned char *)name; *c; c++)
+        h = (h ^ *c) * 1099511628211ULL;
+    return h;
+}
+
+static int index_find(const struct name_index *ix, const struct bal_scene *s,
+                      enum bal_section_kind k, const char *name)
+{
+    if (ix->cap == 0)
+        return -1;
+    for (size_t h = name_hash(k, name) & (ix->cap - 1);; h = (h + 1) & (ix->cap - 1)) {
+        const struct name_slot *e = &ix->slot[h];
+        if (e->kind < 0)
+            return -1;
+        if (e->kind == (int)k &&
+            strcmp(bal_scene_item_name(bal_scene_section(s, k, e->item)), name) == 0)
+            return e->item;
+    }
+}
+
+/* Add item i of kind k; 0, or -1 when out of memory. */
+static int index_add(struct name_index *ix, const struct bal_scene *s, enum bal_section_kind k,
+                     int i)
+{
+    if (2 * (ix->used + 1) > ix->cap) {
+        struct name_index bigger = {NULL, ix->cap ? 2 * ix->cap : 64, 0};
+        bigger.slot = malloc(bigger.cap * sizeof *bigger.slot);
+        if (!bigger.slot)
+            return -1;
+        for (size_t h = 0; h < bigger.cap; h++)
+            bigger.slot[h].kind = -1;
+        for (size_t h = 0; h < ix->cap; h++)
+            if (ix->slot[h].kind >= 0)
+                (void)index_add(&bigger, s, (enum bal_section_kind)ix->slot[h].kind,
+                                ix->slot[h].item);
+        free(ix->slot);
+        *ix = bigger;
+    }
+    const char *name = bal_scene_item_name(bal_scene_section(s, k, i));
+    size_t h = name_hash(k, name) & (ix->cap - 1);
+    while (ix->slot[h].kind >= 0)
+        h = (h + 1) & (ix->cap - 1);
+    ix->slot[h] = (struct name_slot){(int)k, i};
+    ix->used++;
+    return 0;
+}
+
 static enum bal_status new_section(struct bal_scene *s, enum bal_section_kind k,
-                                   const char *name, struct where w,
+                                   const char *name, struct where w, struct name_index *ix,
                                    void **out, struct bal_error *err)
 {
     if (k == BAL_SEC_SETTINGS) {
@@ -452,8 +518,7 @@ static enum bal_status new_section(struct bal_scene *s, enum bal_section_kind k,
                          "%s:%d: [%s]: expected a name of letters, digits, '_' or '-' "
                          "(at most 47), got '%s'",
                          w.file, w.line, bal_scene_sections[k].name, name);
-    int prev = bal_scene_find(s, k, name);
-    if (prev >= 0)
+    if (index_find(ix, s, k, name) >= 0)
         return bal_error(err, BAL_EINVAL, "%s:%d: [%s %s]: name used twice",
                          w.file, w.line, bal_scene_sections[k].name, name);
     struct section_array a = section_array(s, k);
@@ -472,6 +537,8 @@ static enum bal_status new_section(struct bal_scene *s, enum bal_section_kind k,
     strcpy(bal_scene_item_name(item), name);
     *bal_scene_item_line(item) = w.line;
     apply_defaults(item, k);
+    if (index_add(ix, s, k, *a.count - 1))
+        return bal_error(err, BAL_ENOMEM, "%s:%d: out of memory", w.file, w.line);
     *out = item;
     return BAL_OK;
 }
@@ -527,8 +594,8 @@ static int section_kind(const char *word)
     return -1;
 }
 
-enum bal_status bal_scene_parse(struct bal_scene *s, const char *text,
-                                const char *name, struct bal_error *err)
+static enum bal_status parse_text(struct bal_scene *s, const char *text, const char *name,
+                                  struct name_index *ix, struct bal_error *err)
 {
     snprintf(s->path, sizeof s->path, "%s", name);
     struct where w = {s->path, 0};
@@ -590,7 +657,7 @@ enum bal_status bal_scene_parse(struct bal_scene *s, const char *text,
                 return bal_error(err, BAL_EINVAL, "%s:%d: [%s]: takes no name, got '%s'",
                                  w.file, w.line, inner, sec_name);
             kind = (enum bal_section_kind)k;
-            if (new_section(s, kind, sec_name, w, &item, err))
+            if (new_section(s, kind, sec_name, w, ix, &item, err))
                 return err->code;
             continue;
         }
@@ -612,6 +679,24 @@ enum bal_status bal_scene_parse(struct bal_scene *s, const char *text,
             return err->code;
     }
     return BAL_OK;
+}
+
+enum bal_status bal_scene_parse(struct bal_scene *s, const char *text,
+                                const char *name, struct bal_error *err)
+{
+    /* The sections the scene holds already (a second text parsed into it)
+     * are in the index from the start. */
+    struct name_index ix = {NULL, 0, 0};
+    enum bal_status st = BAL_OK;
+    for (int k = 0; k < BAL_SEC_COUNT && st == BAL_OK; k++)
+        for (int i = 0; bal_scene_sections[k].named && i < bal_scene_count(s, k) && st == BAL_OK;
+             i++)
+            if (index_add(&ix, s, (enum bal_section_kind)k, i))
+                st = bal_error(err, BAL_ENOMEM, "%s: out of memory", name);
+    if (st == BAL_OK)
+        st = parse_text(s, text, name, &ix, err);
+    free(ix.slot);
+    return st;
 }
 
 enum bal_status bal_scene_load(struct bal_scene *s, const char *path,

@@ -457,7 +457,11 @@ enum bal_status bal_import_read(struct bal_import_def *imp, const char *what, co
     if (!text)
         return st;
     struct reader r = {.path = path, .msg = msg, .size = size};
-    st = strcmp(what, "discs") == 0 ? read_discs(imp, &r, text) : read_walls(imp, &r, text);
+    /* A UTF-8 byte-order mark, which some editors and spreadsheets put at
+     * the start of a file, is not part of the first column's name (the
+     * scene parser skips it too). */
+    char *start = strncmp(text, "\xEF\xBB\xBF", 3) == 0 ? text + 3 : text;
+    st = strcmp(what, "discs") == 0 ? read_discs(imp, &r, start) : read_walls(imp, &r, start);
     free(text);
     return st;
 }

@@ -322,6 +322,27 @@ START_TEST(specimen_import_set)
 }
 END_TEST
 
+/* Issue 29, item 10: a UTF-8 byte-order mark before the header (a file
+ * saved by a spreadsheet or an editor) is no part of the first column's
+ * name: "no column 'x' in the header" was the message for a header that
+ * visibly had x.  The files read as the same files without it. */
+START_TEST(specimen_import_byte_order_mark)
+{
+    struct tfx *f = tfx_parse("[material m]\nkn = 1e5\ndensity = 2\n[import p]\n"
+                              "discs = scenes/import/bom_discs.tsv\n"
+                              "walls = scenes/import/bom_walls.tsv\nmaterial = m\n"
+                              "wall_material = m\n[stage s]\ncycles = 1\n", "bom");
+    const struct bal_import_def *m = &f->sc.imports[0];
+    ck_assert_int_eq(m->n, 2);
+    ck_assert_double_eq(m->disc_data[BAL_IMPORT_X], 0.5);
+    ck_assert_double_eq(m->disc_data[BAL_IMPORT_COLUMNS + BAL_IMPORT_X], 1.5);
+    ck_assert_double_eq(m->disc_data[BAL_IMPORT_COLUMNS + BAL_IMPORT_R], 0.3);
+    ck_assert_int_eq(m->n_walls, 1);
+    ck_assert_str_eq(m->wall_data[0].name, "floor");
+    ck_assert_double_eq(m->wall_data[0].b[0], 3);
+}
+END_TEST
+
 Suite *suite_specimen(void)
 {
     Suite *s = suite_create("specimen");
@@ -338,6 +359,7 @@ Suite *suite_specimen(void)
     tcase_add_checked_fixture(tc, NULL, tfx_teardown);
     tcase_add_test(tc, specimen_import_round_trip);
     tcase_add_test(tc, specimen_import_set);
+    tcase_add_test(tc, specimen_import_byte_order_mark);
     suite_add_tcase(s, tc);
     return s;
 }

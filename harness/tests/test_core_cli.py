@@ -216,6 +216,23 @@ def test_a_fifo_is_refused_at_once(tmp_path, where):
 
 
 @needs_ballast
+def test_an_import_file_with_a_byte_order_mark_runs(tmp_path):
+    """Item 10: a discs.tsv saved with a UTF-8 byte-order mark before the header x ... runs
+    like the same file without it (it was "no column 'x' in the header")."""
+    rows = "x\ty\tr\ttheta\n0\t0\t0.5\t0\n2\t0\t0.5\t0\n"
+    (tmp_path / "plain.tsv").write_text(rows)
+    (tmp_path / "marked.tsv").write_bytes(b"\xef\xbb\xbf" + rows.encode())
+    out = {}
+    for name in ("plain", "marked"):
+        scene = tmp_path / f"{name}.scene"
+        scene.write_text(IMPORT_HEAD + f"discs = {name}.tsv\nmaterial = m\n[stage s]\ncycles = 5\n")
+        done = ballast("run", scene, "--out", tmp_path / name)
+        assert done.returncode == 0, done.stderr
+        out[name] = (tmp_path / name / "discs.tsv").read_bytes()
+    assert out["plain"] == out["marked"]
+
+
+@needs_ballast
 def test_a_value_just_out_of_range_prints_why(tmp_path):
     """Item 15: `rolling = 2.0000001` was "2 is out of range: expected 0 <= value <= 2"."""
     scene = tmp_path / "r.scene"

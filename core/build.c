@@ -482,6 +482,37 @@ enum bal_status bal_build_timestep(struct bal_sim *s, struct bal_error *err)
     return BAL_OK;
 }
 
+/* Touching within this share of the smaller radius is contact, not an
+ * overlap (the text a run writes, %.17g, comes back to within an ulp). */
+#define TOUCH_SHARE 1e-9
+
+/* The overlap of disc slot i with disc slot j (wall = 0) or wall j, for
+ * check_overlaps' message: "FILE:LINE: KEY: disc A: overlaps disc B by
+ * ...", from the line that placed the free disc. */
+static enum bal_status overlap_error(const struct bal_sim *s, int i, int j, int wall,
+                                     double delta, double rmin, struct bal_error *err)
+{
+    char a[2 * BAL_NAME_MAX], b[3 * BAL_NAME_MAX];
+    bal_specimen_disc_name(s->scene, s->id[i], a, sizeof a);
+    if (wall) {
+        snprintf(b, sizeof b, "wall %s", s->walls[j].name);
+    } else {
+        char d[2 * BAL_NAME_MAX];
+        bal_specimen_disc_name(s->scene, s->id[j], d, sizeof d);
+        snprintf(b, sizeof b, "disc %s", d);
+    }
+    if (s->fixed[i]) /* name the free disc first */
+        snprintf(b, sizeof b, "disc %s", a);
+    /* Where the (free) disc was placed is where the overlap was written. */
+    char where[3 * BAL_NAME_MAX + 600];
+    bal_specimen_disc_origin(s->scene, s->id[s->fixed[i] ? j : i], BAL_DISC_PLACE, where,
+                             sizeof where);
+    return bal_error(err, BAL_EINVAL,
+                     "%s: overlaps %s by %.6g (%.3g of the smaller radius) at the start; "
+                     "expected bodies apart or touching, or settings.allow_overlap = 1",
+                     where, b, delta, delta / rmin);
+}
+
 /* Bodies that overlap at the start are refused unless the scene allows it:
  * an overlap nobody meant is a typo, and it starts the run with energy the
  * scene never declared.  Two held discs may overlap (they never move: MLH's
@@ -499,23 +530,49 @@ static enum bal_status check_overlaps(const struct bal_sim *s, struct bal_error 
             double rmin;
             const struct bal_pair_law *law;
             const double delta = bal_pairs_overlap(s, walls, c, &rmin, &law);
-            if (delta <= 1e-9 * rmin)
-                continue;
-            char a[2 * BAL_NAME_MAX], b[3 * BAL_NAME_MAX];
-            bal_pairs_names(s, walls, c, a, sizeof a, b, sizeof b);
-            if (s->fixed[i]) /* name the free disc first */
-                snprintf(b, sizeof b, "disc %s", a);
-            /* Where the (free) disc was placed is where the overlap was written. */
-            char where[3 * BAL_NAME_MAX + 600];
-            bal_specimen_disc_origin(s->scene, s->id[s->fixed[i] ? j : i], BAL_DISC_PLACE, where,
-                                sizeof where);
-            return bal_error(err, BAL_EINVAL,
-                             "%s: overlaps %s by %.6g (%.3g of the smaller radius) at the start; "
-                             "expected bodies apart or touching, or settings.allow_overlap = 1",
-                             where, b, delta, delta / rmin);
+            if (delta > TOUCH_SHARE * rmin)
+                return overlap_error(s, i, j, walls, delta, rmin, err);
         }
     }
     return BAL_OK;
+}
+
+/* The first rebuild failed on disc slot i, with more candidates than the
+ * lists hold (BAL_MAX_NEIGHBOURS, grid.c).  At the start that is the
+ * scene's doing, and bad input: discs piled on one another (600 imported
+ * discs at one point, say), refused as any overlap at the start is, with
+ * the first body in slot order that i overlaps (check_overlaps never ran:
+ * it reads the lists that could not be built); or, where nothing overlaps,
+ * radii too far apart for the lists (a disc of r_min cannot have that many
+ * neighbours within 2 r_max + skin otherwise), named at the disc's line. */
+static enum bal_status crowded_at_start(const struct bal_sim *s, int i, struct bal_error *err)
+{
+    if (!s->scene->settings.allow_overlap) {
+        for (int j = 0; j < s->n; j++) {
+            if (j == i || (s->fixed[i] && s->fixed[j]))
+                continue;
+            const double rmin = fmin(s->r[i], s->r[j]);
+            const double delta = s->r[i] + s->r[j] - hypot(s->x[j] - s->x[i], s->y[j] - s->y[i]);
+            if (delta > TOUCH_SHARE * rmin)
+                return overlap_error(s, i < j ? i : j, i < j ? j : i, 0, delta, rmin, err);
+        }
+        for (int k = 0; k < s->n_walls && !s->fixed[i]; k++) {
+            double cx, cy;
+            const double delta =
+                s->r[i] - sqrt(bal_walls_closest(&s->walls[k], s->x[i], s->y[i], &cx, &cy));
+            if (delta > TOUCH_SHARE * s->r[i])
+                return overlap_error(s, i, k, 1, delta, s->r[i], err);
+        }
+    }
+    char where[3 * BAL_NAME_MAX + 600];
+    bal_specimen_disc_origin(s->scene, s->id[i], s->scene->settings.allow_overlap ? BAL_DISC_PLACE
+                             : BAL_DISC_SIZE, where, sizeof where);
+    return bal_error(err, BAL_EINVAL,
+                     "%s: has more than %d neighbours within reach at the start, more than the "
+                     "neighbour lists hold; expected fewer discs within r + r_max + skin of one "
+                     "(r_min %.6g, r_max %.6g, skin %.6g): discs apart, radii closer to each "
+                     "other or a smaller settings.skin",
+                     where, BAL_MAX_NEIGHBOURS, s->r_min, s->r_max, s->skin);
 }
 
 enum bal_status bal_build_lists(struct bal_sim *s, struct bal_error *err)
@@ -533,7 +590,7 @@ enum bal_status bal_build_lists(struct bal_sim *s, struct bal_error *err)
     s->pair_loop = bal_contacts_select(s->normal_law, s->has_shear || s->has_rolling,
                                        s->has_damping, s->has_rolling);
     if (bal_grid_rebuild(s, err))
-        return err->code;
+        return s->crowded ? crowded_at_start(s, s->crowded - 1, err) : err->code;
     return check_overlaps(s, err);
 }
 

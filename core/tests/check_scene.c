@@ -682,6 +682,12 @@ static const struct bad_scene bad_scenes[] = {
      "bad:34: stop_servo: -0.01 is out of range"},
     {"stop_unbalanced out of range", BOX_STAGE "stop_unbalanced = -1\n", 'p',
      "bad:34: stop_unbalanced: -1 is out of range"},
+    /* Issue 29, item 11: discs piled at one point pass the neighbour
+     * lists' limit (512 a disc) before the start overlaps are checked; the
+     * overlap is still bad input, named like any other. */
+    {"600 imported discs at one point", IMPORT("discs = scenes/import/pile600.tsv\n") STAGE, 'c',
+     "bad:5: discs: disc p.0 of [import p] (line 2 of scenes/import/pile600.tsv): overlaps disc "
+     "p.1 by 1 (2 of the smaller radius) at the start"},
     /* Item 15: a refused value and its bound print differently (%.6g
      * printed "2 is out of range: expected 0 <= value <= 2"). */
     {"rolling just past its bound", "[material m]\nkn = 1e5\nrolling = 2.0000001\n", 'p',

@@ -343,6 +343,49 @@ START_TEST(specimen_import_byte_order_mark)
 }
 END_TEST
 
+/* Item 11: discs piled at one point, more than the neighbour lists hold
+ * for one disc (BAL_MAX_NEIGHBOURS), from every generator that can pile
+ * them (the [import] is in check_scene.c's table; [pile] and [grains] lay
+ * discs apart by construction): the start overlap is bad input, named at
+ * the line that placed the disc, as any start overlap is; with overlaps
+ * allowed, the crowd itself is, at that line too.  It was "more than 512
+ * neighbours within reach at step 0" with no line, and BAL_EUNSTABLE. */
+START_TEST(specimen_crowded_start_is_bad_input)
+{
+    enum { N = 600 }; /* more than the 512 candidates the lists hold for one disc (grid.h) */
+    const size_t size = 64 + (size_t)N * 96;
+    char *text = malloc(size);
+    ck_assert_ptr_nonnull(text);
+    for (int kind = 0; kind < 3; kind++) {
+        /* 0: [disc] sections, 1: one-disc [fill]s, 2: [disc]s with overlaps allowed */
+        int n = snprintf(text, size, "%s[material m]\nkn = 1e5\ndensity = 2\n",
+                         kind == 2 ? "[settings]\nallow_overlap = 1\n" : "");
+        for (int k = 0; k < N; k++)
+            n += snprintf(text + n, size - (size_t)n,
+                          kind == 1 ? "[fill f%d]\nn = 1\ncolumns = 1\norigin = 0.5 0.5\nrmin = 0.5\n"
+                                      "rmax = 0.5\nmaterial = m\n"
+                                    : "[disc d%d]\nx = 1 1\nr = 0.5\nmaterial = m\n", k);
+        snprintf(text + n, size - (size_t)n, "[stage s]\ncycles = 1\n");
+        struct tfx *f = tfx_parse(text, "crowd");
+        ck_assert_int_eq(tfx_create(f), BAL_EINVAL);
+        /* some disc of the crowd, at its line (after the 3 lines of the
+         * material, and 2 of the settings when given) */
+        const char *expect = kind == 0 ? ": x: disc d" : kind == 1 ? ": origin: disc f" : ": x: disc d";
+        ck_assert_msg(strncmp(f->err.msg, "crowd:", 6) == 0 && t_contains(f->err.msg, expect),
+                      "kind %d: %s", kind, f->err.msg);
+        if (kind < 2)
+            ck_assert_msg(t_contains(f->err.msg, "overlaps disc ") &&
+                          t_contains(f->err.msg, " by 1 (2 of the smaller radius) at the start"),
+                          "kind %d: %s", kind, f->err.msg);
+        else
+            ck_assert_msg(t_contains(f->err.msg, "has more than 512 neighbours within reach at "
+                                                 "the start"), "%s", f->err.msg);
+        tfx_release(f);
+    }
+    free(text);
+}
+END_TEST
+
 Suite *suite_specimen(void)
 {
     Suite *s = suite_create("specimen");
@@ -360,6 +403,7 @@ Suite *suite_specimen(void)
     tcase_add_test(tc, specimen_import_round_trip);
     tcase_add_test(tc, specimen_import_set);
     tcase_add_test(tc, specimen_import_byte_order_mark);
+    tcase_add_test(tc, specimen_crowded_start_is_bad_input);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -233,6 +233,21 @@ def test_an_import_file_with_a_byte_order_mark_runs(tmp_path):
 
 
 @needs_ballast
+def test_discs_piled_at_one_point_are_bad_input(tmp_path):
+    """Item 11: 600 imported discs at one point were "more than 512 neighbours within reach at
+    step 0", exit 1, no line; the start overlap is bad input: exit 2, FILE:LINE: discs:, no
+    output folder."""
+    (tmp_path / "pile.tsv").write_text("x\ty\tr\ttheta\n" + "1\t1\t0.5\t0\n" * 600)
+    scene = tmp_path / "pile.scene"
+    scene.write_text(IMPORT_HEAD + "discs = pile.tsv\nmaterial = m\n[stage s]\ncycles = 1\n")
+    done = ballast("run", scene, "--out", tmp_path / "o", timeout=AT_ONCE_S)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.startswith(f"{scene}:5: discs: disc p.0 of [import p] (line 2 of pile.tsv): "
+                                  "overlaps disc p.1 by 1 (2 of the smaller radius) at the start")
+    assert not (tmp_path / "o").exists()
+
+
+@needs_ballast
 def test_a_value_just_out_of_range_prints_why(tmp_path):
     """Item 15: `rolling = 2.0000001` was "2 is out of range: expected 0 <= value <= 2"."""
     scene = tmp_path / "r.scene"

@@ -268,6 +268,10 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
             return FAIL_AT(g, BAL_SEC_GRAINS, "size",
                            "the region %s x %s must be at least dmax = %s wide and high",
                            BAL_NUM(g->size[0]), BAL_NUM(g->size[1]), BAL_NUM(g->dmax));
+        const char *key = NULL;
+        char why[BAL_MSG_MAX / 2];
+        if (bal_specimen_grains_check(g, &key, why, sizeof why))
+            return FAIL_AT(g, BAL_SEC_GRAINS, key, "%s", why);
         if (check_material_ref(s, g, BAL_SEC_GRAINS, "material", g->material, 1, err))
             return err->code;
         if (g->box) {

@@ -43,6 +43,14 @@ double bal_specimen_grading_diameter(const struct bal_grains_def *g, double u1, 
 /* The curve itself: the share of the area in discs of diameter <= d. */
 double bal_specimen_grading_finer(const struct bal_grains_def *g, double d);
 
+/* Can a [grains] section's discs be placed at all?  0; or 1 with the key
+ * to blame in *key ("n", "origin" or "size") and why in `why`: more discs
+ * of diameter dmin than the densest packing puts in the region, or a
+ * region where the spacing of doubles is not small against the smallest
+ * radius (specimen.c).  Validation asks it, before anything is drawn. */
+int bal_specimen_grains_check(const struct bal_grains_def *g, const char **key, char *why,
+                              size_t size);
+
 /* The name of the disc with scene-order index id: its [disc] name, or
  * FILL.k / PILE.k for the k-th disc a generator made. */
 void bal_specimen_disc_name(const struct bal_scene *sc, int id, char *buf, size_t size);

@@ -688,6 +688,26 @@ static const struct bad_scene bad_scenes[] = {
     {"600 imported discs at one point", IMPORT("discs = scenes/import/pile600.tsv\n") STAGE, 'c',
      "bad:5: discs: disc p.0 of [import p] (line 2 of scenes/import/pile600.tsv): overlaps disc "
      "p.1 by 1 (2 of the smaller radius) at the start"},
+    /* Item 12: a [grains] that cannot fit is refused from the area alone
+     * (2 x 20 x 20 / (sqrt 3 x 1^2) = 461.9 discs of diameter 1 at most),
+     * before any disc is drawn; an origin where the doubles are too far
+     * apart is named, not n. */
+    {"grains of more discs than the densest packing holds",
+     "[material m]\nkn = 1e5\ndensity = 2\n[grains g]\nsize = 20 20\nn = 462\nmaterial = m\n"
+     D5("1", "1.2", "1.5", "1.6", "2") STAGE, 'v',
+     "bad:6: n: [grains g]: 462 discs of diameter >= dmin = 1 cannot lie apart in the region "
+     "20 x 20: at most 461 can"},
+    {"grains of as many discs as the densest packing holds: tried, and jammed",
+     "[material m]\nkn = 1e5\ndensity = 2\n[grains g]\nsize = 20 20\nn = 461\nmaterial = m\n"
+     "tries = 100\n" D5("1", "1.2", "1.5", "1.6", "2") STAGE, 'c', "bad:6: n: [grains g]: placed "},
+    {"grains at an origin where doubles are far apart",
+     GRAINS(D5("1", "2", "2.5", "3", "4"), "40 40", "origin = 1e300 1e300\n") STAGE, 'v',
+     "bad:13: origin: [grains g]: the region reaches x = 1e+300, where doubles are "
+     "1.487016908477783e+284 apart, more than 1e-06 of the smallest radius dmin/2 = 0.5"},
+    {"grains region reaching where doubles are far apart",
+     GRAINS(D5("1", "2", "2.5", "3", "4"), "1e10 40", "") STAGE, 'v',
+     "bad:5: size: [grains g]: the region reaches x = 1e+10, where doubles are "
+     "1.9073486328125e-06 apart"},
     /* Item 15: a refused value and its bound print differently (%.6g
      * printed "2 is out of range: expected 0 <= value <= 2"). */
     {"rolling just past its bound", "[material m]\nkn = 1e5\nrolling = 2.0000001\n", 'p',

@@ -247,6 +247,34 @@ def test_discs_piled_at_one_point_are_bad_input(tmp_path):
     assert not (tmp_path / "o").exists()
 
 
+GRAINS = ("[material m]\nkn = 1e5\ndensity = 2\n[grains g]\nsize = 20 20\nn = {n}\nmaterial = m\n"
+          "dmin = 1\nd10 = 1.2\nd50 = 1.5\nd60 = 1.6\ndmax = 2\n{more}[stage s]\ncycles = 1\n")
+
+
+@needs_ballast
+def test_grains_that_cannot_fit_are_refused_at_once(tmp_path):
+    """Item 12: 1e8 grains of diameter >= 1 in a 20 x 20 region were refused after 56 s and
+    1.9 GB; the densest packing bounds them at 2 x 20 x 20 / sqrt(3) = 461, refused at once."""
+    scene = tmp_path / "g.scene"
+    scene.write_text(GRAINS.format(n=100000000, more=""))
+    done = ballast("run", scene, "--out", tmp_path / "o", timeout=AT_ONCE_S)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.startswith(f"{scene}:6: n: [grains g]: 100000000 discs of diameter >= dmin = 1 "
+                                  "cannot lie apart in the region 20 x 20: at most 461 can")
+
+
+@needs_ballast
+def test_a_grains_origin_beyond_precision_is_named(tmp_path):
+    """Item 12: origin = 1e300 1e300 was blamed on n ("fewer discs"); it is the origin, where
+    the doubles are 1.5e284 apart."""
+    scene = tmp_path / "g.scene"
+    scene.write_text(GRAINS.format(n=40, more="origin = 1e300 1e300\n"))
+    done = ballast("run", scene, "--out", tmp_path / "o", timeout=AT_ONCE_S)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.startswith(f"{scene}:13: origin: [grains g]: the region reaches x = 1e+300, "
+                                  "where doubles are 1.487016908477783e+284 apart")
+
+
 @needs_ballast
 def test_a_value_just_out_of_range_prints_why(tmp_path):
     """Item 15: `rolling = 2.0000001` was "2 is out of range: expected 0 <= value <= 2"."""

@@ -597,8 +597,9 @@ enum bal_status bal_build_lists(struct bal_sim *s, struct bal_error *err)
 static enum bal_status resolve_body(const struct bal_sim *s, const struct bal_scene *sc,
                                     const char *name, int *is_wall, int *index)
 {
-    int i = bal_scene_find(sc, BAL_SEC_DISC, name);
-    if (i >= 0) {
+    char why[BAL_MSG_MAX / 2];
+    const long i = bal_specimen_find_disc(sc, name, why, sizeof why);
+    if (i >= 0 && i < s->n) {
         *is_wall = 0;
         *index = s->slot[i];
         return BAL_OK;

@@ -182,6 +182,28 @@ static int valid_name(const char *v)
     return 1;
 }
 
+/* A body's name: a section's name, or NAME.k (k in decimal, without
+ * leading zeros: one text per disc, as messages print it). */
+static int valid_body(const char *v)
+{
+    const char *dot = strrchr(v, '.');
+    if (!dot)
+        return valid_name(v);
+    char name[BAL_NAME_MAX];
+    const size_t len = (size_t)(dot - v);
+    if (len >= sizeof name)
+        return 0;
+    memcpy(name, v, len);
+    name[len] = '\0';
+    const char *k = dot + 1;
+    if (!valid_name(name) || !*k || (k[0] == '0' && k[1]) || strlen(k) > 9)
+        return 0;
+    for (; *k; k++)
+        if (*k < '0' || *k > '9')
+            return 0;
+    return 1;
+}
+
 static enum bal_status check_range(const struct bal_key *key, double v,
                                    struct where w, struct bal_error *err)
 {
@@ -240,6 +262,14 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
             return where_error(err, w, key->name,
                                "expected a name of letters, digits, '_' or '-' "
                                "(at most 47), got '%s'", value);
+        strcpy(field, value);
+        return BAL_OK;
+    case BAL_KEY_BODY:
+        if (strlen(value) >= BAL_BODY_MAX || (*value && !valid_body(value)))
+            return where_error(err, w, key->name,
+                               "expected the name of a disc or a wall (letters, digits, '_' or "
+                               "'-', at most 47), or NAME.k for the k-th disc of a generator, "
+                               "got '%s'", value);
         strcpy(field, value);
         return BAL_OK;
     case BAL_KEY_ENUM: {

@@ -106,10 +106,12 @@ static int generated_wall(const struct bal_scene *s, const char *name, int *line
     return 0;
 }
 
-/* Is `name` a disc, a wall, or a wall a generator makes? */
+/* Is `name` a disc (NAME.k for a generator's, specimen.c), a wall, or a
+ * wall a generator makes? */
 static int body_exists(const struct bal_scene *s, const char *name, int *is_wall)
 {
-    if (bal_scene_find(s, BAL_SEC_DISC, name) >= 0) {
+    char why[BAL_MSG_MAX / 2];
+    if (bal_specimen_find_disc(s, name, why, sizeof why) >= 0) {
         *is_wall = 0;
         return 1;
     }
@@ -119,6 +121,14 @@ static int body_exists(const struct bal_scene *s, const char *name, int *is_wall
         return 1;
     }
     return 0;
+}
+
+/* Why no body has this name ("no disc or wall named 'x'", or what is
+ * wrong with a NAME.k), into why. */
+static const char *no_body(const struct bal_scene *s, const char *name, char *why, size_t size)
+{
+    (void)bal_specimen_find_disc(s, name, why, size);
+    return why;
 }
 
 /* Probes and moves find bodies by name, so a disc, a wall and the walls a
@@ -345,6 +355,7 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
     for (int i = 0; i < s->n_probes; i++) {
         struct bal_probe_def *p = &s->probes[i];
         int k = p->kind, wa = 0, wb = 0;
+        char why[BAL_MSG_MAX / 2];
         int contact = bal_probe_is_contact(k);
         int wall = bal_probe_is_wall(k);
         int disc = k >= BAL_PROBE_DISC_X && k <= BAL_PROBE_DISC_OMEGA;
@@ -352,7 +363,7 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
             if (!*p->a)
                 return FAIL_AT(p, BAL_SEC_PROBE, "a", "%s", "this quantity needs a body in 'a'");
             if (!body_exists(s, p->a, &wa))
-                return FAIL_AT(p, BAL_SEC_PROBE, "a", "no disc or wall named '%s'", p->a);
+                return FAIL_AT(p, BAL_SEC_PROBE, "a", "%s", no_body(s, p->a, why, sizeof why));
             if (wall && !wa)
                 return FAIL_AT(p, BAL_SEC_PROBE, "a", "'%s' is a disc; this quantity needs a wall",
                                p->a);
@@ -364,7 +375,7 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
             if (!*p->b)
                 return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "a contact probe needs a second body in 'b'");
             if (!body_exists(s, p->b, &wb))
-                return FAIL_AT(p, BAL_SEC_PROBE, "b", "no disc or wall named '%s'", p->b);
+                return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", no_body(s, p->b, why, sizeof why));
             if (wa && wb)
                 return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "two walls never make a contact");
             if (strcmp(p->a, p->b) == 0)

@@ -685,6 +685,63 @@ void bal_specimen_disc_name(const struct bal_scene *sc, int id, char *buf, size_
     snprintf(buf, size, "?%d", id);
 }
 
+long bal_specimen_find_disc(const struct bal_scene *sc, const char *name, char *why, size_t size)
+{
+    const char *dot = strrchr(name, '.');
+    if (!dot) {
+        const int i = bal_scene_find(sc, BAL_SEC_DISC, name);
+        if (i < 0)
+            snprintf(why, size, "no disc or wall named '%s'", name);
+        return i;
+    }
+    /* NAME.k: the generators in scene order, counting the discs before */
+    char gen[BAL_NAME_MAX];
+    const size_t len = (size_t)(dot - name);
+    snprintf(gen, sizeof gen, "%.*s", (int)(len < sizeof gen ? len : sizeof gen - 1), name);
+    char *end;
+    const long k = strtol(dot + 1, &end, 10);
+    long first = sc->n_discs, found = -1, count = 0;
+    const char *kind = NULL, *also = NULL;
+    for (int pass = 0; pass < 4; pass++) {
+        const int n_sec = pass == 0 ? sc->n_fills : pass == 1 ? sc->n_piles
+                        : pass == 2 ? sc->n_grains : sc->n_imports;
+        for (int q = 0; q < n_sec; q++) {
+            const char *nm = pass == 0 ? sc->fills[q].name : pass == 1 ? sc->piles[q].name
+                           : pass == 2 ? sc->grains[q].name : sc->imports[q].name;
+            const long n = pass == 0 ? sc->fills[q].n : pass == 1 ? bal_specimen_pile_count(&sc->piles[q])
+                         : pass == 2 ? sc->grains[q].n : sc->imports[q].n;
+            const char *kd = pass == 0 ? "fill" : pass == 1 ? "pile" : pass == 2 ? "grains" : "import";
+            if (strlen(nm) == len && strncmp(nm, name, len) == 0) {
+                if (kind)
+                    also = kd;
+                else {
+                    kind = kd;
+                    found = first;
+                    count = n;
+                }
+            }
+            first += n;
+        }
+    }
+    if (!kind) {
+        snprintf(why, size, "no disc or wall named '%s' (NAME.k names the k-th disc of the "
+                 "generator NAME: no [fill], [pile], [grains] or [import] is named '%s')", name,
+                 gen);
+        return -1;
+    }
+    if (also) {
+        snprintf(why, size, "'%s' could be a disc of [%s %s] or of [%s %s]; expected "
+                 "generators of different names", name, kind, gen, also, gen);
+        return -1;
+    }
+    if (*end || k < 0 || k >= count) {
+        snprintf(why, size, "no disc named '%s': [%s %s] makes %ld discs, %s.0 to %s.%ld",
+                 name, kind, gen, count, gen, gen, count - 1);
+        return -1;
+    }
+    return found + k;
+}
+
 void bal_specimen_disc_origin(const struct bal_scene *sc, int id, enum bal_disc_prop prop,
                               char *buf, size_t size)
 {

@@ -708,6 +708,22 @@ static const struct bad_scene bad_scenes[] = {
      GRAINS(D5("1", "2", "2.5", "3", "4"), "1e10 40", "") STAGE, 'v',
      "bad:5: size: [grains g]: the region reaches x = 1e+10, where doubles are "
      "1.9073486328125e-06 apart"},
+    /* Item 13: a generator's discs are probed as NAME.k, as messages name
+     * them; what such a name can get wrong. */
+    {"probe of a generator's disc past its count",
+     GRAINS(D5("1", "2", "2.5", "3", "4"), "40 40", "") STAGE "[probe p]\nquantity = disc_y\n"
+     "a = g.40\n", 'v', "bad:17: a: no disc named 'g.40': [grains g] makes 40 discs, g.0 to g.39"},
+    {"probe of NAME.k with a leading zero",
+     GRAINS(D5("1", "2", "2.5", "3", "4"), "40 40", "") STAGE "[probe p]\nquantity = disc_y\n"
+     "a = g.01\n", 'p', "bad:17: a: expected the name of a disc or a wall"},
+    {"probe of a disc two generators could have made",
+     GRAINS(D5("1", "2", "2.5", "3", "4"), "40 40", "")
+     "[fill g]\nn = 2\ncolumns = 2\norigin = 100 0\nrmin = 0.5\nrmax = 0.5\nmaterial = m\n" STAGE
+     "[probe p]\nquantity = contact_fn\na = g.0\nb = g.1\n", 'v',
+     "bad:24: a: 'g.0' could be a disc of [fill g] or of [grains g]; expected generators of "
+     "different names"},
+    {"probe of a generator that does not exist", HEAD STAGE "[probe p]\nquantity = disc_x\n"
+     "a = ghost.0\n", 'v', "bad:12: a: no disc or wall named 'ghost.0'"},
     /* Item 15: a refused value and its bound print differently (%.6g
      * printed "2 is out of range: expected 0 <= value <= 2"). */
     {"rolling just past its bound", "[material m]\nkn = 1e5\nrolling = 2.0000001\n", 'p',

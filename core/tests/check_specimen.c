@@ -386,6 +386,60 @@ START_TEST(specimen_crowded_start_is_bad_input)
 }
 END_TEST
 
+/* Item 13: a generator's discs are named NAME.k in every message, and a
+ * probe names them so: [fill], [pile], [grains] and [import].  A probe of
+ * each disc by the name bal_specimen_disc_name gives it reads that disc;
+ * and the probes read the discs the layout rules put there (fill: the
+ * lattice of pitch 2 rmax from the origin; pile: bottom row from origin +
+ * d/2, one d apart, on the floor; import: the file's rows). */
+#define GENERATED                                                                              \
+    "[material m]\nkn = 1e5\ndensity = 2\n"                                                   \
+    "[fill f]\nn = 6\ncolumns = 3\norigin = 0 30\nrmin = 0.5\nrmax = 0.5\nmaterial = m\n"      \
+    "[pile q]\nL = 4\nd = 1\norigin = 50 0\nmaterial = m\nwall_material = m\n"                 \
+    "[grains g]\nsize = 20 20\nn = 10\nmaterial = m\ndmin = 1\nd10 = 1.2\nd50 = 1.5\n"         \
+    "d60 = 1.6\ndmax = 2\n"                                                                     \
+    "[import p]\ndiscs = scenes/import/discs.tsv\nmaterial = m\n"                              \
+    "[stage s]\ncycles = 1\n"
+
+START_TEST(specimen_generated_discs_probed)
+{
+    struct tfx *names = tfx_parse(GENERATED, "generated");
+    const long n = bal_specimen_count(&names->sc);
+    ck_assert_int_eq(n, 6 + 5 + 10 + 2);
+    char text[T_TEXT_MAX];
+    int len = snprintf(text, sizeof text, "%s", GENERATED
+                       "[probe fy]\nquantity = disc_y\na = f.4\n[probe fx]\nquantity = disc_x\n"
+                       "a = f.4\n[probe qx]\nquantity = disc_x\na = q.3\n[probe qy]\n"
+                       "quantity = disc_y\na = q.3\n[probe px]\nquantity = disc_x\na = p.1\n"
+                       "[probe pr]\nquantity = contact_fn\na = p.0\nb = q_floor\n");
+    for (int id = 0; id < n; id++) {
+        char name[2 * BAL_NAME_MAX];
+        bal_specimen_disc_name(&names->sc, id, name, sizeof name);
+        len += snprintf(text + len, sizeof text - (size_t)len,
+                        "[probe x%d]\nquantity = disc_x\na = %s\n[probe y%d]\nquantity = disc_y\n"
+                        "a = %s\n", id, name, id, name);
+        ck_assert_int_lt(len, (int)sizeof text);
+    }
+    struct tfx *f = tfx_new(text, "generated");
+    t_steps(f, 1);
+    const struct bal_sim *s = f->sim;
+    for (int id = 0; id < n; id++) {
+        char px[16], py[16];
+        snprintf(px, sizeof px, "x%d", id);
+        snprintf(py, sizeof py, "y%d", id);
+        ck_assert_double_eq(t_probe_value(f, px), s->x[s->slot[id]]);
+        ck_assert_double_eq(t_probe_value(f, py), s->y[s->slot[id]]);
+    }
+    /* f.4: row 1, column 1 (3 columns); at rest (no gravity, touching) */
+    ck_assert_double_eq(t_probe_value(f, "fx"), 0 + 0.5 + 1 * 1.0);
+    ck_assert_double_eq(t_probe_value(f, "fy"), 30 + 0.5 + 1 * 1.0);
+    ck_assert_double_eq(t_probe_value(f, "qx"), 50 + 0.5 + 3 * 1.0);
+    ck_assert_double_eq(t_probe_value(f, "qy"), 0.5);
+    ck_assert_double_eq(t_probe_value(f, "px"), 1.5);
+    ck_assert_double_eq(t_probe_value(f, "pr"), 0); /* p.0 is nowhere near the floor */
+}
+END_TEST
+
 Suite *suite_specimen(void)
 {
     Suite *s = suite_create("specimen");
@@ -404,6 +458,7 @@ Suite *suite_specimen(void)
     tcase_add_test(tc, specimen_import_set);
     tcase_add_test(tc, specimen_import_byte_order_mark);
     tcase_add_test(tc, specimen_crowded_start_is_bad_input);
+    tcase_add_test(tc, specimen_generated_discs_probed);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -276,6 +276,23 @@ def test_a_grains_origin_beyond_precision_is_named(tmp_path):
 
 
 @needs_ballast
+def test_a_generated_disc_is_probed_by_its_name(tmp_path):
+    """Item 13: `[probe] quantity = disc_y, a = g.0` was refused although every message names
+    the disc g.0; its column is the y that discs.tsv gives the disc named g.0."""
+    scene = tmp_path / "g.scene"
+    scene.write_text(GRAINS.format(n=40, more="").replace(
+        "[stage s]\ncycles = 1\n", "[stage s]\ncycles = 1\n[probe y]\nquantity = disc_y\na = g.0\n"))
+    done = ballast("run", scene, "--out", tmp_path / "o")
+    assert done.returncode == 0, done.stderr
+    series = (tmp_path / "o" / "series.tsv").read_text().splitlines()
+    assert series[0].split("\t")[-1] == "y"
+    discs = [line.split("\t") for line in (tmp_path / "o" / "discs.tsv").read_text().splitlines()]
+    col = {name: k for k, name in enumerate(discs[0])}
+    row = next(r for r in discs[1:] if r[col["name"]] == "g.0")
+    assert series[-1].split("\t")[-1] == row[col["y"]]
+
+
+@needs_ballast
 def test_a_value_just_out_of_range_prints_why(tmp_path):
     """Item 15: `rolling = 2.0000001` was "2 is out of range: expected 0 <= value <= 2"."""
     scene = tmp_path / "r.scene"

@@ -669,19 +669,6 @@ static const struct bad_scene bad_scenes[] = {
      IMPORT("discs = scenes/import/discs.tsv\n")
      "[wall w]\np = 0 0.4\nangle = 0\nh1 = 0\nh2 = 1\nmaterial = m\n" STAGE, 'c',
      "bad:5: discs: disc p.0 of [import p] (line 2 of scenes/import/discs.tsv): overlaps wall w"},
-    {"hold of an unknown component", HEAD "hold = x z\n" STAGE, 'p',
-     "bad:8: hold: expected 'none' or words of {x y rotation}, got 'z'"},
-    {"hold of a moving component", HEAD "hold = y\nv = 0 0.5\n" STAGE, 'v',
-     "bad:8: hold: a held component cannot have a velocity"},
-    {"hold of a spinning disc", HEAD "omega = 2\nhold = rotation x\n" STAGE, 'v',
-     "bad:9: hold: a held component cannot have a velocity"},
-    {"a partly held disc overlapping another at the start",
-     HEAD "hold = x rotation\n[disc b]\nx = 0.9 0\nr = 0.5\nmaterial = m\n" STAGE, 'c',
-     "bad:5: x: disc a: overlaps disc b by 0.1"},
-    {"stop_servo out of range", BOX_STAGE "stop_servo = -0.01\n", 'p',
-     "bad:34: stop_servo: -0.01 is out of range"},
-    {"stop_unbalanced out of range", BOX_STAGE "stop_unbalanced = -1\n", 'p',
-     "bad:34: stop_unbalanced: -1 is out of range"},
     /* Issue 29, item 11: discs piled at one point pass the neighbour
      * lists' limit (512 a disc) before the start overlaps are checked; the
      * overlap is still bad input, named like any other. */
@@ -740,6 +727,19 @@ static const struct bad_scene bad_scenes[] = {
     {"grains with d50 a hair below d10", GRAINS(D5("1", "2", "1.9999999", "3", "4"), "40 40", "")
      STAGE, 'v', "bad:10: d50: expected dmin <= d10 <= d50 <= d60 <= dmax (the share finer by "
      "area rises with d), got d50 = 1.9999999 < d10 = 2"},
+    {"hold of an unknown component", HEAD "hold = x z\n" STAGE, 'p',
+     "bad:8: hold: expected 'none' or words of {x y rotation}, got 'z'"},
+    {"hold of a moving component", HEAD "hold = y\nv = 0 0.5\n" STAGE, 'v',
+     "bad:8: hold: a held component cannot have a velocity"},
+    {"hold of a spinning disc", HEAD "omega = 2\nhold = rotation x\n" STAGE, 'v',
+     "bad:9: hold: a held component cannot have a velocity"},
+    {"a partly held disc overlapping another at the start",
+     HEAD "hold = x rotation\n[disc b]\nx = 0.9 0\nr = 0.5\nmaterial = m\n" STAGE, 'c',
+     "bad:5: x: disc a: overlaps disc b by 0.1"},
+    {"stop_servo out of range", BOX_STAGE "stop_servo = -0.01\n", 'p',
+     "bad:34: stop_servo: -0.01 is out of range"},
+    {"stop_unbalanced out of range", BOX_STAGE "stop_unbalanced = -1\n", 'p',
+     "bad:34: stop_unbalanced: -1 is out of range"},
 };
 
 /* What the refusals let through: touching bodies, two held discs that

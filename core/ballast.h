@@ -65,6 +65,10 @@ const char *bal_strerror(enum bal_status code);
 /* ------------------------------------------------------------------ */
 
 #define BAL_NAME_MAX 48
+/* A body a probe names: a section's name, or NAME.k for the k-th disc of a
+ * generator (a name of 47 characters, a dot and up to 9 digits: k <
+ * BAL_MAX_DISCS = 1e8). */
+#define BAL_BODY_MAX 64
 #define BAL_MAX_MOVES 16
 #define BAL_KEYS_MAX 24   /* most keys one section kind has */
 
@@ -358,8 +362,8 @@ struct bal_probe_def {
     char name[BAL_NAME_MAX];  /* column name in series.tsv */
     int line;
     int kind;                 /* enum bal_probe_kind */
-    char a[BAL_NAME_MAX];     /* first body (disc or wall name) */
-    char b[BAL_NAME_MAX];     /* second body, for contact probes */
+    char a[BAL_BODY_MAX];     /* first body (disc or wall name, or NAME.k) */
+    char b[BAL_BODY_MAX];     /* second body, for contact probes */
     BAL_SECTION_TAIL;
 };
 

@@ -35,6 +35,7 @@
 #include "pairs.h"
 #include "scene.h"
 #include "specimen.h"
+#include "status.h"
 #include "timestep.h"
 #include "walls.h"
 
@@ -461,10 +462,11 @@ enum bal_status bal_build_timestep(struct bal_sim *s, struct bal_error *err)
          * velocity (the centred update's factor 1 - alpha dt/2 <= 0) and the
          * velocity at t_N can no longer be recovered (a division by it). */
         return bal_error(err, BAL_EINVAL,
-                         "%s:%d: alpha: global damping alpha = %g with the time step %g gives "
-                         "alpha dt = %g; expected alpha dt < 2 (alpha < %g)",
+                         "%s:%d: alpha: global damping alpha = %s with the time step %s gives "
+                         "alpha dt = %s; expected alpha dt < 2 (alpha < %s)",
                          sc->path, st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "alpha")],
-                         st->alpha, s->dt, s->alpha * s->dt, 2 / s->dt);
+                         BAL_NUM(st->alpha), BAL_NUM(s->dt), BAL_NUM(s->alpha * s->dt),
+                         BAL_NUM(2 / s->dt));
     if (s->dt >= s->dt_estimate && !st->force_dt) {
         const char *key = st->dt > 0 ? "dt" : "dt_fraction";
         const int line = st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, key)];
@@ -472,11 +474,43 @@ enum bal_status bal_build_timestep(struct bal_sim *s, struct bal_error *err)
         if (line > 0)
             snprintf(where, sizeof where, ":%d", line);
         return bal_error(err, BAL_EINVAL,
-                         "%s%s: %s: the time step %.6g is at or above the stability estimate "
-                         "%.6g (bin/ballast info); expected a smaller one, or settings.force_dt "
-                         "= 1 to run it anyway", sc->path, where, key, s->dt, s->dt_estimate);
+                         "%s%s: %s: the time step %s is at or above the stability estimate "
+                         "%s (bin/ballast info); expected a smaller one, or settings.force_dt "
+                         "= 1 to run it anyway", sc->path, where, key, BAL_NUM(s->dt),
+                         BAL_NUM(s->dt_estimate));
     }
     return BAL_OK;
+}
+
+/* Touching within this share of the smaller radius is contact, not an
+ * overlap (the text a run writes, %.17g, comes back to within an ulp). */
+#define TOUCH_SHARE 1e-9
+
+/* The overlap of disc slot i with disc slot j (wall = 0) or wall j, for
+ * check_overlaps' message: "FILE:LINE: KEY: disc A: overlaps disc B by
+ * ...", from the line that placed the free disc. */
+static enum bal_status overlap_error(const struct bal_sim *s, int i, int j, int wall,
+                                     double delta, double rmin, struct bal_error *err)
+{
+    char a[2 * BAL_NAME_MAX], b[3 * BAL_NAME_MAX];
+    bal_specimen_disc_name(s->scene, s->id[i], a, sizeof a);
+    if (wall) {
+        snprintf(b, sizeof b, "wall %s", s->walls[j].name);
+    } else {
+        char d[2 * BAL_NAME_MAX];
+        bal_specimen_disc_name(s->scene, s->id[j], d, sizeof d);
+        snprintf(b, sizeof b, "disc %s", d);
+    }
+    if (s->fixed[i]) /* name the free disc first */
+        snprintf(b, sizeof b, "disc %s", a);
+    /* Where the (free) disc was placed is where the overlap was written. */
+    char where[3 * BAL_NAME_MAX + 600];
+    bal_specimen_disc_origin(s->scene, s->id[s->fixed[i] ? j : i], BAL_DISC_PLACE, where,
+                             sizeof where);
+    return bal_error(err, BAL_EINVAL,
+                     "%s: overlaps %s by %.6g (%.3g of the smaller radius) at the start; "
+                     "expected bodies apart or touching, or settings.allow_overlap = 1",
+                     where, b, delta, delta / rmin);
 }
 
 /* Bodies that overlap at the start are refused unless the scene allows it:
@@ -496,23 +530,49 @@ static enum bal_status check_overlaps(const struct bal_sim *s, struct bal_error 
             double rmin;
             const struct bal_pair_law *law;
             const double delta = bal_pairs_overlap(s, walls, c, &rmin, &law);
-            if (delta <= 1e-9 * rmin)
-                continue;
-            char a[2 * BAL_NAME_MAX], b[3 * BAL_NAME_MAX];
-            bal_pairs_names(s, walls, c, a, sizeof a, b, sizeof b);
-            if (s->fixed[i]) /* name the free disc first */
-                snprintf(b, sizeof b, "disc %s", a);
-            /* Where the (free) disc was placed is where the overlap was written. */
-            char where[3 * BAL_NAME_MAX + 600];
-            bal_specimen_disc_origin(s->scene, s->id[s->fixed[i] ? j : i], BAL_DISC_PLACE, where,
-                                sizeof where);
-            return bal_error(err, BAL_EINVAL,
-                             "%s: overlaps %s by %.6g (%.3g of the smaller radius) at the start; "
-                             "expected bodies apart or touching, or settings.allow_overlap = 1",
-                             where, b, delta, delta / rmin);
+            if (delta > TOUCH_SHARE * rmin)
+                return overlap_error(s, i, j, walls, delta, rmin, err);
         }
     }
     return BAL_OK;
+}
+
+/* The first rebuild failed on disc slot i, with more candidates than the
+ * lists hold (BAL_MAX_NEIGHBOURS, grid.c).  At the start that is the
+ * scene's doing, and bad input: discs piled on one another (600 imported
+ * discs at one point, say), refused as any overlap at the start is, with
+ * the first body in slot order that i overlaps (check_overlaps never ran:
+ * it reads the lists that could not be built); or, where nothing overlaps,
+ * radii too far apart for the lists (a disc of r_min cannot have that many
+ * neighbours within 2 r_max + skin otherwise), named at the disc's line. */
+static enum bal_status crowded_at_start(const struct bal_sim *s, int i, struct bal_error *err)
+{
+    if (!s->scene->settings.allow_overlap) {
+        for (int j = 0; j < s->n; j++) {
+            if (j == i || (s->fixed[i] && s->fixed[j]))
+                continue;
+            const double rmin = fmin(s->r[i], s->r[j]);
+            const double delta = s->r[i] + s->r[j] - hypot(s->x[j] - s->x[i], s->y[j] - s->y[i]);
+            if (delta > TOUCH_SHARE * rmin)
+                return overlap_error(s, i < j ? i : j, i < j ? j : i, 0, delta, rmin, err);
+        }
+        for (int k = 0; k < s->n_walls && !s->fixed[i]; k++) {
+            double cx, cy;
+            const double delta =
+                s->r[i] - sqrt(bal_walls_closest(&s->walls[k], s->x[i], s->y[i], &cx, &cy));
+            if (delta > TOUCH_SHARE * s->r[i])
+                return overlap_error(s, i, k, 1, delta, s->r[i], err);
+        }
+    }
+    char where[3 * BAL_NAME_MAX + 600];
+    bal_specimen_disc_origin(s->scene, s->id[i], s->scene->settings.allow_overlap ? BAL_DISC_PLACE
+                             : BAL_DISC_SIZE, where, sizeof where);
+    return bal_error(err, BAL_EINVAL,
+                     "%s: has more than %d neighbours within reach at the start, more than the "
+                     "neighbour lists hold; expected fewer discs within r + r_max + skin of one "
+                     "(r_min %.6g, r_max %.6g, skin %.6g): discs apart, radii closer to each "
+                     "other or a smaller settings.skin",
+                     where, BAL_MAX_NEIGHBOURS, s->r_min, s->r_max, s->skin);
 }
 
 enum bal_status bal_build_lists(struct bal_sim *s, struct bal_error *err)
@@ -530,15 +590,16 @@ enum bal_status bal_build_lists(struct bal_sim *s, struct bal_error *err)
     s->pair_loop = bal_contacts_select(s->normal_law, s->has_shear || s->has_rolling,
                                        s->has_damping, s->has_rolling);
     if (bal_grid_rebuild(s, err))
-        return err->code;
+        return s->crowded ? crowded_at_start(s, s->crowded - 1, err) : err->code;
     return check_overlaps(s, err);
 }
 
 static enum bal_status resolve_body(const struct bal_sim *s, const struct bal_scene *sc,
                                     const char *name, int *is_wall, int *index)
 {
-    int i = bal_scene_find(sc, BAL_SEC_DISC, name);
-    if (i >= 0) {
+    char why[BAL_MSG_MAX / 2];
+    const long i = bal_specimen_find_disc(sc, name, why, sizeof why);
+    if (i >= 0 && i < s->n) {
         *is_wall = 0;
         *index = s->slot[i];
         return BAL_OK;
@@ -588,10 +649,10 @@ enum bal_status bal_build_stages(struct bal_sim *s, struct bal_error *err)
             const int ki = bal_scene_key_index(BAL_SEC_STAGE, "time");
             if (!(n <= 1e15))
                 return bal_error(err, BAL_EINVAL,
-                                 "%s:%d: time: [stage %s]: time %g with the time step %g is %g "
+                                 "%s:%d: time: [stage %s]: time %s with the time step %s is %s "
                                  "cycles; expected at most 1e15", sc->path,
                                  st->key_line[ki] > 0 ? st->key_line[ki] : st->line, st->name,
-                                 st->time, s->dt, st->time / s->dt);
+                                 BAL_NUM(st->time), BAL_NUM(s->dt), BAL_NUM(st->time / s->dt));
             s->log[g].max_cycles = n > 0 ? (long)n : 0;
             s->log[g].in_time = 1;
         }
@@ -601,10 +662,10 @@ enum bal_status bal_build_stages(struct bal_sim *s, struct bal_error *err)
             const struct bal_move_def *mv = &sc->stages[g].moves[m];
             if (mv->control == BAL_CONTROL_STRAIN_RATE && !(mv->rate * s->dt < 1))
                 return bal_error(err, BAL_EINVAL,
-                                 "%s:%d: strain_rate: rate %g with the time step %g gives rate "
-                                 "dt = %g; expected rate dt < 1 (the gap shrinks by 1 - rate dt "
+                                 "%s:%d: strain_rate: rate %s with the time step %s gives rate "
+                                 "dt = %s; expected rate dt < 1 (the gap shrinks by 1 - rate dt "
                                  "a cycle)", sc->path, mv->line > 0 ? mv->line : sc->stages[g].line,
-                                 mv->rate, s->dt, mv->rate * s->dt);
+                                 BAL_NUM(mv->rate), BAL_NUM(s->dt), BAL_NUM(mv->rate * s->dt));
         }
     }
     s->stage = -1; /* none yet: bal_sim_run or bal_sim_step selects the first */

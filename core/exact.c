@@ -83,6 +83,7 @@
 #include "exact.h"
 #include "scene_keys.h"
 #include "specimen.h"
+#include "status.h"
 #include "walls.h"
 
 /* Most solves (factorisations of K) of the whole iteration.  Phase 1 takes
@@ -747,12 +748,12 @@ enum bal_status bal_exact_solve(const struct bal_sim *s, struct bal_exact *out,
 
     if (s->normal_law == BAL_NORMAL_POWER && s->nu != 1.0)
         return bal_error(err, BAL_EINVAL,
-                         "%s:%d: nu: exact solver: the power law with nu = %g is not linear; "
+                         "%s:%d: nu: exact solver: the power law with nu = %s is not linear; "
                          "the exact solution needs linear springs (nu = 1 or the incremental "
                          "law)",
                          scene_path(s),
                          s->scene->settings.key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "nu")],
-                         s->nu);
+                         BAL_NUM(s->nu));
 
     /* Its unknowns are the free discs' two displacements: a disc held along
      * one axis only (`hold`) would need one; not built. */

@@ -38,10 +38,8 @@
 #include "specimen.h"
 #include "walls.h"
 
-/* Most candidates one disc can have in a rebuild; a disc of radius r_min
- * cannot have more non-overlapping neighbours within 2 r_max + skin.  The
- * generator keeps radius ratios moderate; beyond this the rebuild fails. */
-#define MAX_NEIGHBOURS 512
+/* Most candidates one disc can have in a rebuild (grid.h). */
+#define MAX_NEIGHBOURS BAL_MAX_NEIGHBOURS
 
 void bal_grid_free(struct bal_grid *g)
 {
@@ -256,6 +254,7 @@ search(struct bal_sim *s, double inv_h, long *count, long *edge, const int band,
                 nb[k] = j;
                 k += keep;
                 if (k == MAX_NEIGHBOURS + 1) {
+                    s->crowded = i + 1;
                     char name[2 * BAL_NAME_MAX];
                     bal_specimen_disc_name(s->scene, s->id[i], name, sizeof name);
                     return bal_error(err, BAL_EUNSTABLE,
@@ -361,6 +360,7 @@ enum bal_status bal_grid_rebuild(struct bal_sim *s, struct bal_error *err)
     const int n = s->n;
     struct bal_rebuild_scratch *rs = &s->rs;
     long count = 0;
+    s->crowded = 0;
 
     /* --- disc–disc candidates ------------------------------------- */
     if (!s->use_grid) {

@@ -29,6 +29,11 @@ void bal_grid_cell_order(const double *x, const double *y, int n, double h,
 /* Rebuilds between two re-sorts: the order decays only as discs flow, and a
  * re-sort costs about as much as a few rebuilds. */
 #define BAL_REORDER_EVERY 20
+/* Most candidates one disc can have in a rebuild; a disc of radius r_min
+ * cannot have more non-overlapping neighbours within 2 r_max + skin.  The
+ * generator keeps radius ratios moderate; beyond this the rebuild fails
+ * (and sets s->crowded). */
+#define BAL_MAX_NEIGHBOURS 512
 void bal_grid_free(struct bal_grid *g);
 void bal_grid_scratch_free(struct bal_rebuild_scratch *rs);
 /* With fewer discs than this, `grid = auto` uses all pairs.  Measured with

@@ -24,59 +24,121 @@
  * was (a failed --set must not change the scene).
  */
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "import.h"
+#include "specimen.h"
 
 /* Largest data file read (a discs.tsv of 10 million discs is ~2 GB). */
 #define IMPORT_MAX_BYTES (4L << 30)
 /* Most columns a header may have. */
 #define IMPORT_MAX_COLUMNS 64
+/* Most walls a walls.tsv may hold: each is checked against the others by
+ * name (pair by pair: 10 000 walls take 0.4 s, 200 000 would take 2.5
+ * minutes) and every rebuild of the lists tests every disc against every
+ * wall (grid.c).  A run writes the walls of its scene: four for a box. */
+#define IMPORT_MAX_WALLS 10000
 
-/* The whole file, NUL-terminated, or NULL with the reason in msg. */
-static char *read_file(const char *path, long *len, enum bal_status *st, char *msg, size_t size)
+/* What a file that is not regular is, for the message. */
+static const char *file_kind(mode_t mode)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) {
+    return S_ISFIFO(mode)  ? "a FIFO (named pipe)"
+           : S_ISDIR(mode) ? "a directory"
+           : S_ISCHR(mode) ? "a character device"
+           : S_ISBLK(mode) ? "a block device"
+           : S_ISSOCK(mode) ? "a socket"
+                            : "a file of another kind";
+}
+
+char *bal_read_text_file(const char *path, long max_bytes, enum bal_status missing, long *len,
+                         enum bal_status *st, char *msg, size_t size)
+{
+    /* A FIFO blocks an fopen until a writer comes, a terminal or
+     * /dev/stdin until input ends, and /dev/zero never ends: only a regular
+     * file is read.  stat() first, so that no device is even opened; then
+     * open without blocking and fstat() what was opened, in case the path
+     * changed in between. */
+    struct stat sb;
+    if (stat(path, &sb) != 0) {
         snprintf(msg, size, "%s: cannot open: %s", path, strerror(errno));
+        *st = missing;
+        return NULL;
+    }
+    int fd = -1;
+    if (S_ISREG(sb.st_mode)) {
+        fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+        if (fd < 0) {
+            snprintf(msg, size, "%s: cannot open: %s", path, strerror(errno));
+            *st = missing;
+            return NULL;
+        }
+        if (fstat(fd, &sb) != 0)
+            sb.st_mode = 0;
+    }
+    if (!S_ISREG(sb.st_mode)) {
+        snprintf(msg, size, "%s: not a regular file: %s; expected a file of text", path,
+                 file_kind(sb.st_mode));
+        if (fd >= 0)
+            close(fd);
         *st = BAL_EINVAL;
         return NULL;
     }
-    struct stat sb;
-    if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode) || sb.st_size > IMPORT_MAX_BYTES) {
-        snprintf(msg, size, "%s: not a regular file of at most %ld bytes", path, IMPORT_MAX_BYTES);
-        fclose(f);
+    if (sb.st_size > max_bytes) {
+        snprintf(msg, size, "%s: %lld bytes; expected a file of at most %ld bytes", path,
+                 (long long)sb.st_size, max_bytes);
+        close(fd);
         *st = BAL_EINVAL;
         return NULL;
     }
     char *buf = malloc((size_t)sb.st_size + 1);
     if (!buf) {
         snprintf(msg, size, "%s: out of memory", path);
-        fclose(f);
+        close(fd);
         *st = BAL_ENOMEM;
         return NULL;
     }
-    const size_t got = fread(buf, 1, (size_t)sb.st_size, f);
-    const int bad = ferror(f) || got != (size_t)sb.st_size;
-    fclose(f);
+    /* Up to the size fstat gave (a file that grows meanwhile is read as it
+     * was); one that shrinks ends early, at its end. */
+    size_t got = 0;
+    int bad = 0;
+    while (got < (size_t)sb.st_size) {
+        const ssize_t r = read(fd, buf + got, (size_t)sb.st_size - got);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r < 0)
+            bad = 1;
+        if (r <= 0)
+            break;
+        got += (size_t)r;
+    }
+    close(fd);
     if (bad) {
-        snprintf(msg, size, "%s: read error", path);
+        snprintf(msg, size, "%s: read error: %s", path, strerror(errno));
         free(buf);
         *st = BAL_EIO;
         return NULL;
     }
     buf[got] = '\0';
-    if (memchr(buf, '\0', got)) {
+    *len = (long)got;
+    return buf;
+}
+
+/* The whole data file, NUL-terminated, or NULL with the reason in msg. */
+static char *read_file(const char *path, long *len, enum bal_status *st, char *msg, size_t size)
+{
+    char *buf = bal_read_text_file(path, IMPORT_MAX_BYTES, BAL_EINVAL, len, st, msg, size);
+    if (buf && memchr(buf, '\0', (size_t)*len)) {
         snprintf(msg, size, "%s: contains a NUL byte; not a data file", path);
         free(buf);
         *st = BAL_EINVAL;
         return NULL;
     }
-    *len = (long)got;
     return buf;
 }
 
@@ -227,6 +289,12 @@ static enum bal_status read_discs(struct bal_import_def *imp, struct reader *r, 
             st = BAL_EINVAL;
             break;
         }
+        if (n == BAL_MAX_DISCS) { /* before memory for more: 68 bytes a row of 8 */
+            snprintf(r->msg, r->size, "%s:%d: more than %ld discs, the most a scene may hold",
+                     r->path, line, BAL_MAX_DISCS);
+            st = BAL_EINVAL;
+            break;
+        }
         if (n == cap) {
             cap = cap ? 2 * cap : 1024;
             double *d = realloc(data, (size_t)cap * BAL_IMPORT_COLUMNS * sizeof *d);
@@ -311,6 +379,12 @@ static enum bal_status read_walls(struct bal_import_def *imp, struct reader *r, 
             st = BAL_EINVAL;
             break;
         }
+        if (n == IMPORT_MAX_WALLS) {
+            snprintf(r->msg, r->size, "%s:%d: more than %d walls (a rebuild tests every disc "
+                     "against every wall)", r->path, line, IMPORT_MAX_WALLS);
+            st = BAL_EINVAL;
+            break;
+        }
         if (n == cap) {
             cap = cap ? 2 * cap : 16;
             struct bal_import_wall *q = realloc(walls, (size_t)cap * sizeof *q);
@@ -383,7 +457,11 @@ enum bal_status bal_import_read(struct bal_import_def *imp, const char *what, co
     if (!text)
         return st;
     struct reader r = {.path = path, .msg = msg, .size = size};
-    st = strcmp(what, "discs") == 0 ? read_discs(imp, &r, text) : read_walls(imp, &r, text);
+    /* A UTF-8 byte-order mark, which some editors and spreadsheets put at
+     * the start of a file, is not part of the first column's name (the
+     * scene parser skips it too). */
+    char *start = strncmp(text, "\xEF\xBB\xBF", 3) == 0 ? text + 3 : text;
+    st = strcmp(what, "discs") == 0 ? read_discs(imp, &r, start) : read_walls(imp, &r, start);
     free(text);
     return st;
 }

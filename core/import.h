@@ -16,6 +16,14 @@
  * file, line and key. */
 enum bal_status bal_import_read(struct bal_import_def *imp, const char *what, const char *path,
                                 char *msg, size_t size);
+/* The whole of the regular file at `path`, NUL-terminated (its length in
+ * *len), or NULL with *st and "PATH: why" in msg: `missing` for a file
+ * that cannot be opened; BAL_EINVAL for one that is not a regular file (a
+ * FIFO, a device, a directory) or is larger than max_bytes; BAL_EIO,
+ * BAL_ENOMEM.  Never blocks on what it is given: the scene file and the
+ * data files of [import] are read with it.  Free the text with free(). */
+char *bal_read_text_file(const char *path, long max_bytes, enum bal_status missing, long *len,
+                         enum bal_status *st, char *msg, size_t size);
 /* Release the data of imp (its arrays; the keys stay). */
 void bal_import_free(struct bal_import_def *imp);
 /* Did the discs.tsv have the columns vx, vy, omega?  (velocities = 1 needs them.) */

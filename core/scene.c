@@ -22,6 +22,7 @@
  */
 #include <ctype.h>
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -29,9 +30,15 @@
 
 #include "import.h"
 #include "scene.h"
+#include "status.h"
 
 /* Longest line a scene file may hold; longer lines are refused, not cut. */
 #define LINE_MAX_CHARS 4096
+/* Largest scene file read: a million discs written one [disc] section each
+ * (harness/peer/race.py writes about 150 bytes a disc) with room to spare;
+ * the largest scene of the catalogue is 34 kB.  A larger state belongs in
+ * the data file of an [import] (import.c: up to 4 GB). */
+#define SCENE_MAX_BYTES (256L << 20)
 
 /* ------------------------------------------------------------------ */
 /* Section storage                                                     */
@@ -175,13 +182,43 @@ static int valid_name(const char *v)
     return 1;
 }
 
+/* A body's name: a section's name, or NAME.k (k in decimal, without
+ * leading zeros: one text per disc, as messages print it). */
+static int valid_body(const char *v)
+{
+    const char *dot = strrchr(v, '.');
+    if (!dot)
+        return valid_name(v);
+    char name[BAL_NAME_MAX];
+    const size_t len = (size_t)(dot - v);
+    if (len >= sizeof name)
+        return 0;
+    memcpy(name, v, len);
+    name[len] = '\0';
+    const char *k = dot + 1;
+    if (!valid_name(name) || !*k || (k[0] == '0' && k[1]) || strlen(k) > 9)
+        return 0;
+    for (; *k; k++)
+        if (*k < '0' || *k > '9')
+            return 0;
+    return 1;
+}
+
 static enum bal_status check_range(const struct bal_key *key, double v,
                                    struct where w, struct bal_error *err)
 {
     if (v < key->min || v > key->max) {
-        char range[160];
-        snprintf(range, sizeof range, "%.6g is out of range: expected %.6g <= value <= %.6g",
-                 v, key->min, key->max);
+        /* Each number in its shortest exact text (status.h): with %.6g,
+         * rolling = 2.0000001 was "2 is out of range: expected 0 <= value
+         * <= 2".  A bound at the end of the doubles (BIG) is no bound. */
+        char range[3 * BAL_NUM_CHARS + 64], a[BAL_NUM_CHARS], lo[BAL_NUM_CHARS + 8] = "",
+             hi[BAL_NUM_CHARS + 8] = "";
+        if (key->min > -DBL_MAX)
+            snprintf(lo, sizeof lo, "%s <= ", bal_num_text(a, key->min));
+        if (key->max < DBL_MAX)
+            snprintf(hi, sizeof hi, " <= %s", bal_num_text(a, key->max));
+        snprintf(range, sizeof range, "%s is out of range: expected %svalue%s",
+                 bal_num_text(a, v), lo, hi);
         return where_error(err, w, key->name, "%s", range);
     }
     return BAL_OK;
@@ -225,6 +262,14 @@ static enum bal_status set_value(void *item, const struct bal_key *key,
             return where_error(err, w, key->name,
                                "expected a name of letters, digits, '_' or '-' "
                                "(at most 47), got '%s'", value);
+        strcpy(field, value);
+        return BAL_OK;
+    case BAL_KEY_BODY:
+        if (strlen(value) >= BAL_BODY_MAX || (*value && !valid_body(value)))
+            return where_error(err, w, key->name,
+                               "expected the name of a disc or a wall (letters, digits, '_' or "
+                               "'-', at most 47), or NAME.k for the k-th disc of a generator, "
+                               "got '%s'", value);
         strcpy(field, value);
         return BAL_OK;
     case BAL_KEY_ENUM: {
@@ -419,8 +464,74 @@ void bal_scene_free(struct bal_scene *s)
     memset(s, 0, sizeof *s);
 }
 
+/* The named sections of a scene being parsed, hashed by kind and name, so
+ * that "name used twice" is one lookup a section: a pass over the sections
+ * of its kind made a scene of 100 000 [disc] sections (4.5 MB) take 54 s to
+ * parse, growing with the square of the count.  Open addressing, at most
+ * half full. */
+struct name_slot {
+    int kind; /* -1: empty */
+    int item; /* index within its kind */
+};
+
+struct name_index {
+    struct name_slot *slot;
+    size_t cap; /* a power of two */
+    size_t used;
+};
+
+static uint64_t name_hash(enum bal_section_kind k, const char *name)
+{
+    uint64_t h = 1469598103934665603ULL ^ (uint64_t)k; /* FNV-1a */
+    for (const unsigned char *c = (const unsigned char *)name; *c; c++)
+        h = (h ^ *c) * 1099511628211ULL;
+    return h;
+}
+
+static int index_find(const struct name_index *ix, const struct bal_scene *s,
+                      enum bal_section_kind k, const char *name)
+{
+    if (ix->cap == 0)
+        return -1;
+    for (size_t h = name_hash(k, name) & (ix->cap - 1);; h = (h + 1) & (ix->cap - 1)) {
+        const struct name_slot *e = &ix->slot[h];
+        if (e->kind < 0)
+            return -1;
+        if (e->kind == (int)k &&
+            strcmp(bal_scene_item_name(bal_scene_section(s, k, e->item)), name) == 0)
+            return e->item;
+    }
+}
+
+/* Add item i of kind k; 0, or -1 when out of memory. */
+static int index_add(struct name_index *ix, const struct bal_scene *s, enum bal_section_kind k,
+                     int i)
+{
+    if (2 * (ix->used + 1) > ix->cap) {
+        struct name_index bigger = {NULL, ix->cap ? 2 * ix->cap : 64, 0};
+        bigger.slot = malloc(bigger.cap * sizeof *bigger.slot);
+        if (!bigger.slot)
+            return -1;
+        for (size_t h = 0; h < bigger.cap; h++)
+            bigger.slot[h].kind = -1;
+        for (size_t h = 0; h < ix->cap; h++)
+            if (ix->slot[h].kind >= 0)
+                (void)index_add(&bigger, s, (enum bal_section_kind)ix->slot[h].kind,
+                                ix->slot[h].item);
+        free(ix->slot);
+        *ix = bigger;
+    }
+    const char *name = bal_scene_item_name(bal_scene_section(s, k, i));
+    size_t h = name_hash(k, name) & (ix->cap - 1);
+    while (ix->slot[h].kind >= 0)
+        h = (h + 1) & (ix->cap - 1);
+    ix->slot[h] = (struct name_slot){(int)k, i};
+    ix->used++;
+    return 0;
+}
+
 static enum bal_status new_section(struct bal_scene *s, enum bal_section_kind k,
-                                   const char *name, struct where w,
+                                   const char *name, struct where w, struct name_index *ix,
                                    void **out, struct bal_error *err)
 {
     if (k == BAL_SEC_SETTINGS) {
@@ -437,8 +548,7 @@ static enum bal_status new_section(struct bal_scene *s, enum bal_section_kind k,
                          "%s:%d: [%s]: expected a name of letters, digits, '_' or '-' "
                          "(at most 47), got '%s'",
                          w.file, w.line, bal_scene_sections[k].name, name);
-    int prev = bal_scene_find(s, k, name);
-    if (prev >= 0)
+    if (index_find(ix, s, k, name) >= 0)
         return bal_error(err, BAL_EINVAL, "%s:%d: [%s %s]: name used twice",
                          w.file, w.line, bal_scene_sections[k].name, name);
     struct section_array a = section_array(s, k);
@@ -457,6 +567,8 @@ static enum bal_status new_section(struct bal_scene *s, enum bal_section_kind k,
     strcpy(bal_scene_item_name(item), name);
     *bal_scene_item_line(item) = w.line;
     apply_defaults(item, k);
+    if (index_add(ix, s, k, *a.count - 1))
+        return bal_error(err, BAL_ENOMEM, "%s:%d: out of memory", w.file, w.line);
     *out = item;
     return BAL_OK;
 }
@@ -512,8 +624,8 @@ static int section_kind(const char *word)
     return -1;
 }
 
-enum bal_status bal_scene_parse(struct bal_scene *s, const char *text,
-                                const char *name, struct bal_error *err)
+static enum bal_status parse_text(struct bal_scene *s, const char *text, const char *name,
+                                  struct name_index *ix, struct bal_error *err)
 {
     snprintf(s->path, sizeof s->path, "%s", name);
     struct where w = {s->path, 0};
@@ -575,7 +687,7 @@ enum bal_status bal_scene_parse(struct bal_scene *s, const char *text,
                 return bal_error(err, BAL_EINVAL, "%s:%d: [%s]: takes no name, got '%s'",
                                  w.file, w.line, inner, sec_name);
             kind = (enum bal_section_kind)k;
-            if (new_section(s, kind, sec_name, w, &item, err))
+            if (new_section(s, kind, sec_name, w, ix, &item, err))
                 return err->code;
             continue;
         }
@@ -599,45 +711,41 @@ enum bal_status bal_scene_parse(struct bal_scene *s, const char *text,
     return BAL_OK;
 }
 
+enum bal_status bal_scene_parse(struct bal_scene *s, const char *text,
+                                const char *name, struct bal_error *err)
+{
+    /* The sections the scene holds already (a second text parsed into it)
+     * are in the index from the start. */
+    struct name_index ix = {NULL, 0, 0};
+    enum bal_status st = BAL_OK;
+    for (int k = 0; k < BAL_SEC_COUNT && st == BAL_OK; k++)
+        for (int i = 0; bal_scene_sections[k].named && i < bal_scene_count(s, k) && st == BAL_OK;
+             i++)
+            if (index_add(&ix, s, (enum bal_section_kind)k, i))
+                st = bal_error(err, BAL_ENOMEM, "%s: out of memory", name);
+    if (st == BAL_OK)
+        st = parse_text(s, text, name, &ix, err);
+    free(ix.slot);
+    return st;
+}
+
 enum bal_status bal_scene_load(struct bal_scene *s, const char *path,
                                struct bal_error *err)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return bal_error(err, BAL_EIO, "%s: cannot open: %s", path, strerror(errno));
-    size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap);
-    if (!buf) {
-        fclose(f);
-        return bal_error(err, BAL_ENOMEM, "%s: out of memory", path);
-    }
-    for (;;) {
-        if (n + 1 >= cap) {
-            char *nb = realloc(buf, cap *= 2);
-            if (!nb) {
-                free(buf);
-                fclose(f);
-                return bal_error(err, BAL_ENOMEM, "%s: out of memory", path);
-            }
-            buf = nb;
-        }
-        size_t got = fread(buf + n, 1, cap - n - 1, f);
-        n += got;
-        if (got == 0)
-            break;
-    }
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        free(buf);
-        return bal_error(err, BAL_EIO, "%s: read error", path);
-    }
-    if (memchr(buf, '\0', n)) {
+    /* Only a regular file, never a FIFO or a device (import.c): an fopen
+     * of a FIFO waited for a writer forever, and /dev/zero was read until
+     * memory ran out. */
+    char msg[BAL_MSG_MAX];
+    enum bal_status st = BAL_OK;
+    long n = 0;
+    char *buf = bal_read_text_file(path, SCENE_MAX_BYTES, BAL_EIO, &n, &st, msg, sizeof msg);
+    if (!buf)
+        return bal_error(err, st, "%s", msg);
+    if (memchr(buf, '\0', (size_t)n)) {
         free(buf);
         return bal_error(err, BAL_EINVAL, "%s: contains a NUL byte; not a scene file", path);
     }
-    buf[n] = '\0';
-    enum bal_status st = bal_scene_parse(s, buf, path, err);
+    st = bal_scene_parse(s, buf, path, err);
     free(buf);
     return st;
 }

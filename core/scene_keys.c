@@ -285,9 +285,10 @@ const struct bal_key bal_scene_keys[] = {
      "held_fx held_fy weight_x weight_y contact_mr contact_theta_r contact_rolling "
      "dissipated_rolling wall_px wall_py wall_gap wall_stress",
      "what the series column holds"},
-    {BAL_SEC_PROBE, "a", BAL_KEY_NAME, P(a), "", 0, 0, 0, NULL,
-     "body: the disc (disc_*), the wall (wall_*), or the first body of a contact"},
-    {BAL_SEC_PROBE, "b", BAL_KEY_NAME, P(b), "", 0, 0, 0, NULL,
+    {BAL_SEC_PROBE, "a", BAL_KEY_BODY, P(a), "", 0, 0, 0, NULL,
+     "body: the disc (disc_*), the wall (wall_*), or the first body of a contact; a "
+     "generator's discs are NAME.k"},
+    {BAL_SEC_PROBE, "b", BAL_KEY_BODY, P(b), "", 0, 0, 0, NULL,
      "second body of a contact (contact_*), or the second wall of wall_gap"},
 };
 
@@ -501,7 +502,7 @@ const struct bal_key *bal_scene_key_at(enum bal_section_kind sec, int k)
 void bal_scene_print_keys(FILE *out)
 {
     static const char *const type_names[] = {"number", "integer", "two numbers", "name",
-                                             "word", NULL, "file", "words"};
+                                             "word", NULL, "file", "words", "body"};
     for (int k = 0; k < BAL_SEC_COUNT; k++) {
         const struct bal_section_info *sec = &bal_scene_sections[k];
         fprintf(out, "\n`[%s%s]` — %s\n\n", sec->name, sec->named ? " NAME" : "", sec->doc);

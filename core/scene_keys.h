@@ -28,8 +28,10 @@ enum bal_key_type {
     BAL_KEY_FILE,     /* a data file's path, relative to the scene's directory, read when
                        * the key is parsed: `choices` says what it holds ("discs", "walls";
                        * import.c), the section struct its data */
-    BAL_KEY_FLAGS     /* any of the words of `choices`, or "none", stored as an int with
+    BAL_KEY_FLAGS,    /* any of the words of `choices`, or "none", stored as an int with
                        * bit k for the k-th word */
+    BAL_KEY_BODY      /* a disc or a wall: a name, or NAME.k for the k-th disc of the
+                       * generator NAME (resolved in validate; specimen.c) */
 };
 
 enum bal_section_kind {

@@ -15,6 +15,8 @@
 
 #include "import.h"
 #include "scene.h"
+#include "specimen.h"
+#include "status.h"
 #include "walls.h"
 
 static int line_of(void *item, enum bal_section_kind k, const char *key)
@@ -104,10 +106,12 @@ static int generated_wall(const struct bal_scene *s, const char *name, int *line
     return 0;
 }
 
-/* Is `name` a disc, a wall, or a wall a generator makes? */
+/* Is `name` a disc (NAME.k for a generator's, specimen.c), a wall, or a
+ * wall a generator makes? */
 static int body_exists(const struct bal_scene *s, const char *name, int *is_wall)
 {
-    if (bal_scene_find(s, BAL_SEC_DISC, name) >= 0) {
+    char why[BAL_MSG_MAX / 2];
+    if (bal_specimen_find_disc(s, name, why, sizeof why) >= 0) {
         *is_wall = 0;
         return 1;
     }
@@ -117,6 +121,14 @@ static int body_exists(const struct bal_scene *s, const char *name, int *is_wall
         return 1;
     }
     return 0;
+}
+
+/* Why no body has this name ("no disc or wall named 'x'", or what is
+ * wrong with a NAME.k), into why. */
+static const char *no_body(const struct bal_scene *s, const char *name, char *why, size_t size)
+{
+    (void)bal_specimen_find_disc(s, name, why, size);
+    return why;
 }
 
 /* Probes and moves find bodies by name, so a disc, a wall and the walls a
@@ -215,15 +227,15 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
         struct bal_wall_def *w = &s->walls[i];
         if (!(w->h2 > w->h1))
             return FAIL_AT(w, BAL_SEC_WALL, "h2", "expected h2 > h1 (a wall of positive length), "
-                                                  "got h1 = %g, h2 = %g", w->h1, w->h2);
+                                                  "got h1 = %s, h2 = %s", BAL_NUM(w->h1), BAL_NUM(w->h2));
         if (check_material_ref(s, w, BAL_SEC_WALL, "material", w->material, 0, err))
             return err->code;
     }
     for (int i = 0; i < s->n_fills; i++) {
         struct bal_fill_def *f = &s->fills[i];
         if (!(f->rmax >= f->rmin))
-            return FAIL_AT(f, BAL_SEC_FILL, "rmax", "expected rmax >= rmin, got %g < %g",
-                           f->rmax, f->rmin);
+            return FAIL_AT(f, BAL_SEC_FILL, "rmax", "expected rmax >= rmin, got %s < %s",
+                           BAL_NUM(f->rmax), BAL_NUM(f->rmin));
         if (check_material_ref(s, f, BAL_SEC_FILL, "material", f->material, 1, err))
             return err->code;
         if (f->box) {
@@ -239,7 +251,7 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
             return err->code;
         if (!(p->size_spread < 1))
             return FAIL_AT(p, BAL_SEC_PILE, "size_spread", "expected 0 <= size_spread < 1 "
-                           "(diameters d (1 + r), |r| <= size_spread/2), got %g", p->size_spread);
+                           "(diameters d (1 + r), |r| <= size_spread/2), got %s", BAL_NUM(p->size_spread));
         if (p->bottom == 0) {
             if (!*p->wall_material)
                 return FAIL_AT(p, BAL_SEC_PILE, "wall_material", "%s",
@@ -260,12 +272,16 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
             if (!(d[k] >= d[k - 1]))
                 return FAIL_AT(g, BAL_SEC_GRAINS, names[k],
                                "expected dmin <= d10 <= d50 <= d60 <= dmax (the share finer "
-                               "by area rises with d), got %s = %g < %s = %g",
-                               names[k], d[k], names[k - 1], d[k - 1]);
+                               "by area rises with d), got %s = %s < %s = %s",
+                               names[k], BAL_NUM(d[k]), names[k - 1], BAL_NUM(d[k - 1]));
         if (!(g->size[0] >= g->dmax && g->size[1] >= g->dmax))
             return FAIL_AT(g, BAL_SEC_GRAINS, "size",
-                           "the region %g x %g must be at least dmax = %g wide and high",
-                           g->size[0], g->size[1], g->dmax);
+                           "the region %s x %s must be at least dmax = %s wide and high",
+                           BAL_NUM(g->size[0]), BAL_NUM(g->size[1]), BAL_NUM(g->dmax));
+        const char *key = NULL;
+        char why[BAL_MSG_MAX / 2];
+        if (bal_specimen_grains_check(g, &key, why, sizeof why))
+            return FAIL_AT(g, BAL_SEC_GRAINS, key, "%s", why);
         if (check_material_ref(s, g, BAL_SEC_GRAINS, "material", g->material, 1, err))
             return err->code;
         if (g->box) {
@@ -294,7 +310,7 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
         struct bal_material_def *m = &s->materials[i];
         if (!(m->ks >= 1e-150 || m->ks == -1))
             return FAIL_AT(m, BAL_SEC_MATERIAL, "ks", "expected ks >= 1e-150, like kn (or omit it "
-                                                      "for ks = kn), got %g", m->ks);
+                                                      "for ks = kn), got %s", BAL_NUM(m->ks));
     }
     if (check_body_names(s, err))
         return err->code;
@@ -339,6 +355,7 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
     for (int i = 0; i < s->n_probes; i++) {
         struct bal_probe_def *p = &s->probes[i];
         int k = p->kind, wa = 0, wb = 0;
+        char why[BAL_MSG_MAX / 2];
         int contact = bal_probe_is_contact(k);
         int wall = bal_probe_is_wall(k);
         int disc = k >= BAL_PROBE_DISC_X && k <= BAL_PROBE_DISC_OMEGA;
@@ -346,7 +363,7 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
             if (!*p->a)
                 return FAIL_AT(p, BAL_SEC_PROBE, "a", "%s", "this quantity needs a body in 'a'");
             if (!body_exists(s, p->a, &wa))
-                return FAIL_AT(p, BAL_SEC_PROBE, "a", "no disc or wall named '%s'", p->a);
+                return FAIL_AT(p, BAL_SEC_PROBE, "a", "%s", no_body(s, p->a, why, sizeof why));
             if (wall && !wa)
                 return FAIL_AT(p, BAL_SEC_PROBE, "a", "'%s' is a disc; this quantity needs a wall",
                                p->a);
@@ -358,7 +375,7 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
             if (!*p->b)
                 return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "a contact probe needs a second body in 'b'");
             if (!body_exists(s, p->b, &wb))
-                return FAIL_AT(p, BAL_SEC_PROBE, "b", "no disc or wall named '%s'", p->b);
+                return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", no_body(s, p->b, why, sizeof why));
             if (wa && wb)
                 return FAIL_AT(p, BAL_SEC_PROBE, "b", "%s", "two walls never make a contact");
             if (strcmp(p->a, p->b) == 0)

@@ -61,6 +61,7 @@
 
 #include "scene.h"
 #include "specimen.h"
+#include "status.h"
 #include "state.h" /* BAL_PI */
 
 /* ------------------------------------------------------------------ */
@@ -382,6 +383,64 @@ double bal_specimen_grading_finer(const struct bal_grains_def *g, double dia)
     return 1;
 }
 
+/* The spacing of doubles at a position of a [grains] region may be at most
+ * this share of the smallest radius: an overlap of 1e-3 of the radius (a
+ * stiff contact) is then resolved to 1e-3 of itself, and discs placed at
+ * random are placed apart.  At origin = 1e300 the spacing is 1.5e284 and
+ * every disc landed on the same point. */
+#define GRAINS_POSITION_RESOLUTION 1e-6
+
+int bal_specimen_grains_check(const struct bal_grains_def *g, const char **key, char *why,
+                              size_t size)
+{
+    const double r_min = 0.5 * g->dmin;
+    for (int a = 0; a < 2; a++) {
+        /* The side of the region farther from 0, where the doubles are
+         * widest apart. */
+        const double end = g->origin[a] + g->size[a];
+        const double far = fabs(end) > fabs(g->origin[a]) ? end : g->origin[a];
+        const double spacing = nextafter(fabs(far), INFINITY) - fabs(far);
+        const double at_origin = nextafter(fabs(g->origin[a]), INFINITY) - fabs(g->origin[a]);
+        if (spacing <= GRAINS_POSITION_RESOLUTION * r_min)
+            continue;
+        /* the origin's doing unless the origin alone is fine */
+        *key = at_origin <= GRAINS_POSITION_RESOLUTION * r_min ? "size" : "origin";
+        if (!isfinite(end))
+            snprintf(why, size, "[grains %s]: the region's far side %s = origin + size is "
+                     "beyond the largest double; expected a region nearer 0", g->name,
+                     a ? "y" : "x");
+        else
+            snprintf(why, size, "[grains %s]: the region reaches %s = %s, where doubles are "
+                     "%s apart, more than %g of the smallest radius dmin/2 = %s: positions "
+                     "there lose their precision (the discs would be placed on top of each "
+                     "other); expected a region nearer 0 or larger discs", g->name,
+                     a ? "y" : "x", BAL_NUM(far), BAL_NUM(spacing),
+                     GRAINS_POSITION_RESOLUTION, BAL_NUM(r_min));
+        return 1;
+    }
+    /* n discs of radius r_i >= r_min inside the region, apart: shrunk to
+     * r_min about their centres they still are, with the centres in the
+     * (size_x - dmin) x (size_y - dmin) rectangle at distances >= dmin.
+     * Oler's inequality (1961) bounds such a set of points: n <= (2/sqrt 3)
+     * A/dmin^2 + P/(2 dmin) + 1 (A, P the rectangle's area and perimeter),
+     * which is below n_max = 2 size_x size_y / (sqrt 3 dmin^2), the
+     * hexagonal packing fraction pi/(2 sqrt 3) of the region's area over
+     * the area of a disc of diameter dmin: n <= n_max for any grading (by
+     * at least 0.15 of a disc, far above the rounding of n_max up to
+     * n = 1e8).  (Random sequential addition jams long before, near 0.55.) */
+    const double n_max = 2 * g->size[0] * g->size[1] / (sqrt(3.0) * g->dmin * g->dmin);
+    if ((double)g->n > n_max) {
+        *key = "n";
+        snprintf(why, size, "[grains %s]: %ld discs of diameter >= dmin = %s cannot lie apart "
+                 "in the region %s x %s: at most %.0f can (the densest packing, hexagonal, "
+                 "covers pi/(2 sqrt 3) of the area: n <= 2 size_x size_y / (sqrt 3 dmin^2)); "
+                 "expected fewer discs or a larger region", g->name, g->n, BAL_NUM(g->dmin),
+                 BAL_NUM(g->size[0]), BAL_NUM(g->size[1]), floor(n_max));
+        return 1;
+    }
+    return 0;
+}
+
 static int descending(const void *a, const void *b)
 {
     const double x = *(const double *)a, y = *(const double *)b;
@@ -624,6 +683,63 @@ void bal_specimen_disc_name(const struct bal_scene *sc, int id, char *buf, size_
         k -= sc->imports[i].n;
     }
     snprintf(buf, size, "?%d", id);
+}
+
+long bal_specimen_find_disc(const struct bal_scene *sc, const char *name, char *why, size_t size)
+{
+    const char *dot = strrchr(name, '.');
+    if (!dot) {
+        const int i = bal_scene_find(sc, BAL_SEC_DISC, name);
+        if (i < 0)
+            snprintf(why, size, "no disc or wall named '%s'", name);
+        return i;
+    }
+    /* NAME.k: the generators in scene order, counting the discs before */
+    char gen[BAL_NAME_MAX];
+    const size_t len = (size_t)(dot - name);
+    snprintf(gen, sizeof gen, "%.*s", (int)(len < sizeof gen ? len : sizeof gen - 1), name);
+    char *end;
+    const long k = strtol(dot + 1, &end, 10);
+    long first = sc->n_discs, found = -1, count = 0;
+    const char *kind = NULL, *also = NULL;
+    for (int pass = 0; pass < 4; pass++) {
+        const int n_sec = pass == 0 ? sc->n_fills : pass == 1 ? sc->n_piles
+                        : pass == 2 ? sc->n_grains : sc->n_imports;
+        for (int q = 0; q < n_sec; q++) {
+            const char *nm = pass == 0 ? sc->fills[q].name : pass == 1 ? sc->piles[q].name
+                           : pass == 2 ? sc->grains[q].name : sc->imports[q].name;
+            const long n = pass == 0 ? sc->fills[q].n : pass == 1 ? bal_specimen_pile_count(&sc->piles[q])
+                         : pass == 2 ? sc->grains[q].n : sc->imports[q].n;
+            const char *kd = pass == 0 ? "fill" : pass == 1 ? "pile" : pass == 2 ? "grains" : "import";
+            if (strlen(nm) == len && strncmp(nm, name, len) == 0) {
+                if (kind)
+                    also = kd;
+                else {
+                    kind = kd;
+                    found = first;
+                    count = n;
+                }
+            }
+            first += n;
+        }
+    }
+    if (!kind) {
+        snprintf(why, size, "no disc or wall named '%s' (NAME.k names the k-th disc of the "
+                 "generator NAME: no [fill], [pile], [grains] or [import] is named '%s')", name,
+                 gen);
+        return -1;
+    }
+    if (also) {
+        snprintf(why, size, "'%s' could be a disc of [%s %s] or of [%s %s]; expected "
+                 "generators of different names", name, kind, gen, also, gen);
+        return -1;
+    }
+    if (*end || k < 0 || k >= count) {
+        snprintf(why, size, "no disc named '%s': [%s %s] makes %ld discs, %s.0 to %s.%ld",
+                 name, kind, gen, count, gen, gen, count - 1);
+        return -1;
+    }
+    return found + k;
 }
 
 void bal_specimen_disc_origin(const struct bal_scene *sc, int id, enum bal_disc_prop prop,

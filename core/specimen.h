@@ -43,9 +43,23 @@ double bal_specimen_grading_diameter(const struct bal_grains_def *g, double u1, 
 /* The curve itself: the share of the area in discs of diameter <= d. */
 double bal_specimen_grading_finer(const struct bal_grains_def *g, double d);
 
+/* Can a [grains] section's discs be placed at all?  0; or 1 with the key
+ * to blame in *key ("n", "origin" or "size") and why in `why`: more discs
+ * of diameter dmin than the densest packing puts in the region, or a
+ * region where the spacing of doubles is not small against the smallest
+ * radius (specimen.c).  Validation asks it, before anything is drawn. */
+int bal_specimen_grains_check(const struct bal_grains_def *g, const char **key, char *why,
+                              size_t size);
+
 /* The name of the disc with scene-order index id: its [disc] name, or
  * FILL.k / PILE.k for the k-th disc a generator made. */
 void bal_specimen_disc_name(const struct bal_scene *sc, int id, char *buf, size_t size);
+/* The scene-order index of the disc a probe names: a [disc]'s name, or
+ * NAME.k, the k-th disc of the [fill], [pile], [grains] or [import] named
+ * NAME (as bal_specimen_disc_name names it).  -1 with the reason in `why`
+ * ("no disc or wall named ...", k past the generator's discs, or two
+ * generators of that name). */
+long bal_specimen_find_disc(const struct bal_scene *sc, const char *name, char *why, size_t size);
 /* A property of a disc, for naming where the scene set it. */
 enum bal_disc_prop { BAL_DISC_PLACE, BAL_DISC_SIZE, BAL_DISC_SPEED, BAL_DISC_SPIN };
 /* "FILE:LINE: KEY: disc NAME" of the key that set property `prop` of the

@@ -284,6 +284,9 @@ struct bal_sim {
     double skin_edge;            /* candidates per unit of skin at the edge of the last
                                   * search's skin (its outer half); 0: not measured */
     long built_step;             /* s->step when the lists were built */
+    int crowded;                 /* 1 + the slot of the disc whose candidates passed
+                                  * BAL_MAX_NEIGHBOURS in the rebuild that just failed on
+                                  * it (grid.c), else 0: the builder names it */
     long rebuilds;
     int need_rebuild;
     bal_pair_loop_fn pair_loop;

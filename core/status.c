@@ -7,10 +7,16 @@
  * Set a breakpoint on bal_error to stop at the first error of any kind.
  * There is no global error state: the message lives in the caller's struct.
  */
+#include <float.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 
 #include "ballast.h"
+#include "status.h"
+
+/* The fewest significant digits bal_num_text prints: %g's default. */
+#define BAL_NUM_DIGITS_FROM 6
 
 enum bal_status bal_error(struct bal_error *err, enum bal_status code,
                           const char *fmt, ...)
@@ -23,6 +29,19 @@ enum bal_status bal_error(struct bal_error *err, enum bal_status code,
         err->code = code;
     }
     return code;
+}
+
+const char *bal_num_text(char buf[BAL_NUM_CHARS], double v)
+{
+    /* From the 6 digits of %g (20, not 2e+01), up to DBL_DECIMAL_DIG (17),
+     * which always read back; the first that does is the text a user typed
+     * (up to 15 digits). */
+    for (int digits = BAL_NUM_DIGITS_FROM; digits <= DBL_DECIMAL_DIG; digits++) {
+        snprintf(buf, BAL_NUM_CHARS, "%.*g", digits, v);
+        if (strtod(buf, NULL) == v)
+            break;
+    }
+    return buf;
 }
 
 const char *bal_strerror(enum bal_status code)

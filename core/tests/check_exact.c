@@ -520,6 +520,11 @@ START_TEST(exact_refuses_friction_cohesion_power)
     tfx_release(f);
     f = on_two_held(3.7e4, "", "normal_law = power\nnu = 1.5\ndelta0 = 0.37");
     solve_refused(f, "nu = 1.5");
+    tfx_release(f);
+    /* the refused value as it differs from 1 (issue 29: %g printed "nu = 1
+     * is not linear") */
+    f = on_two_held(3.7e4, "", "normal_law = power\nnu = 1.0000001\ndelta0 = 0.37");
+    solve_refused(f, "nu = 1.0000001 is not linear");
 }
 END_TEST
 

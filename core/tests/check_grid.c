@@ -319,7 +319,9 @@ END_TEST
  * 0.5 + k, exact in binary); disc k is a candidate of disc 0 while its
  * distance k < 1 + skin.  A skin of 511.5 gives disc 0 exactly 512
  * candidates: the list must be the brute-force one.  A skin of 512.5 gives
- * it 513: bal_sim_create must refuse the scene and say why. */
+ * it 513: bal_sim_create must refuse the scene as bad input (issue 29: at
+ * the start it is the scene's doing) and say why, at the line of the
+ * generator's radii. */
 START_TEST(grid_neighbour_limit)
 {
     static const char *fmt = "[settings]\ngrid = on\nskin = %s\n"
@@ -347,8 +349,10 @@ START_TEST(grid_neighbour_limit)
     snprintf(text, sizeof text, fmt, "512.5");
     struct tfx *g = tfx_parse(text, "limit-513");
     g->sc.settings.force_dt = 1;
-    ck_assert_int_eq(tfx_create(g), BAL_EUNSTABLE);
-    ck_assert_msg(t_contains(g->err.msg, "more than 512 neighbours"), "%s", g->err.msg);
+    ck_assert_int_eq(tfx_create(g), BAL_EINVAL);
+    ck_assert_msg(t_contains(g->err.msg, "limit-513:10: rmin: disc row.0 of [fill row]: has more "
+                                         "than 512 neighbours within reach at the start"),
+                  "%s", g->err.msg);
 }
 END_TEST
 

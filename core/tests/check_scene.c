@@ -12,6 +12,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "check_main.h"
 
@@ -233,6 +235,92 @@ START_TEST(scene_missing_file_is_eio)
     ck_assert_int_eq(err.code, BAL_EIO);
     ck_assert_msg(t_contains(err.msg, "scenes/no_such_file.scene: cannot open"), "%s", err.msg);
     ck_assert_str_eq(bal_strerror(BAL_EIO), "input/output error");
+}
+END_TEST
+
+/* Issue 29, item 9: a FIFO as the scene or as an [import] data file
+ * blocked in fopen until a writer came (forever, for a run); /dev/zero as
+ * the scene was read until memory ran out.  Each is refused at once as not
+ * a regular file (a hang fails the test by Check's timeout). */
+START_TEST(scene_fifo_and_devices_refused)
+{
+    char dir[] = "/tmp/ballast_fifo_XXXXXX", fifo[64], text[256];
+    ck_assert_ptr_nonnull(mkdtemp(dir));
+    snprintf(fifo, sizeof fifo, "%s/pipe", dir);
+    ck_assert_int_eq(mkfifo(fifo, 0600), 0);
+    static const char *const data_files[] = {"discs", "walls"};
+    for (int k = 0; k < 2; k++)
+        for (int dev = 0; dev < 2; dev++) {
+            const char *path = dev ? "/dev/zero" : fifo;
+            snprintf(text, sizeof text, "[material m]\nkn = 1e5\ndensity = 2\n[import p]\n%s = %s\n",
+                     data_files[k], path);
+            struct bal_scene sc;
+            struct bal_error err = {0};
+            bal_scene_default(&sc);
+            const enum bal_status st = bal_scene_parse(&sc, text, "bad", &err);
+            bal_scene_free(&sc);
+            char expect[160];
+            snprintf(expect, sizeof expect, "bad:5: %s: %s: not a regular file: %s", data_files[k],
+                     path, dev ? "a character device" : "a FIFO (named pipe)");
+            ck_assert_int_eq(st, BAL_EINVAL);
+            ck_assert_msg(t_contains(err.msg, expect), "'%s' lacks '%s'", err.msg, expect);
+        }
+    for (int dev = 0; dev < 3; dev++) {
+        const char *path = dev == 0 ? fifo : dev == 1 ? "/dev/zero" : dir;
+        struct bal_scene sc;
+        struct bal_error err = {0};
+        bal_scene_default(&sc);
+        const enum bal_status st = bal_scene_load(&sc, path, &err);
+        bal_scene_free(&sc);
+        char expect[160];
+        snprintf(expect, sizeof expect, "%s: not a regular file: %s", path,
+                 dev == 0 ? "a FIFO (named pipe)" : dev == 1 ? "a character device" : "a directory");
+        ck_assert_int_eq(st, BAL_EINVAL);
+        ck_assert_msg(t_contains(err.msg, expect), "'%s' lacks '%s'", err.msg, expect);
+    }
+    unlink(fifo);
+    rmdir(dir);
+}
+END_TEST
+
+/* Issue 29, item 9 (what else hangs): "name used twice" passed over every
+ * section of its kind, so 100 000 [disc] sections took 54 s to parse, and
+ * a million (45 MB, within the scene's size limit) an hour and a half.
+ * With the names hashed they parse at once (the case's timeout is 30 s, for
+ * sanitized builds); a name used twice is still found, at its line, after
+ * the table has grown many times over. */
+START_TEST(scene_many_sections_parse_at_once)
+{
+    enum { N = 100000 };
+    const size_t size = (size_t)N * 64 + 256;
+    char *text = malloc(size);
+    ck_assert_ptr_nonnull(text);
+    int n = snprintf(text, size, "[material m]\nkn = 1e5\ndensity = 2\n");
+    for (int k = 0; k < N; k++)
+        n += snprintf(text + n, size - (size_t)n, "[disc d%d]\nx = %d 0\nr = 1\nmaterial = m\n",
+                      k, 3 * k);
+    struct bal_scene sc;
+    struct bal_error err = {0};
+    bal_scene_default(&sc);
+    ck_assert_int_eq(bal_scene_parse(&sc, text, "many", &err), BAL_OK);
+    ck_assert_int_eq(sc.n_discs, N);
+    ck_assert_int_eq(bal_scene_find(&sc, BAL_SEC_DISC, "d77777"), 77777);
+    bal_scene_free(&sc);
+    /* the same name again at the end; and a second text parsed into a scene
+     * sees the sections of the first */
+    snprintf(text + n, size - (size_t)n, "[disc d4321]\n");
+    bal_scene_default(&sc);
+    ck_assert_int_eq(bal_scene_parse(&sc, text, "many", &err), BAL_EINVAL);
+    bal_scene_free(&sc);
+    char expect[64];
+    snprintf(expect, sizeof expect, "many:%d: [disc d4321]: name used twice", 3 + 4 * N + 1);
+    ck_assert_msg(t_contains(err.msg, expect), "'%s' lacks '%s'", err.msg, expect);
+    bal_scene_default(&sc);
+    ck_assert_int_eq(bal_scene_parse(&sc, "[material m]\nkn = 1\n", "one", &err), BAL_OK);
+    ck_assert_int_eq(bal_scene_parse(&sc, "[disc a]\n[material m]\n", "two", &err), BAL_EINVAL);
+    bal_scene_free(&sc);
+    ck_assert_msg(t_contains(err.msg, "two:2: [material m]: name used twice"), "%s", err.msg);
+    free(text);
 }
 END_TEST
 
@@ -621,6 +709,64 @@ static const struct bad_scene bad_scenes[] = {
      IMPORT("discs = scenes/import/discs.tsv\n")
      "[wall w]\np = 0 0.4\nangle = 0\nh1 = 0\nh2 = 1\nmaterial = m\n" STAGE, 'c',
      "bad:5: discs: disc p.0 of [import p] (line 2 of scenes/import/discs.tsv): overlaps wall w"},
+    /* Issue 29, item 11: discs piled at one point pass the neighbour
+     * lists' limit (512 a disc) before the start overlaps are checked; the
+     * overlap is still bad input, named like any other. */
+    {"600 imported discs at one point", IMPORT("discs = scenes/import/pile600.tsv\n") STAGE, 'c',
+     "bad:5: discs: disc p.0 of [import p] (line 2 of scenes/import/pile600.tsv): overlaps disc "
+     "p.1 by 1 (2 of the smaller radius) at the start"},
+    /* Item 12: a [grains] that cannot fit is refused from the area alone
+     * (2 x 20 x 20 / (sqrt 3 x 1^2) = 461.9 discs of diameter 1 at most),
+     * before any disc is drawn; an origin where the doubles are too far
+     * apart is named, not n. */
+    {"grains of more discs than the densest packing holds",
+     "[material m]\nkn = 1e5\ndensity = 2\n[grains g]\nsize = 20 20\nn = 462\nmaterial = m\n"
+     D5("1", "1.2", "1.5", "1.6", "2") STAGE, 'v',
+     "bad:6: n: [grains g]: 462 discs of diameter >= dmin = 1 cannot lie apart in the region "
+     "20 x 20: at most 461 can"},
+    {"grains of as many discs as the densest packing holds: tried, and jammed",
+     "[material m]\nkn = 1e5\ndensity = 2\n[grains g]\nsize = 20 20\nn = 461\nmaterial = m\n"
+     "tries = 100\n" D5("1", "1.2", "1.5", "1.6", "2") STAGE, 'c', "bad:6: n: [grains g]: placed "},
+    {"grains at an origin where doubles are far apart",
+     GRAINS(D5("1", "2", "2.5", "3", "4"), "40 40", "origin = 1e300 1e300\n") STAGE, 'v',
+     "bad:13: origin: [grains g]: the region reaches x = 1e+300, where doubles are "
+     "1.487016908477783e+284 apart, more than 1e-06 of the smallest radius dmin/2 = 0.5"},
+    {"grains region reaching where doubles are far apart",
+     GRAINS(D5("1", "2", "2.5", "3", "4"), "1e10 40", "") STAGE, 'v',
+     "bad:5: size: [grains g]: the region reaches x = 1e+10, where doubles are "
+     "1.9073486328125e-06 apart"},
+    /* Item 13: a generator's discs are probed as NAME.k, as messages name
+     * them; what such a name can get wrong. */
+    {"probe of a generator's disc past its count",
+     GRAINS(D5("1", "2", "2.5", "3", "4"), "40 40", "") STAGE "[probe p]\nquantity = disc_y\n"
+     "a = g.40\n", 'v', "bad:17: a: no disc named 'g.40': [grains g] makes 40 discs, g.0 to g.39"},
+    {"probe of NAME.k with a leading zero",
+     GRAINS(D5("1", "2", "2.5", "3", "4"), "40 40", "") STAGE "[probe p]\nquantity = disc_y\n"
+     "a = g.01\n", 'p', "bad:17: a: expected the name of a disc or a wall"},
+    {"probe of a disc two generators could have made",
+     GRAINS(D5("1", "2", "2.5", "3", "4"), "40 40", "")
+     "[fill g]\nn = 2\ncolumns = 2\norigin = 100 0\nrmin = 0.5\nrmax = 0.5\nmaterial = m\n" STAGE
+     "[probe p]\nquantity = contact_fn\na = g.0\nb = g.1\n", 'v',
+     "bad:24: a: 'g.0' could be a disc of [fill g] or of [grains g]; expected generators of "
+     "different names"},
+    {"probe of a generator that does not exist", HEAD STAGE "[probe p]\nquantity = disc_x\n"
+     "a = ghost.0\n", 'v', "bad:12: a: no disc or wall named 'ghost.0'"},
+    /* Item 15: a refused value and its bound print differently (%.6g
+     * printed "2 is out of range: expected 0 <= value <= 2"). */
+    {"rolling just past its bound", "[material m]\nkn = 1e5\nrolling = 2.0000001\n", 'p',
+     "bad:3: rolling: 2.0000001 is out of range: expected 0 <= value <= 2"},
+    {"cycles one beyond the largest count", HEAD "[stage s]\ncycles = 1000000000000001\n", 'p',
+     "bad:9: cycles: 1000000000000001 is out of range: expected 0 <= value <= 1e+15"},
+    {"fill with rmax a hair below rmin",
+     "[material m]\nkn = 1e5\ndensity = 2\n[fill f]\nn = 4\ncolumns = 2\nrmin = 0.5\n"
+     "rmax = 0.4999999\nmaterial = m\n" STAGE,
+     'v', "bad:8: rmax: expected rmax >= rmin, got 0.4999999 < 0.5"},
+    {"wall with h2 a hair below h1",
+     HEAD "[wall w]\np = 0 -1\nangle = 30\nh1 = 1.0000001\nh2 = 1\nmaterial = m\n" STAGE, 'v',
+     "bad:12: h2: expected h2 > h1 (a wall of positive length), got h1 = 1.0000001, h2 = 1"},
+    {"grains with d50 a hair below d10", GRAINS(D5("1", "2", "1.9999999", "3", "4"), "40 40", "")
+     STAGE, 'v', "bad:10: d50: expected dmin <= d10 <= d50 <= d60 <= dmax (the share finer by "
+     "area rises with d), got d50 = 1.9999999 < d10 = 2"},
     {"hold of an unknown component", HEAD "hold = x z\n" STAGE, 'p',
      "bad:8: hold: expected 'none' or words of {x y rotation}, got 'z'"},
     {"hold of a moving component", HEAD "hold = y\nv = 0 0.5\n" STAGE, 'v',
@@ -1051,7 +1197,7 @@ static const struct bad_scene bad_piles[] = {
     {"seed 0 (GSL's mt19937 would take 4357)", PILE_HEAD "[pile p]\nseed = 0\n", 'p',
      "bad:7: seed: 0 is out of range"},
     {"seed beyond 32 bits", PILE_HEAD "[pile p]\nseed = 4294967296\n", 'p',
-     "bad:7: seed: 4.29497e+09 is out of range"},
+     "bad:7: seed: 4294967296 is out of range: expected 1 <= value <= 4294967295"},
     {"seed not whole", PILE_HEAD "[pile p]\nseed = 2.5\n", 'p',
      "bad:7: seed: expected an integer, got '2.5'"},
     {"size_spread not a number", PILE_HEAD "[pile p]\nsize_spread = 1/30\n", 'p',
@@ -1456,7 +1602,14 @@ Suite *suite_scene(void)
     tcase_add_test(tc, scene_long_line_refused);
     tcase_add_test(tc, scene_allowed_overlaps_and_forced_steps);
     tcase_add_test(tc, scene_missing_file_is_eio);
+    tcase_add_test(tc, scene_fifo_and_devices_refused);
     tcase_add_test(tc, scene_strerror_names_every_status);
+    suite_add_tcase(s, tc);
+
+    tc = tcase_create("scale");
+    tcase_add_checked_fixture(tc, NULL, tfx_teardown);
+    tcase_set_timeout(tc, 30);
+    tcase_add_test(tc, scene_many_sections_parse_at_once);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("pile");

@@ -322,6 +322,124 @@ START_TEST(specimen_import_set)
 }
 END_TEST
 
+/* Issue 29, item 10: a UTF-8 byte-order mark before the header (a file
+ * saved by a spreadsheet or an editor) is no part of the first column's
+ * name: "no column 'x' in the header" was the message for a header that
+ * visibly had x.  The files read as the same files without it. */
+START_TEST(specimen_import_byte_order_mark)
+{
+    struct tfx *f = tfx_parse("[material m]\nkn = 1e5\ndensity = 2\n[import p]\n"
+                              "discs = scenes/import/bom_discs.tsv\n"
+                              "walls = scenes/import/bom_walls.tsv\nmaterial = m\n"
+                              "wall_material = m\n[stage s]\ncycles = 1\n", "bom");
+    const struct bal_import_def *m = &f->sc.imports[0];
+    ck_assert_int_eq(m->n, 2);
+    ck_assert_double_eq(m->disc_data[BAL_IMPORT_X], 0.5);
+    ck_assert_double_eq(m->disc_data[BAL_IMPORT_COLUMNS + BAL_IMPORT_X], 1.5);
+    ck_assert_double_eq(m->disc_data[BAL_IMPORT_COLUMNS + BAL_IMPORT_R], 0.3);
+    ck_assert_int_eq(m->n_walls, 1);
+    ck_assert_str_eq(m->wall_data[0].name, "floor");
+    ck_assert_double_eq(m->wall_data[0].b[0], 3);
+}
+END_TEST
+
+/* Item 11: discs piled at one point, more than the neighbour lists hold
+ * for one disc (BAL_MAX_NEIGHBOURS), from every generator that can pile
+ * them (the [import] is in check_scene.c's table; [pile] and [grains] lay
+ * discs apart by construction): the start overlap is bad input, named at
+ * the line that placed the disc, as any start overlap is; with overlaps
+ * allowed, the crowd itself is, at that line too.  It was "more than 512
+ * neighbours within reach at step 0" with no line, and BAL_EUNSTABLE. */
+START_TEST(specimen_crowded_start_is_bad_input)
+{
+    enum { N = 600 }; /* more than the 512 candidates the lists hold for one disc (grid.h) */
+    const size_t size = 64 + (size_t)N * 96;
+    char *text = malloc(size);
+    ck_assert_ptr_nonnull(text);
+    for (int kind = 0; kind < 3; kind++) {
+        /* 0: [disc] sections, 1: one-disc [fill]s, 2: [disc]s with overlaps allowed */
+        int n = snprintf(text, size, "%s[material m]\nkn = 1e5\ndensity = 2\n",
+                         kind == 2 ? "[settings]\nallow_overlap = 1\n" : "");
+        for (int k = 0; k < N; k++)
+            n += snprintf(text + n, size - (size_t)n,
+                          kind == 1 ? "[fill f%d]\nn = 1\ncolumns = 1\norigin = 0.5 0.5\nrmin = 0.5\n"
+                                      "rmax = 0.5\nmaterial = m\n"
+                                    : "[disc d%d]\nx = 1 1\nr = 0.5\nmaterial = m\n", k);
+        snprintf(text + n, size - (size_t)n, "[stage s]\ncycles = 1\n");
+        struct tfx *f = tfx_parse(text, "crowd");
+        ck_assert_int_eq(tfx_create(f), BAL_EINVAL);
+        /* some disc of the crowd, at its line (after the 3 lines of the
+         * material, and 2 of the settings when given) */
+        const char *expect = kind == 0 ? ": x: disc d" : kind == 1 ? ": origin: disc f" : ": x: disc d";
+        ck_assert_msg(strncmp(f->err.msg, "crowd:", 6) == 0 && t_contains(f->err.msg, expect),
+                      "kind %d: %s", kind, f->err.msg);
+        if (kind < 2)
+            ck_assert_msg(t_contains(f->err.msg, "overlaps disc ") &&
+                          t_contains(f->err.msg, " by 1 (2 of the smaller radius) at the start"),
+                          "kind %d: %s", kind, f->err.msg);
+        else
+            ck_assert_msg(t_contains(f->err.msg, "has more than 512 neighbours within reach at "
+                                                 "the start"), "%s", f->err.msg);
+        tfx_release(f);
+    }
+    free(text);
+}
+END_TEST
+
+/* Item 13: a generator's discs are named NAME.k in every message, and a
+ * probe names them so: [fill], [pile], [grains] and [import].  A probe of
+ * each disc by the name bal_specimen_disc_name gives it reads that disc;
+ * and the probes read the discs the layout rules put there (fill: the
+ * lattice of pitch 2 rmax from the origin; pile: bottom row from origin +
+ * d/2, one d apart, on the floor; import: the file's rows). */
+#define GENERATED                                                                              \
+    "[material m]\nkn = 1e5\ndensity = 2\n"                                                   \
+    "[fill f]\nn = 6\ncolumns = 3\norigin = 0 30\nrmin = 0.5\nrmax = 0.5\nmaterial = m\n"      \
+    "[pile q]\nL = 4\nd = 1\norigin = 50 0\nmaterial = m\nwall_material = m\n"                 \
+    "[grains g]\nsize = 20 20\nn = 10\nmaterial = m\ndmin = 1\nd10 = 1.2\nd50 = 1.5\n"         \
+    "d60 = 1.6\ndmax = 2\n"                                                                     \
+    "[import p]\ndiscs = scenes/import/discs.tsv\nmaterial = m\n"                              \
+    "[stage s]\ncycles = 1\n"
+
+START_TEST(specimen_generated_discs_probed)
+{
+    struct tfx *names = tfx_parse(GENERATED, "generated");
+    const long n = bal_specimen_count(&names->sc);
+    ck_assert_int_eq(n, 6 + 5 + 10 + 2);
+    char text[T_TEXT_MAX];
+    int len = snprintf(text, sizeof text, "%s", GENERATED
+                       "[probe fy]\nquantity = disc_y\na = f.4\n[probe fx]\nquantity = disc_x\n"
+                       "a = f.4\n[probe qx]\nquantity = disc_x\na = q.3\n[probe qy]\n"
+                       "quantity = disc_y\na = q.3\n[probe px]\nquantity = disc_x\na = p.1\n"
+                       "[probe pr]\nquantity = contact_fn\na = p.0\nb = q_floor\n");
+    for (int id = 0; id < n; id++) {
+        char name[2 * BAL_NAME_MAX];
+        bal_specimen_disc_name(&names->sc, id, name, sizeof name);
+        len += snprintf(text + len, sizeof text - (size_t)len,
+                        "[probe x%d]\nquantity = disc_x\na = %s\n[probe y%d]\nquantity = disc_y\n"
+                        "a = %s\n", id, name, id, name);
+        ck_assert_int_lt(len, (int)sizeof text);
+    }
+    struct tfx *f = tfx_new(text, "generated");
+    t_steps(f, 1);
+    const struct bal_sim *s = f->sim;
+    for (int id = 0; id < n; id++) {
+        char px[16], py[16];
+        snprintf(px, sizeof px, "x%d", id);
+        snprintf(py, sizeof py, "y%d", id);
+        ck_assert_double_eq(t_probe_value(f, px), s->x[s->slot[id]]);
+        ck_assert_double_eq(t_probe_value(f, py), s->y[s->slot[id]]);
+    }
+    /* f.4: row 1, column 1 (3 columns); at rest (no gravity, touching) */
+    ck_assert_double_eq(t_probe_value(f, "fx"), 0 + 0.5 + 1 * 1.0);
+    ck_assert_double_eq(t_probe_value(f, "fy"), 30 + 0.5 + 1 * 1.0);
+    ck_assert_double_eq(t_probe_value(f, "qx"), 50 + 0.5 + 3 * 1.0);
+    ck_assert_double_eq(t_probe_value(f, "qy"), 0.5);
+    ck_assert_double_eq(t_probe_value(f, "px"), 1.5);
+    ck_assert_double_eq(t_probe_value(f, "pr"), 0); /* p.0 is nowhere near the floor */
+}
+END_TEST
+
 Suite *suite_specimen(void)
 {
     Suite *s = suite_create("specimen");
@@ -338,6 +456,9 @@ Suite *suite_specimen(void)
     tcase_add_checked_fixture(tc, NULL, tfx_teardown);
     tcase_add_test(tc, specimen_import_round_trip);
     tcase_add_test(tc, specimen_import_set);
+    tcase_add_test(tc, specimen_import_byte_order_mark);
+    tcase_add_test(tc, specimen_crowded_start_is_bad_input);
+    tcase_add_test(tc, specimen_generated_discs_probed);
     suite_add_tcase(s, tc);
     return s;
 }

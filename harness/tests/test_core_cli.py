@@ -182,3 +182,122 @@ def test_a_sweep_over_the_time_step_keeps_the_simulated_time(tmp_path):
     assert runs[1]["time"] == pytest.approx(runs[0]["time"], rel=1e-12)
     for run in runs:
         assert [st["cycles"] * run["dt"] for st in run["stages"]] == pytest.approx([0.4, 6.0], rel=1e-12)
+
+
+# ---- issue 29: inputs refused badly, slowly or not at all (items 9-13, 15) ----------------
+
+# A refusal that takes longer than this was not "at once": each of these took from minutes to
+# forever before (a FIFO blocked in fopen; 1e8 grains took 56 s and 1.9 GB before the refusal).
+AT_ONCE_S = 10
+IMPORT_HEAD = "[material m]\nkn = 1e5\ndensity = 2\n[import p]\n"
+
+
+@needs_ballast
+@pytest.mark.parametrize("where", ["scene", "discs", "walls"])
+def test_a_fifo_is_refused_at_once(tmp_path, where):
+    """Item 9: a FIFO as the scene, or as an [import]'s data file, is not a regular file:
+    exit 2 at once, nothing written (it blocked forever in fopen, waiting for a writer)."""
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    if where == "scene":
+        scene, line = fifo, ""
+    else:
+        (tmp_path / "d.tsv").write_text("x\ty\tr\ttheta\n0\t0\t0.5\t0\n")
+        scene = tmp_path / "imp.scene"
+        files = "discs = pipe\n" if where == "discs" else "discs = d.tsv\nwalls = pipe\n"
+        scene.write_text(IMPORT_HEAD + files + "material = m\nwall_material = m\n"
+                         "[stage s]\ncycles = 1\n")
+        line = ":5: discs: " if where == "discs" else ":6: walls: "
+    done = ballast("run", scene, "--out", tmp_path / "o", timeout=AT_ONCE_S)
+    assert done.returncode == 2, done.stderr
+    head = f"{fifo}" if where == "scene" else f"{scene}{line}{fifo}"
+    assert done.stderr.startswith(f"{head}: not a regular file: a FIFO (named pipe)")
+    assert not (tmp_path / "o").exists()
+
+
+@needs_ballast
+def test_an_import_file_with_a_byte_order_mark_runs(tmp_path):
+    """Item 10: a discs.tsv saved with a UTF-8 byte-order mark before the header x ... runs
+    like the same file without it (it was "no column 'x' in the header")."""
+    rows = "x\ty\tr\ttheta\n0\t0\t0.5\t0\n2\t0\t0.5\t0\n"
+    (tmp_path / "plain.tsv").write_text(rows)
+    (tmp_path / "marked.tsv").write_bytes(b"\xef\xbb\xbf" + rows.encode())
+    out = {}
+    for name in ("plain", "marked"):
+        scene = tmp_path / f"{name}.scene"
+        scene.write_text(IMPORT_HEAD + f"discs = {name}.tsv\nmaterial = m\n[stage s]\ncycles = 5\n")
+        done = ballast("run", scene, "--out", tmp_path / name)
+        assert done.returncode == 0, done.stderr
+        out[name] = (tmp_path / name / "discs.tsv").read_bytes()
+    assert out["plain"] == out["marked"]
+
+
+@needs_ballast
+def test_discs_piled_at_one_point_are_bad_input(tmp_path):
+    """Item 11: 600 imported discs at one point were "more than 512 neighbours within reach at
+    step 0", exit 1, no line; the start overlap is bad input: exit 2, FILE:LINE: discs:, no
+    output folder."""
+    (tmp_path / "pile.tsv").write_text("x\ty\tr\ttheta\n" + "1\t1\t0.5\t0\n" * 600)
+    scene = tmp_path / "pile.scene"
+    scene.write_text(IMPORT_HEAD + "discs = pile.tsv\nmaterial = m\n[stage s]\ncycles = 1\n")
+    done = ballast("run", scene, "--out", tmp_path / "o", timeout=AT_ONCE_S)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.startswith(f"{scene}:5: discs: disc p.0 of [import p] (line 2 of pile.tsv): "
+                                  "overlaps disc p.1 by 1 (2 of the smaller radius) at the start")
+    assert not (tmp_path / "o").exists()
+
+
+GRAINS = ("[material m]\nkn = 1e5\ndensity = 2\n[grains g]\nsize = 20 20\nn = {n}\nmaterial = m\n"
+          "dmin = 1\nd10 = 1.2\nd50 = 1.5\nd60 = 1.6\ndmax = 2\n{more}[stage s]\ncycles = 1\n")
+
+
+@needs_ballast
+def test_grains_that_cannot_fit_are_refused_at_once(tmp_path):
+    """Item 12: 1e8 grains of diameter >= 1 in a 20 x 20 region were refused after 56 s and
+    1.9 GB; the densest packing bounds them at 2 x 20 x 20 / sqrt(3) = 461, refused at once."""
+    scene = tmp_path / "g.scene"
+    scene.write_text(GRAINS.format(n=100000000, more=""))
+    done = ballast("run", scene, "--out", tmp_path / "o", timeout=AT_ONCE_S)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.startswith(f"{scene}:6: n: [grains g]: 100000000 discs of diameter >= dmin = 1 "
+                                  "cannot lie apart in the region 20 x 20: at most 461 can")
+
+
+@needs_ballast
+def test_a_grains_origin_beyond_precision_is_named(tmp_path):
+    """Item 12: origin = 1e300 1e300 was blamed on n ("fewer discs"); it is the origin, where
+    the doubles are 1.5e284 apart."""
+    scene = tmp_path / "g.scene"
+    scene.write_text(GRAINS.format(n=40, more="origin = 1e300 1e300\n"))
+    done = ballast("run", scene, "--out", tmp_path / "o", timeout=AT_ONCE_S)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.startswith(f"{scene}:13: origin: [grains g]: the region reaches x = 1e+300, "
+                                  "where doubles are 1.487016908477783e+284 apart")
+
+
+@needs_ballast
+def test_a_generated_disc_is_probed_by_its_name(tmp_path):
+    """Item 13: `[probe] quantity = disc_y, a = g.0` was refused although every message names
+    the disc g.0; its column is the y that discs.tsv gives the disc named g.0."""
+    scene = tmp_path / "g.scene"
+    scene.write_text(GRAINS.format(n=40, more="").replace(
+        "[stage s]\ncycles = 1\n", "[stage s]\ncycles = 1\n[probe y]\nquantity = disc_y\na = g.0\n"))
+    done = ballast("run", scene, "--out", tmp_path / "o")
+    assert done.returncode == 0, done.stderr
+    series = (tmp_path / "o" / "series.tsv").read_text().splitlines()
+    assert series[0].split("\t")[-1] == "y"
+    discs = [line.split("\t") for line in (tmp_path / "o" / "discs.tsv").read_text().splitlines()]
+    col = {name: k for k, name in enumerate(discs[0])}
+    row = next(r for r in discs[1:] if r[col["name"]] == "g.0")
+    assert series[-1].split("\t")[-1] == row[col["y"]]
+
+
+@needs_ballast
+def test_a_value_just_out_of_range_prints_why(tmp_path):
+    """Item 15: `rolling = 2.0000001` was "2 is out of range: expected 0 <= value <= 2"."""
+    scene = tmp_path / "r.scene"
+    scene.write_text("[material m]\nkn = 1e5\nrolling = 2.0000001\n")
+    done = ballast("run", scene, "--out", tmp_path / "o")
+    assert done.returncode == 2
+    assert done.stderr.strip() == (f"{scene}:3: rolling: 2.0000001 is out of range: "
+                                   "expected 0 <= value <= 2")

@@ -257,7 +257,19 @@ static int has_stop_rule(const struct bal_stage_def *g)
  * energy ... and the stresses no longer vary with time" (stop_ke,
  * stop_stress); a servo-controlled consolidation (JYH Sec. 5.1): every servo
  * wall within stop_servo of its target stress, and ΔF/F within
- * stop_unbalanced.  Record the measures and say whether the rule is met. */
+ * stop_unbalanced.  Record the measures and say whether the rule is met.
+ *
+ * Each rule is a rule of equilibrium, and none is met while nothing bears a
+ * load: with no contact force every ratio has a zero below it and the
+ * "measure" is 0/0 or x/0, which the log records as INFINITY (run.json:
+ * null), never as 0.  Without this, 30 discs falling freely "stopped" at
+ * the first check with ΔF/F = 0 (issue 29, item 4):
+ *   stop_ke          E_k/E_el, no elastic energy: not at rest;
+ *   stop_stress      the change of the stress moments over their size, all
+ *                    moments zero: nothing to compare;
+ *   stop_servo       a servo wall whose springs carry no force touches
+ *                    nothing (its error is then 1, within a tolerance >= 1);
+ *   stop_unbalanced  ΔF/F with no contact force. */
 static int stop_rule_met(struct bal_sim *s, const struct bal_stage_def *g, struct bal_stage_log *log)
 {
     const double ee = bal_measure_elastic(s);
@@ -272,20 +284,25 @@ static int stop_rule_met(struct bal_sim *s, const struct bal_stage_def *g, struc
         }
         memcpy(s->moment_prev, s->moment, 4 * (size_t)s->n * sizeof *s->moment);
         /* The first check has nothing to compare with: not met. */
-        log->stress_change = log->stress_change < 0 ? INFINITY : (size > 0 ? change / size : 0);
+        log->stress_change = log->stress_change < 0 ? INFINITY
+                                                    : (size > 0 ? change / size : INFINITY);
         met = met && log->stress_change <= g->stop_stress;
     }
     if (g->stop_servo > 0) {
         /* The stresses the servos measured in this cycle (bal_walls_control). */
         double worst = 0;
-        for (int k = 0; k < s->n_walls; k++)
-            if (s->walls[k].move && s->walls[k].move->control == BAL_CONTROL_SERVO)
-                worst = fmax(worst, s->walls[k].stress_error);
+        for (int k = 0; k < s->n_walls; k++) {
+            const struct bal_wall *w = &s->walls[k];
+            if (w->move && w->move->control == BAL_CONTROL_SERVO)
+                worst = fmax(worst, w->stress == 0 ? INFINITY : w->stress_error);
+        }
         log->servo_error = worst;
         met = met && worst <= g->stop_servo;
     }
     if (g->stop_unbalanced > 0) {
-        log->unbalanced = bal_measure_unbalanced(s);
+        double largest;
+        const double ratio = bal_measure_unbalanced_of(s, &largest);
+        log->unbalanced = largest > 0 ? ratio : INFINITY;
         met = met && log->unbalanced <= g->stop_unbalanced;
     }
     return met;

@@ -149,7 +149,7 @@ double bal_measure_rolling_dashpot(const struct bal_sim *s, const struct bal_pai
     const double dist = sqrt(dx * dx + dy * dy); /* as the cycle computes it */
     const struct bal_law_params P = bal_law_params_of(s);
     const struct bal_roll R = bal_law_roll_of(L, bal_law_common_radius(s->r[i], s->r[j]));
-    return bal_law_rolling_dashpot(&P, L, R, s->r[i] + s->r[j] - dist, wi - wj);
+    return bal_law_rolling_dashpot(&P, L, R, s->r[i] + s->r[j] - dist, wi - wj, p->flags[c]);
 }
 
 static double contact_force(const struct bal_sim *s, const struct bal_pairs *p, long c)

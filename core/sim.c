@@ -30,8 +30,9 @@
  * bal_sim_run() runs the stages of the loading protocol in order (each
  * stage gives its walls their controllers and sets the gravity ramp, and
  * may stop early on its stop rule), writes a series row every output_every cycles (output.c),
- * and stops, with a status, on a signal, a state that is no longer finite
- * or an energy runaway (energy.c).
+ * and stops, with a status, on a signal, a state that is no longer finite,
+ * an energy runaway (energy.c) or a wall about to outrun the discs or a
+ * servo's span closed (walls.c).
  */
 #include <float.h>
 #include <math.h>
@@ -80,7 +81,8 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         bal_integrate_setup(s, err) ||     /* the law of motion */
         bal_build_lists(s, err) ||         /* the first candidate lists */
         bal_build_probes(s, err) ||        /* probe bodies */
-        bal_build_stages(s, err)) {        /* the stages' log; none begun */
+        bal_build_stages(s, err) ||        /* the stages' log; none begun */
+        bal_walls_check_steps(s, err)) {   /* no wall outruns the discs (walls.c) */
         bal_sim_free(s);
         return err->code;
     }
@@ -157,6 +159,10 @@ static enum bal_status cycle(struct bal_sim *s, struct bal_error *err)
     /* Each phase is timed (five clock reads a cycle, ~0.1 us: negligible
      * beside a cycle of any scene worth timing). */
     double t0 = seconds_now(), t1;
+    /* A wall whose stage began with a step beyond the limit does not move
+     * (walls.c). */
+    if (s->wall_fault)
+        return bal_walls_fault(s, err);
     if (!s->audit.started)
         bal_energy_begin(s); /* the energy audit's baseline at t_0 (energy.c) */
     bal_energy_gravity_before(s);
@@ -206,6 +212,10 @@ static enum bal_status cycle(struct bal_sim *s, struct bal_error *err)
         if (bal_energy_overlap(s, err) != BAL_OK)
             return err->code;
     }
+    /* ... as does a wall whose controller set a step beyond the limit, or
+     * whose servo's span closed (walls.c): before it moves again. */
+    if (s->wall_fault)
+        return bal_walls_fault(s, err);
     return BAL_OK;
 }
 

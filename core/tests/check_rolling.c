@@ -376,7 +376,8 @@ START_TEST(rolling_energy_ledger)
         struct bal_energy e;
         bal_energy_report(f->sim, &e);
         ck_assert_msg(e.relative < 0.01, "%s: relative imbalance %g", models[k], e.relative);
-        /* measured: 1.3e3 (Model 1) and 3.5e2 (Model 2) of 9e3-1e4 of gravity's work */
+        /* measured: 1.3e3 (Model 1) and 4.5e2 (Model 2; 3.5e2 while a lost contact kept its
+         * rolling dashpot) of 9e3-1.1e4 of gravity's work */
         ck_assert_msg(e.dissipated_rolling > 0.01 * e.work_gravity, "%s: rolling loss %g",
                       models[k], e.dissipated_rolling);
         /* the rolling springs hold some of E_el: the ledger without them is off */

@@ -545,7 +545,7 @@ enum bal_status bal_walls_check_steps(const struct bal_sim *s, struct bal_error 
             if (step > limit)
                 return bal_error(err, BAL_EINVAL,
                                  "%s:%d: %s: wall '%s' would move %.6g in one time step (%s, dt "
-                                 "= %g): %.3g of the smallest disc radius %g; expected at most "
+                                 "= %g): %.4g of the smallest disc radius %g; expected at most "
                                  "%g of it (a disc the wall meets gains that much overlap in a "
                                  "cycle; a wall that moves a diameter passes through discs)",
                                  sc->path, line, key, mv->wall, step, how, s->dt,
@@ -573,8 +573,9 @@ enum bal_status bal_walls_fault(const struct bal_sim *s, struct bal_error *err)
     const double step = bal_walls_step(w, w->v[0], w->v[1], w->omega, s->dt);
     return bal_error(err, BAL_EUNSTABLE,
                      "%s: wall '%s' at step %ld: its %s would move it %.6g in one time step, "
-                     "%.3g of the smallest disc radius %g (limit %g): it would pass through "
-                     "discs (%s:%d: %s)", s->scene->path, w->name, s->step,
+                     "%.4g of the smallest disc radius %g, beyond the limit %g of it (a disc "
+                     "it meets gains that much overlap in a cycle; a wall that moves a "
+                     "diameter passes through discs) (%s:%d: %s)", s->scene->path, w->name, s->step,
                      w->controller ? w->controller->name : "controller", step, step / s->r_min,
                      s->r_min, BAL_WALL_STEP_SHARE, s->scene->path, line, key);
 }

@@ -486,7 +486,7 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
                 mr = bal_law_rolling(&P, R, fn, dtheta, pmr[c], &lost_roll, &flags);
                 pmr[c] = mr;
                 if (damp) {
-                    md = bal_law_rolling_dashpot(&P, L, R, k.delta, wrel);
+                    md = bal_law_rolling_dashpot(&P, L, R, k.delta, wrel, flags);
                     mr += md;
                 }
             }
@@ -795,7 +795,7 @@ void bal_contacts_walls(struct bal_sim *s)
             mr = bal_law_rolling(&P, R, fn, dtheta, p->mr[c], &lost_roll, &flags);
             p->mr[c] = mr;
             if (p->dm) {
-                md = bal_law_rolling_dashpot(&P, L, R, k.delta, wrel);
+                md = bal_law_rolling_dashpot(&P, L, R, k.delta, wrel, flags);
                 p->dm[c] = md;
             }
         }

@@ -25,7 +25,8 @@
  *               unloading elastic from the cap), Model 2 (eq. 36) loses M
  *               for good once |M| would pass M_0 (|θ_r| > θ_r⁰ = M_0/K_m =
  *               2 F_n/(K_n B)): the contact width is gone until the contact
- *               opens and forms again.  The couples act on the rotations only
+ *               opens and forms again, and the rolling dashpot μ_m, which
+ *               lives on that width, with it.  The couples act on the rotations only
  *               (eq. 52): −(M + M_d) on x, +(M + M_d) on y, M_d = μ_m θ̇_r.
  *               history: M, θ_r; flags ROLLING (at the cap), BROKEN (Model 2)
  *
@@ -231,11 +232,15 @@ static inline double bal_law_rolling(const struct bal_law_params *P, struct bal_
 }
 
 /* The rolling dashpot's moment M_d = μ_m θ̇_r, μ_m = μ_n B²/12 (eq. 49c),
- * with μ_n the pair's normal dashpot coefficient at overlap δ. */
+ * with μ_n the pair's normal dashpot coefficient at overlap δ.  A contact
+ * flagged BROKEN (Model 2: its width B is gone, Sec. 3.1) has none: μ_m is
+ * the normal dashpots spread over B (eqs 44–47), and they go with it. */
 static inline double bal_law_rolling_dashpot(const struct bal_law_params *P,
                                              const struct bal_pair_law *L, struct bal_roll R,
-                                             double delta, double theta_dot)
+                                             double delta, double theta_dot, uint8_t flags)
 {
+    if (flags & BAL_PAIR_BROKEN)
+        return 0;
     return (L->cn + bal_law_viscous(P, delta)) * R.b * R.b * (1.0 / 12) * theta_dot;
 }
 

@@ -149,7 +149,7 @@ double bal_measure_rolling_dashpot(const struct bal_sim *s, const struct bal_pai
     const double dist = sqrt(dx * dx + dy * dy); /* as the cycle computes it */
     const struct bal_law_params P = bal_law_params_of(s);
     const struct bal_roll R = bal_law_roll_of(L, bal_law_common_radius(s->r[i], s->r[j]));
-    return bal_law_rolling_dashpot(&P, L, R, s->r[i] + s->r[j] - dist, wi - wj);
+    return bal_law_rolling_dashpot(&P, L, R, s->r[i] + s->r[j] - dist, wi - wj, p->flags[c]);
 }
 
 static double contact_force(const struct bal_sim *s, const struct bal_pairs *p, long c)
@@ -159,7 +159,7 @@ static double contact_force(const struct bal_sim *s, const struct bal_pairs *p, 
     return hypot(p->fn[c] + dn, pair_fs(p, c) + ds);
 }
 
-double bal_measure_unbalanced(const struct bal_sim *s)
+double bal_measure_unbalanced_of(const struct bal_sim *s, double *largest)
 {
     double fbig = 0;
     for (long c = 0; c < s->pp.n; c++)
@@ -168,6 +168,7 @@ double bal_measure_unbalanced(const struct bal_sim *s)
     for (long c = 0; c < s->pw.n; c++)
         if (s->pw.flags[c] & BAL_PAIR_TOUCHING)
             fbig = fmax(fbig, contact_force(s, &s->pw, c));
+    *largest = fbig;
     if (fbig == 0)
         return 0;
     double smax = 0;
@@ -185,6 +186,12 @@ double bal_measure_unbalanced(const struct bal_sim *s)
         smax = fmax(smax, hypot(sx, sy));
     }
     return smax / fbig;
+}
+
+double bal_measure_unbalanced(const struct bal_sim *s)
+{
+    double largest;
+    return bal_measure_unbalanced_of(s, &largest);
 }
 
 double bal_measure_disc_volume(double r)

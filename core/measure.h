@@ -24,6 +24,11 @@ void bal_measure_velocity(const struct bal_sim *s, int i, double *vx, double *vy
 /* Per disc, Σ_c f^c ⊗ l^c over its contacts (MLH eq. 8 without 1/V), into
  * m[4 i .. 4 i + 3] = xx, xz, zx, zz (z vertical). */
 void bal_measure_moments(const struct bal_sim *s, double *m);
+/* ΔF/F of C&S Tables 1–3 (bal_measure_unbalanced), and in *largest the F
+ * it divides by: the largest contact force.  With no contact carrying force
+ * (*largest = 0) the ratio is undefined and 0 is returned, as the probe
+ * `unbalanced` writes it; an equilibrium rule must read *largest (sim.c). */
+double bal_measure_unbalanced_of(const struct bal_sim *s, double *largest);
 /* The volume V_i of MLH eq. (8) for one disc: the hexagonal cell of a disc of
  * its size in a triangular packing, 2 sqrt(3) r^2. */
 double bal_measure_disc_volume(double r);

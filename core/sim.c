@@ -30,8 +30,9 @@
  * bal_sim_run() runs the stages of the loading protocol in order (each
  * stage gives its walls their controllers and sets the gravity ramp, and
  * may stop early on its stop rule), writes a series row every output_every cycles (output.c),
- * and stops, with a status, on a signal, a state that is no longer finite
- * or an energy runaway (energy.c).
+ * and stops, with a status, on a signal, a state that is no longer finite,
+ * an energy runaway (energy.c) or a wall about to outrun the discs or a
+ * servo's span closed (walls.c).
  */
 #include <float.h>
 #include <math.h>
@@ -80,7 +81,8 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         bal_integrate_setup(s, err) ||     /* the law of motion */
         bal_build_lists(s, err) ||         /* the first candidate lists */
         bal_build_probes(s, err) ||        /* probe bodies */
-        bal_build_stages(s, err)) {        /* the stages' log; none begun */
+        bal_build_stages(s, err) ||        /* the stages' log; none begun */
+        bal_walls_check_steps(s, err)) {   /* no wall outruns the discs (walls.c) */
         bal_sim_free(s);
         return err->code;
     }
@@ -157,6 +159,10 @@ static enum bal_status cycle(struct bal_sim *s, struct bal_error *err)
     /* Each phase is timed (five clock reads a cycle, ~0.1 us: negligible
      * beside a cycle of any scene worth timing). */
     double t0 = seconds_now(), t1;
+    /* A wall whose stage began with a step beyond the limit does not move
+     * (walls.c). */
+    if (s->wall_fault)
+        return bal_walls_fault(s, err);
     if (!s->audit.started)
         bal_energy_begin(s); /* the energy audit's baseline at t_0 (energy.c) */
     bal_energy_gravity_before(s);
@@ -206,6 +212,10 @@ static enum bal_status cycle(struct bal_sim *s, struct bal_error *err)
         if (bal_energy_overlap(s, err) != BAL_OK)
             return err->code;
     }
+    /* ... as does a wall whose controller set a step beyond the limit, or
+     * whose servo's span closed (walls.c): before it moves again. */
+    if (s->wall_fault)
+        return bal_walls_fault(s, err);
     return BAL_OK;
 }
 
@@ -257,7 +267,19 @@ static int has_stop_rule(const struct bal_stage_def *g)
  * energy ... and the stresses no longer vary with time" (stop_ke,
  * stop_stress); a servo-controlled consolidation (JYH Sec. 5.1): every servo
  * wall within stop_servo of its target stress, and ΔF/F within
- * stop_unbalanced.  Record the measures and say whether the rule is met. */
+ * stop_unbalanced.  Record the measures and say whether the rule is met.
+ *
+ * Each rule is a rule of equilibrium, and none is met while nothing bears a
+ * load: with no contact force every ratio has a zero below it and the
+ * "measure" is 0/0 or x/0, which the log records as INFINITY (run.json:
+ * null), never as 0.  Without this, 30 discs falling freely "stopped" at
+ * the first check with ΔF/F = 0 (issue 29, item 4):
+ *   stop_ke          E_k/E_el, no elastic energy: not at rest;
+ *   stop_stress      the change of the stress moments over their size, all
+ *                    moments zero: nothing to compare;
+ *   stop_servo       a servo wall whose springs carry no force touches
+ *                    nothing (its error is then 1, within a tolerance >= 1);
+ *   stop_unbalanced  ΔF/F with no contact force. */
 static int stop_rule_met(struct bal_sim *s, const struct bal_stage_def *g, struct bal_stage_log *log)
 {
     const double ee = bal_measure_elastic(s);
@@ -272,20 +294,25 @@ static int stop_rule_met(struct bal_sim *s, const struct bal_stage_def *g, struc
         }
         memcpy(s->moment_prev, s->moment, 4 * (size_t)s->n * sizeof *s->moment);
         /* The first check has nothing to compare with: not met. */
-        log->stress_change = log->stress_change < 0 ? INFINITY : (size > 0 ? change / size : 0);
+        log->stress_change = log->stress_change < 0 ? INFINITY
+                                                    : (size > 0 ? change / size : INFINITY);
         met = met && log->stress_change <= g->stop_stress;
     }
     if (g->stop_servo > 0) {
         /* The stresses the servos measured in this cycle (bal_walls_control). */
         double worst = 0;
-        for (int k = 0; k < s->n_walls; k++)
-            if (s->walls[k].move && s->walls[k].move->control == BAL_CONTROL_SERVO)
-                worst = fmax(worst, s->walls[k].stress_error);
+        for (int k = 0; k < s->n_walls; k++) {
+            const struct bal_wall *w = &s->walls[k];
+            if (w->move && w->move->control == BAL_CONTROL_SERVO)
+                worst = fmax(worst, w->stress == 0 ? INFINITY : w->stress_error);
+        }
         log->servo_error = worst;
         met = met && worst <= g->stop_servo;
     }
     if (g->stop_unbalanced > 0) {
-        log->unbalanced = bal_measure_unbalanced(s);
+        double largest;
+        const double ratio = bal_measure_unbalanced_of(s, &largest);
+        log->unbalanced = largest > 0 ? ratio : INFINITY;
         met = met && log->unbalanced <= g->stop_unbalanced;
     }
     return met;

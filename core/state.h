@@ -261,6 +261,9 @@ struct bal_sim {
     struct bal_wall *walls;
     int walls_controlled;        /* walls of this stage whose controller acts in every
                                   * cycle: 0 lets a cycle skip them all (walls.c) */
+    int wall_fault;              /* a wall's run-time guard tripped (walls.c): 1 + its index,
+                                  * else 0; the next cycle stops the run before it moves */
+    int wall_fault_kind;         /* enum bal_wall_fault of that wall (walls.h) */
 
     /* materials */
     double *density;             /* per material: mass per area */

@@ -117,12 +117,21 @@
  * Walls that never move pay nothing: the stage leaves them without a
  * controller, bal_walls_move skips a wall at rest, and a stage in which no
  * controller acts per cycle (s->walls_controlled = 0) skips the pass.
+ *
+ * Guards.  No wall may move more than BAL_WALL_STEP_SHARE of the smallest
+ * disc radius in one step, and no servo may divide by a span below the
+ * smallest radius: what the scene alone decides is refused when the
+ * simulation is built (bal_walls_check_steps, naming the stage's line);
+ * the rest is caught once a controller sets the velocity (or its servo
+ * measures the span), and the run stops before the wall moves
+ * (s->wall_fault, checked by the cycle in sim.c).
  */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "pairs.h"
+#include "scene_keys.h"
 #include "walls.h"
 
 double bal_walls_closest(const struct bal_wall *w, double x, double y,
@@ -162,11 +171,14 @@ void bal_walls_move(struct bal_sim *s)
             w->e[0] = cos(w->alpha);
             w->e[1] = sin(w->alpha);
         }
-        /* Every point of a rigidly moving segment moves by at most what its
-         * farther end moves, so this bounds the wall's displacement. */
-        const double hmax = fmax(fabs(w->h1), fabs(w->h2));
-        w->disp += hypot(w->v[0], w->v[1]) * dt + fabs(w->omega) * hmax * dt;
+        w->disp += bal_walls_step(w, w->v[0], w->v[1], w->omega, dt);
     }
+}
+
+double bal_walls_step(const struct bal_wall *w, double vx, double vy, double omega, double dt)
+{
+    const double hmax = fmax(fabs(w->h1), fabs(w->h2));
+    return hypot(vx, vy) * dt + fabs(omega) * hmax * dt;
 }
 
 double bal_walls_normal(const struct bal_wall *w, double x, double y, double *ex, double *ey)
@@ -182,6 +194,73 @@ double bal_walls_normal(const struct bal_wall *w, double x, double y, double *ex
         *ey = w->e[0];
     }
     return d;
+}
+
+/* ------------------------------------------------------------------ */
+/* Guards: how far a wall may move in a cycle, how close a servo's span */
+/* ------------------------------------------------------------------ */
+
+/* The most a wall may move in one time step, as a share of the smallest
+ * disc radius.  A wall that moves d in a cycle gives a disc it meets up to
+ * d of new overlap before the contact can answer (its force acts from the
+ * next cycle on); a wall that moves a diameter in a cycle can pass through
+ * a disc without ever touching it, and the run used to end "ok" with the
+ * specimen behind the wall (issue 29, item 5: a servo with vmax dt = 24 in
+ * a 10 x 10 box).  Why a tenth:
+ *   - DEM contacts work at overlaps of 1e-3 to a few 1e-2 of a radius
+ *     (JYH's at 400 kPa: 3e-2), built up over tens of cycles; a tenth in
+ *     one cycle is already several working overlaps at once;
+ *   - it is a fifth of the default overlap budget (0.5, energy.c): a disc
+ *     pinned by such a wall reaches the budget within a few cycles, and the
+ *     overlap guard stops the run on it rather than let the wall pass (at
+ *     the usual dt ~ 0.2 sqrt(m/k), a wall at d per cycle drives a pinned
+ *     disc to an overlap of about d/0.2 = 5 d);
+ *   - the catalogue's walls move at most 4.0e-4 of the smallest radius a
+ *     cycle (biaxial's shear servos: vmax = 1 m/s, dt = 1.2e-6 s, r_min =
+ *     3.0 mm; prepare.scene 2.9e-4, nine_discs_speed 2.2e-4), 250 times
+ *     below. */
+#define BAL_WALL_STEP_SHARE 0.1
+
+static double step_limit(const struct bal_sim *s)
+{
+    return BAL_WALL_STEP_SHARE * s->r_min; /* INFINITY without discs: nothing to pass */
+}
+
+/* The smallest span a servo may divide its force by: the smallest disc
+ * radius.  A disc between walls closer than that overlaps each by more than
+ * half its radius, beyond the default overlap budget (0.5, energy.c): no
+ * disc is between them as a contact, and as the span goes to 0 the "stress"
+ * force/span grows without bound (issue 29: a span of 1e-16 gave 5e16, with
+ * the energy imbalance at 0.44 of the throughput; a span of 0 measured 0).  Not
+ * the diameter: a column of discs that exactly fits its walls (the span one
+ * diameter, give or take the round-off of the walls' directions) is a
+ * servo's ordinary work (check_walls' walls_servo_column).  Without discs,
+ * any positive span. */
+static double span_min(const struct bal_sim *s)
+{
+    return s->n > 0 ? s->r_min : 0;
+}
+
+static int span_ok(const struct bal_sim *s, double span)
+{
+    return span > 0 && span >= span_min(s);
+}
+
+/* Record the first fault of a cycle; the next cycle stops the run before
+ * the wall moves (sim.c). */
+static void trip(struct bal_sim *s, const struct bal_wall *w, enum bal_wall_fault kind)
+{
+    if (s->wall_fault)
+        return;
+    s->wall_fault = 1 + (int)(w - s->walls);
+    s->wall_fault_kind = kind;
+}
+
+/* The velocity a controller has just set: beyond the limit, trip. */
+static void guard_step(struct bal_sim *s, const struct bal_wall *w)
+{
+    if (!(bal_walls_step(w, w->v[0], w->v[1], w->omega, s->dt) <= step_limit(s)))
+        trip(s, w, BAL_WALL_FAULT_STEP);
 }
 
 /* ------------------------------------------------------------------ */
@@ -225,6 +304,8 @@ static void servo_control(struct bal_sim *s, struct bal_wall *w)
     const struct bal_move_def *mv = w->move;
     const int k = (int)(w - s->walls);
     const double span = bal_walls_gap(&s->walls[w->other[0]], &s->walls[w->other[1]], NULL);
+    if (!span_ok(s, span))
+        trip(s, w, BAL_WALL_FAULT_SPAN); /* the span walls closed on each other */
     /* The springs' force: the dashpots' share answers the wall's velocity
      * within the cycle (the header), and vanishes at rest. */
     const double force = -((w->f[0] - w->dash_f[0]) * w->toward[0] +
@@ -356,10 +437,13 @@ void bal_walls_stage(struct bal_sim *s, const struct bal_stage_def *g)
             w->other[q] = *mv->walls[q] ? bal_walls_find(s, mv->walls[q]) : -1;
     }
     /* Every wall has its line before any starts: a controller's start may
-     * read the other walls. */
+     * read the other walls.  A fault of the stage before is that stage's. */
+    s->wall_fault = 0;
     for (int k = 0; k < s->n_walls; k++)
-        if (s->walls[k].controller)
+        if (s->walls[k].controller) {
             s->walls[k].controller->start(s, &s->walls[k]);
+            guard_step(s, &s->walls[k]);
+        }
     s->walls_controlled = 0;
     for (int k = 0; k < s->n_walls; k++)
         s->walls_controlled += s->walls[k].controller && s->walls[k].controller->control;
@@ -375,6 +459,7 @@ void bal_walls_control(struct bal_sim *s)
             continue;
         const double vx = w->v[0], vy = w->v[1], om = w->omega;
         w->controller->control(s, w);
+        guard_step(s, w);
         /* The energy audit prices the dashpots' loss at t_N with the discs'
          * centred velocities (v_{N-1/2} + v_{N+1/2})/2 (energy.c); a wall's
          * V_N is its v_{N-1/2}, the one it moved with, and the velocity just
@@ -387,4 +472,110 @@ void bal_walls_control(struct bal_sim *s)
             s->audit.wall_dash += 0.5 * (w->dash_f[0] * (w->v[0] - vx) +
                                          w->dash_f[1] * (w->v[1] - vy) + w->dash_m * (w->omega - om));
     }
+}
+
+/* ------------------------------------------------------------------ */
+/* Refusals once the time step is known, and the run-time guard's error */
+/* ------------------------------------------------------------------ */
+
+/* Does a stage before g name wall `name` (and so may have moved it)? */
+static int named_before(const struct bal_scene *sc, int g, const char *name)
+{
+    for (int h = 0; h < g; h++)
+        for (int m = 0; m < sc->stages[h].n_moves; m++)
+            if (strcmp(sc->stages[h].moves[m].wall, name) == 0)
+                return 1;
+    return 0;
+}
+
+enum bal_status bal_walls_check_steps(const struct bal_sim *s, struct bal_error *err)
+{
+    const struct bal_scene *sc = s->scene;
+    const double limit = step_limit(s);
+    for (int g = 0; g < sc->n_stages; g++) {
+        const struct bal_stage_def *st = &sc->stages[g];
+        for (int m = 0; m < st->n_moves; m++) {
+            const struct bal_move_def *mv = &st->moves[m];
+            const int k = bal_walls_find(s, mv->wall);
+            if (k < 0)
+                continue; /* refused by bal_scene_validate */
+            const struct bal_wall *w = &s->walls[k];
+            const char *key = bal_scene_key_for_control(mv->control);
+            const int line = mv->line > 0 ? mv->line : st->line;
+            const int other = *mv->walls[0] ? bal_walls_find(s, mv->walls[0]) : -1;
+            const int other2 = *mv->walls[1] ? bal_walls_find(s, mv->walls[1]) : -1;
+            /* The walls as the scene put them, if no earlier stage moved them. */
+            const int as_built = !named_before(sc, g, mv->wall) &&
+                                 (other < 0 || !named_before(sc, g, mv->walls[0])) &&
+                                 (other2 < 0 || !named_before(sc, g, mv->walls[1]));
+            double step = -1;
+            char how[96] = "";
+            switch (mv->control) {
+            case BAL_CONTROL_PRESCRIBED:
+                step = bal_walls_step(w, mv->v[0], mv->v[1], mv->omega, s->dt);
+                snprintf(how, sizeof how, "|V| dt + |omega| dt reach, its far end %g from P",
+                         fmax(fabs(w->h1), fabs(w->h2)));
+                break;
+            case BAL_CONTROL_SERVO:
+                if (mv->vmax > 0) { /* vmax = 0: BAL_SERVO_CAP_SHARE of r_min, far below */
+                    step = mv->vmax * s->dt;
+                    snprintf(how, sizeof how, "vmax dt");
+                }
+                if (as_built && other >= 0 && other2 >= 0) {
+                    const double span = bal_walls_gap(&s->walls[other], &s->walls[other2], NULL);
+                    if (!span_ok(s, span))
+                        return bal_error(err, BAL_EINVAL,
+                                         "%s:%d: %s: wall '%s': its span gap(%s, %s) = %g is "
+                                         "below the smallest disc radius %g; expected walls a "
+                                         "disc fits between (the servo's stress is its force "
+                                         "over the span)", sc->path, line, key, mv->wall,
+                                         mv->walls[0], mv->walls[1], span, span_min(s));
+                }
+                break;
+            case BAL_CONTROL_STRAIN_RATE:
+                if (as_built && other >= 0) {
+                    step = fabs(mv->rate) * s->dt * bal_walls_gap(w, &s->walls[other], NULL);
+                    snprintf(how, sizeof how, "|rate| dt gap(%s, %s), the gap %g", mv->wall,
+                             mv->walls[0], bal_walls_gap(w, &s->walls[other], NULL));
+                }
+                break;
+            default:
+                break;
+            }
+            if (step > limit)
+                return bal_error(err, BAL_EINVAL,
+                                 "%s:%d: %s: wall '%s' would move %.6g in one time step (%s, dt "
+                                 "= %g): %.4g of the smallest disc radius %g; expected at most "
+                                 "%g of it (a disc the wall meets gains that much overlap in a "
+                                 "cycle; a wall that moves a diameter passes through discs)",
+                                 sc->path, line, key, mv->wall, step, how, s->dt,
+                                 step / s->r_min, s->r_min, BAL_WALL_STEP_SHARE);
+        }
+    }
+    return BAL_OK;
+}
+
+enum bal_status bal_walls_fault(const struct bal_sim *s, struct bal_error *err)
+{
+    const struct bal_wall *w = &s->walls[s->wall_fault - 1];
+    const struct bal_move_def *mv = w->move;
+    const char *key = mv ? bal_scene_key_for_control(mv->control) : "?";
+    const struct bal_stage_def *st = s->stage >= 0 ? &s->scene->stages[s->stage] : NULL;
+    const int line = mv && mv->line > 0 ? mv->line : st ? st->line : 0;
+    if (s->wall_fault_kind == BAL_WALL_FAULT_SPAN)
+        return bal_error(err, BAL_EUNSTABLE,
+                         "%s: wall '%s' at step %ld: its servo's span gap(%s, %s) = %g has closed "
+                         "below the smallest disc radius %g: no disc fits between those walls "
+                         "(%s:%d: %s)", s->scene->path, w->name, s->step, mv->walls[0],
+                         mv->walls[1],
+                         bal_walls_gap(&s->walls[w->other[0]], &s->walls[w->other[1]], NULL),
+                         span_min(s), s->scene->path, line, key);
+    const double step = bal_walls_step(w, w->v[0], w->v[1], w->omega, s->dt);
+    return bal_error(err, BAL_EUNSTABLE,
+                     "%s: wall '%s' at step %ld: its %s would move it %.6g in one time step, "
+                     "%.4g of the smallest disc radius %g, beyond the limit %g of it (a disc "
+                     "it meets gains that much overlap in a cycle; a wall that moves a "
+                     "diameter passes through discs) (%s:%d: %s)", s->scene->path, w->name, s->step,
+                     w->controller ? w->controller->name : "controller", step, step / s->r_min,
+                     s->r_min, BAL_WALL_STEP_SHARE, s->scene->path, line, key);
 }

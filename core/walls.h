@@ -42,6 +42,29 @@ int bal_walls_check(const struct bal_move_def *mv, char *msg, size_t size);
  * NULL) receives a's unit normal on b's side. */
 double bal_walls_gap(const struct bal_wall *a, const struct bal_wall *b, double toward[2]);
 
+/* How far any point of wall w moves in one time step dt with velocity
+ * (vx, vy) of P and angular velocity omega about P: |V| dt + |ω| dt reach,
+ * reach the farther end's distance from P (a bound: every point of a rigidly
+ * moving segment moves by at most what its farther end moves). */
+double bal_walls_step(const struct bal_wall *w, double vx, double vy, double omega, double dt);
+
+/* What a wall's run-time guard found (state.h: wall_fault_kind). */
+enum bal_wall_fault {
+    BAL_WALL_FAULT_STEP = 1, /* its controller set a step beyond the limit */
+    BAL_WALL_FAULT_SPAN      /* its servo's span closed below the smallest radius */
+};
+/* Once the time step is known (bal_sim_create): refuse, naming FILE:LINE:
+ * KEY of the stage's line, a wall whose step in one cycle would exceed
+ * BAL_WALL_STEP_SHARE of the smallest disc radius (prescribed |V| dt + |ω|
+ * dt reach, servo vmax dt, strain_rate |rate| dt gap), and a servo whose span
+ * is below the smallest disc radius; the last two only where the walls
+ * involved are where the scene put them when the stage begins (no earlier
+ * stage names them).  The run-time guard covers the rest. */
+enum bal_status bal_walls_check_steps(const struct bal_sim *s, struct bal_error *err);
+/* The error of a tripped run-time guard (s->wall_fault): BAL_EUNSTABLE,
+ * naming the wall, the step and the stage's line. */
+enum bal_status bal_walls_fault(const struct bal_sim *s, struct bal_error *err);
+
 /* Stage g begins: each wall it names gets its controller and parameters;
  * the others are at rest, with none. */
 void bal_walls_stage(struct bal_sim *s, const struct bal_stage_def *g);

@@ -678,6 +678,56 @@ START_TEST(integrate_stop_rule_never_met)
 }
 END_TEST
 
+/* No rule of equilibrium is met while nothing touches (issue 29, item 4):
+ * 30 discs 3 diameters apart falling freely under gravity, no contact all
+ * run long, and a servo lid far above them (vmax = 0: 1e-3 of a radius a
+ * cycle, so it never reaches them).  Each rule alone, checked every 10
+ * cycles for 200: ΔF/F is 0/0-like (the largest contact force is 0: it
+ * was 0, met at the first check), the stress moments are all zero (change
+ * over size was 0/0 = 0, met at the second check), the servo's error is 1
+ * with nothing touching (met by stop_servo = 1 at the first check), E_k/E_el
+ * has no elastic energy.  None stops the stage, and each log holds INFINITY
+ * (run.json: null), not a ratio of zero. */
+START_TEST(integrate_stop_rule_nothing_touches)
+{
+    static const char *const rules[] = {"stop_unbalanced = 1e-3", "stop_stress = 1e-3",
+                                        "stop_servo = 1", "stop_ke = 1e9"};
+    for (size_t k = 0; k < sizeof rules / sizeof rules[0]; k++) {
+        char text[T_TEXT_MAX];
+        int len = snprintf(text, sizeof text,
+                           "[settings]\ndt = 1e-3\ngravity = 0 -9.81\n"
+                           "[material m]\nkn = 1e5\ndensity = 2.385\n"
+                           "[wall lid]\np = -5 100\nangle = 0\nh1 = 0\nh2 = 30\nmaterial = m\n"
+                           "[wall left]\np = -10 -50\nangle = 90\nh1 = 0\nh2 = 200\nmaterial = m\n"
+                           "[wall right]\np = 30 -50\nangle = 90\nh1 = 0\nh2 = 200\n"
+                           "material = m\n");
+        for (int d = 0; d < 30; d++)
+            len += snprintf(text + len, sizeof text - (size_t)len,
+                            "[disc d%d]\nx = %d %d\nr = 0.5\nmaterial = m\n", d, 3 * (d % 6),
+                            3 * (d / 6));
+        snprintf(text + len, sizeof text - (size_t)len,
+                 "[stage fall]\ncycles = 200\ncheck_every = 10\n%s\n"
+                 "servo = lid 100 0.5 0 left right\n",
+                 rules[k]);
+        struct tfx *f = tfx_new(text, "free_fall");
+        ck_assert_int_eq(bal_sim_run(f->sim, NULL, NULL, &f->err), BAL_OK);
+        const struct bal_sim *s = f->sim;
+        ck_assert_double_eq(bal_measure_elastic(s), 0.0); /* nothing touched */
+        const struct bal_stage_log *log = &s->log[0];
+        ck_assert_msg(!log->stopped, "%s: stopped at cycle %ld", rules[k], log->cycles);
+        ck_assert_int_eq(log->cycles, 200);
+        ck_assert(isinf(log->ke_over_ee));
+        if (k == 0)
+            ck_assert(isinf(log->unbalanced));
+        if (k == 1)
+            ck_assert(isinf(log->stress_change));
+        if (k == 2)
+            ck_assert(isinf(log->servo_error));
+        tfx_release(f);
+    }
+}
+END_TEST
+
 /* A stage with cycles = 0 is skipped: no cycle, no check of its stop rule,
  * its ramp and wall motion never applied (log: 0 cycles, not stopped, the
  * measures −1 = never checked).  The next stage then runs at full gravity
@@ -1328,6 +1378,7 @@ Suite *suite_integrate(void)
     tcase_add_test(tc, integrate_stop_rule);
     tcase_add_test(tc, integrate_stop_rule_per_stage);
     tcase_add_test(tc, integrate_stop_rule_never_met);
+    tcase_add_test(tc, integrate_stop_rule_nothing_touches);
     tcase_add_test(tc, integrate_stage_zero_cycles_skipped);
     suite_add_tcase(s, tc);
 

@@ -155,9 +155,13 @@ START_TEST(rolling_dashpot)
     P.gamma_n = 0.7;
     const struct bal_roll R = bal_law_roll_of(&L, R1);
     const double thetadot = -0.37;
-    ASSERT_REL(bal_law_rolling_dashpot(&P, &L, R, 1e-3, thetadot),
+    ASSERT_REL(bal_law_rolling_dashpot(&P, &L, R, 1e-3, thetadot, BAL_PAIR_TOUCHING),
                (3.1 + 0.7) * R.b * R.b / 12 * thetadot);
     ASSERT_REL(bal_law_rolling_energy(R, 0.02), 0.02 * 0.02 / (2 * R.km));
+    /* Model 2 once broken: the width B is gone, and μ_m = μ_n B²/12 with it */
+    ck_assert_double_eq(bal_law_rolling_dashpot(&P, &L, R, 1e-3, thetadot,
+                                                BAL_PAIR_TOUCHING | BAL_PAIR_BROKEN),
+                        0.0);
 }
 END_TEST
 
@@ -372,7 +376,8 @@ START_TEST(rolling_energy_ledger)
         struct bal_energy e;
         bal_energy_report(f->sim, &e);
         ck_assert_msg(e.relative < 0.01, "%s: relative imbalance %g", models[k], e.relative);
-        /* measured: 1.3e3 (Model 1) and 3.5e2 (Model 2) of 9e3-1e4 of gravity's work */
+        /* measured: 1.3e3 (Model 1) and 4.5e2 (Model 2; 3.5e2 while a lost contact kept its
+         * rolling dashpot) of 9e3-1.1e4 of gravity's work */
         ck_assert_msg(e.dissipated_rolling > 0.01 * e.work_gravity, "%s: rolling loss %g",
                       models[k], e.dissipated_rolling);
         /* the rolling springs hold some of E_el: the ledger without them is off */
@@ -420,6 +425,93 @@ START_TEST(rolling_elastic_returns_energy)
 }
 END_TEST
 
+/* A broken Model 2 contact has no rolling moment of either kind (issue 29,
+ * item 8): JYH's Model 2 is the "abrupt disappearance of contact width"
+ * (Sec. 3.1), and the rolling dashpot μ_m = μ_n B²/12 (eq. 49c) is the
+ * normal dashpots spread over that width (eqs 44–47): it goes with B.  With
+ * contact damping on (β = 1e-5, as JYH's biaxial material):
+ *   - on a wall: a disc rolling without slip on a floor (v = 1, ω = −v/r),
+ *     resting at its equilibrium overlap δ = m g/k_n.  Its relative rotation
+ *     ω Δt = 2e-4 a cycle passes θ_r⁰ = 2 F_n/(k_n B) = 2 δ/B ≈ 9.6e-5 in the
+ *     first cycle, so the contact breaks before its spring holds anything;
+ *     the contact point does not slip (ṡ = −v − ω r = 0 exactly, t = (−1, 0)),
+ *     so nothing else acts along the floor and v and ω stay what they were.
+ *     With the dashpot kept, M_d = μ_m ω = 0.43 slowed it by 0.7 m/s²;
+ *   - between discs: a free disc resting on a held one (frictionless, so no
+ *     shear force), spinning at 0.1: elastic for about 20 cycles (θ_r⁰ =
+ *     2 δ/B with B = 1.6 × 0.5), then broken; from then on no couple acts on
+ *     it and its spin is constant.
+ * "To round-off": 1e-12 of the value (the spins are carried exactly; only
+ * the vertical balance of spring and gravity rounds). */
+START_TEST(rolling_model2_broken_has_no_dashpot)
+{
+    const double r = 0.5, rho = 1, kn = 1e5, g = 9.81, dt = 1e-4;
+    const double m = rho * BAL_PI * r * r, delta = m * g / kn;
+    struct tfx *f = tfx_newf(
+        "broken_wall",
+        "[settings]\ndt = %.17g\ngravity = 0 %.17g\nbeta = 1e-5\nnormal_law = power\nnu = 1\n"
+        "delta0 = 1\nrolling_model = model2\n"
+        "[material g]\nkn = %.17g\ndensity = %.17g\nfriction = 0.5\nrolling = 1.6\n"
+        "[disc d]\nx = 0 %.17g\nr = %.17g\nv = 1 0\nomega = -2\nmaterial = g\n"
+        "[wall floor]\np = -50 0\nangle = 0\nh1 = 0\nh2 = 100\nmaterial = g\n"
+        "[stage s]\ncycles = 2000\n"
+        "[probe st]\nquantity = contact_rolling\na = d\nb = floor\n",
+        dt, -g, kn, rho, r - delta, r);
+    t_steps(f, 1);
+    ck_assert_double_eq(t_probe_value(f, "st"), 2); /* broken in the first cycle */
+    t_steps(f, 1999);
+    const struct bal_sim *s = f->sim;
+    const int d = t_slot(f, "d");
+    ck_assert_double_eq(t_probe_value(f, "st"), 2);
+    ck_assert_msg(fabs(s->vx[d] - 1) <= 1e-12, "v = %.17g after 2000 cycles", s->vx[d]);
+    ck_assert_msg(fabs(s->w[d] + 2) <= 2e-12, "omega = %.17g after 2000 cycles", s->w[d]);
+    const struct bal_pairs *p;
+    const long c = t_contact(f, "d", "floor", &p);
+    ck_assert(p->flags[c] & BAL_PAIR_TOUCHING);
+    ck_assert_double_eq(p->mr[c], 0);
+    ck_assert_double_eq(bal_measure_rolling_dashpot(s, p, c), 0);
+    tfx_release(f);
+
+    f = tfx_newf(
+        "broken_pair",
+        "[settings]\ndt = %.17g\ngravity = 0 %.17g\nbeta = 1e-5\nnormal_law = power\nnu = 1\n"
+        "delta0 = 1\nrolling_model = model2\n"
+        "[material g]\nkn = %.17g\ndensity = %.17g\nrolling = 1.6\n"
+        "[disc h]\nx = 0 0\nr = %.17g\nmaterial = g\nfixed = 1\n"
+        "[disc a]\nx = 0 %.17g\nr = %.17g\nomega = 0.1\nmaterial = g\n"
+        "[stage s]\ncycles = 2000\n"
+        "[probe st]\nquantity = contact_rolling\na = a\nb = h\n"
+        "[probe mr]\nquantity = contact_mr\na = a\nb = h\n",
+        dt, -g, kn, rho, r, 2 * r - delta, r);
+    s = f->sim;
+    const int a = t_slot(f, "a");
+    long broke = -1;
+    for (long n = 1; n <= 400 && broke < 0; n++) {
+        t_steps(f, 1);
+        if (t_probe_value(f, "st") == 2)
+            broke = n;
+    }
+    /* The spring and the disc's inertia: θ_r = (ω0/Ω) sin Ω t with
+     * Ω = sqrt(K_m/I), K_m = k_n B²/12; it reaches θ_r⁰ at
+     * t = asin(θ_r⁰ Ω/ω0)/Ω (about 20 cycles, ω then ω0 cos Ω t ≈ 0.09). */
+    const double b = 1.6 * r, km = kn * b * b / 12, om = sqrt(km / (m * r * r / 2));
+    const double t_break = asin(2 * delta / b * om / 0.1) / om;
+    ck_assert_msg(fabs((double)broke - t_break / dt) <= 1, "broke at cycle %ld, expected %.1f",
+                  broke, t_break / dt);
+    const double w_broken = s->w[a];
+    /* within what the spin changes in one cycle, ω0 Ω Δt, of the continuous form */
+    ck_assert_double_eq_tol(w_broken, 0.1 * cos(om * t_break), 0.1 * om * dt);
+    t_steps(f, 2000);
+    ck_assert_msg(fabs(s->w[a] - w_broken) <= 1e-12 * w_broken,
+                  "omega %.17g after the break, %.17g 2000 cycles later", w_broken, s->w[a]);
+    ck_assert_double_eq(t_probe_value(f, "st"), 2);
+    ck_assert_double_eq(t_probe_value(f, "mr"), 0);
+    const long cc = t_contact(f, "a", "h", &p);
+    ck_assert(p->flags[cc] & BAL_PAIR_TOUCHING);
+    ck_assert_double_eq(bal_measure_rolling_dashpot(s, p, cc), 0);
+}
+END_TEST
+
 Suite *suite_rolling(void)
 {
     Suite *s = suite_create("rolling");
@@ -438,6 +530,7 @@ Suite *suite_rolling(void)
     tcase_add_test(tc, rolling_zero_is_plain_bit_for_bit);
     tcase_add_test(tc, rolling_energy_ledger);
     tcase_add_test(tc, rolling_elastic_returns_energy);
+    tcase_add_test(tc, rolling_model2_broken_has_no_dashpot);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -780,6 +780,34 @@ static const struct bad_scene bad_scenes[] = {
      "bad:34: stop_servo: -0.01 is out of range"},
     {"stop_unbalanced out of range", BOX_STAGE "stop_unbalanced = -1\n", 'p',
      "bad:34: stop_unbalanced: -1 is out of range"},
+    /* Issue 29, items 5 and 6 (walls.c, bal_walls_check_steps): a wall that
+     * would move more than a tenth of the smallest radius (0.5) in a cycle,
+     * and a servo whose span walls leave no room for a disc (below the
+     * smallest radius 0.5).
+     * The box's lid (y = 1, 4 long) is line 14, the stage's line 34; dt =
+     * 1e-3 (the estimate is 6.1e-3). */
+    {"a prescribed wall that passes the discs in one step",
+     BOX_STAGE "move = top 0 -1e6 0\n[settings]\ndt = 1e-3\n", 'c',
+     "bad:34: move: wall 'top' would move 1000 in one time step"},
+    {"a prescribed turn whose far end passes the discs in one step",
+     BOX_STAGE "move = top 0 0 30\n[settings]\ndt = 1e-3\n", 'c',
+     "bad:34: move: wall 'top' would move 0.12 in one time step (|V| dt + |omega| dt reach"},
+    {"a servo whose cap passes the discs in one step",
+     BOX_STAGE "servo = top 100 0.5 1e6 left right\n[settings]\ndt = 1e-3\n", 'c',
+     "bad:34: servo: wall 'top' would move 1000 in one time step (vmax dt"},
+    {"a strain rate whose first step is beyond a tenth of a radius",
+     BOX_STAGE "strain_rate = top 60 bottom\n[settings]\ndt = 1e-3\n", 'c',
+     "bad:34: strain_rate: wall 'top' would move 0.12 in one time step"},
+    {"a servo whose span walls are on one line",
+     BOX "[wall s1]\np = 0 5\nangle = 90\nh1 = 0\nh2 = 1\nmaterial = m\n"
+     "[wall s2]\np = 1e-16 5\nangle = 90\nh1 = 0\nh2 = 1\nmaterial = m\n" HEAD
+     "[stage s]\ncycles = 3\nservo = top 100 0.5 0 s1 s2\n", 'c',
+     "bad:46: servo: wall 'top': its span gap(s1, s2) = "},
+    {"a servo whose span walls are one wall",
+     BOX "[wall s1]\np = 0 5\nangle = 90\nh1 = 0\nh2 = 1\nmaterial = m\n"
+     "[wall s2]\np = 0 5\nangle = 90\nh1 = 0\nh2 = 1\nmaterial = m\n" HEAD
+     "[stage s]\ncycles = 3\nservo = top 100 0.5 0 s1 s2\n", 'c',
+     "bad:46: servo: wall 'top': its span gap(s1, s2) = 0 is below the smallest disc radius 0.5"},
 };
 
 /* What the refusals let through: touching bodies, two held discs that

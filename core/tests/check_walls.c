@@ -16,6 +16,7 @@
  * for a normal force on the interior the two give the same moment.)
  */
 #include <math.h>
+#include <stdlib.h>
 #include <stdio.h>
 
 #include "check_main.h"
@@ -398,7 +399,10 @@ END_TEST
  * v Δt to F_n: the error e_N = σ_t − F_n/L obeys e_{N+1} = (1 − α) e_N
  * exactly in real arithmetic.  Checked for α = 0.3 (monotone), 1 (gone in
  * one cycle) and 1.7 (alternating, decaying), the wall above and below the
- * disc (it moves towards the disc when the stress is below the target). */
+ * disc (it moves towards the disc when the stress is below the target).
+ * The cap vmax = 50 is never reached (the fastest move asked for is
+ * 1.7 × 339 × 3/(k_n Δt) = 24) and keeps within the step limit of a tenth
+ * of the radius a cycle (100; it was 1e9, which is now refused). */
 START_TEST(walls_servo_gain)
 {
     const double kn = 7.3e4, sigma = 351.5, span = 3, dt = 1e-3, push = 0.013;
@@ -414,7 +418,7 @@ START_TEST(walls_servo_gain)
                 "[wall l]\np = -1.5 -5\nangle = 90\nh1 = 0\nh2 = 10\nmaterial = m\n"
                 "[wall r]\np = 1.5 -5\nangle = 90\nh1 = 0\nh2 = 10\nmaterial = m\n"
                 "[stage press]\ncycles = 40\nmove = w 0 %.17g 0\n"
-                "[stage hold]\ncycles = 30\nservo = w %.17g %.17g 1e9 l r\n",
+                "[stage hold]\ncycles = 30\nservo = w %.17g %.17g 50 l r\n",
                 dt, kn, y, above ? -push : push, sigma, gains[g]);
             struct bal_sim *s = f->sim;
             struct bal_wall *w = &s->walls[0];
@@ -690,6 +694,130 @@ START_TEST(walls_strain_rate)
 }
 END_TEST
 
+/* ------------------------------------------------------------------ */
+/* Guards: a wall that would outrun the discs, a servo's span (issue 29) */
+/* ------------------------------------------------------------------ */
+
+/* A lid 8 above a floor, two discs between (radii 0.5, the smallest: a
+ * limit of 0.05 a cycle, and 0.9), two short upright walls l, r 7 apart
+ * above the lid (out of the discs' way), the lid moved by `line` (line 40)
+ * in a stage of 10 cycles at dt = 1e-3. */
+static enum bal_status lid_scene(struct tfx **out, const char *line)
+{
+    char text[T_TEXT_MAX];
+    snprintf(text, sizeof text,
+             "[settings]\ndt = 1e-3\n[material m]\nkn = 1e5\ndensity = 1\n"
+             "[disc d]\nx = 0 0\nr = 0.5\nmaterial = m\n[disc e]\nx = 3 0\nr = 0.9\nmaterial = m\n"
+             "[wall floor]\np = -2 -4\nangle = 0\nh1 = 0\nh2 = 6\nmaterial = m\n"
+             "[wall lid]\np = -2 4\nangle = 0\nh1 = -1\nh2 = 6\nmaterial = m\n"
+             "[wall l]\np = -2 5\nangle = 90\nh1 = 0\nh2 = 2\nmaterial = m\n"
+             "[wall r]\np = 5 5\nangle = 90\nh1 = 0\nh2 = 2\nmaterial = m\n"
+             "[stage s]\ncycles = 10\n%s\n", line);
+    *out = tfx_parse(text, "lid");
+    (*out)->sc.settings.force_dt = 1;
+    return tfx_create(*out);
+}
+
+/* The stated limit, BAL_WALL_STEP_SHARE = 0.1 of the smallest radius (0.5)
+ * per cycle: each kind of line a little below it runs, a little above it is
+ * refused when the simulation is built, naming the line and its key.
+ * Prescribed: |V| dt + |ω| dt × 6 (the lid's far end, h2 = 6 from P);
+ * servo: vmax dt; strain rate: |rate| dt × the gap 8 to the floor. */
+START_TEST(walls_step_limit)
+{
+    static const struct {
+        const char *below, *above, *key;
+    } lines[] = {
+        {"move = lid 0 -49 0", "move = lid 0 -51 0", "move"},
+        {"move = lid 0 0 8.3", "move = lid 0 0 8.4", "move"},        /* 0.0498, 0.0504 */
+        {"move = lid 30 -30 0", "move = lid 36 -36 0", "move"},      /* 0.0424, 0.0509 */
+        {"servo = lid 100 0.5 49 l r", "servo = lid 100 0.5 51 l r", "servo"},
+        {"strain_rate = lid 6 floor", "strain_rate = lid 6.4 floor", "strain_rate"}, /* 0.048, 0.0512 */
+        /* away: the gap, and the step, grow 0.5 % a cycle (10 cycles: 0.042) */
+        {"strain_rate = lid -5 floor", "strain_rate = lid -6.4 floor", "strain_rate"},
+    };
+    for (size_t k = 0; k < sizeof lines / sizeof lines[0]; k++) {
+        struct tfx *f;
+        ck_assert_msg(lid_scene(&f, lines[k].below) == BAL_OK, "'%s' refused: %s", lines[k].below,
+                      f->err.msg);
+        ck_assert_int_eq(bal_sim_run(f->sim, NULL, NULL, &f->err), BAL_OK);
+        tfx_release(f);
+        ck_assert_msg(lid_scene(&f, lines[k].above) == BAL_EINVAL, "'%s' accepted",
+                      lines[k].above);
+        char where[64];
+        snprintf(where, sizeof where, "lid:40: %s: wall 'lid' would move ", lines[k].key);
+        ck_assert_msg(t_contains(f->err.msg, where), "'%s': %s", lines[k].above, f->err.msg);
+        ck_assert_msg(t_contains(f->err.msg, "expected at most 0.1 of it"), "%s", f->err.msg);
+        tfx_release(f);
+    }
+}
+END_TEST
+
+/* What the check at creation cannot see, the run-time guard stops before
+ * the wall moves, naming the wall and its line (BAL_EUNSTABLE: exit 1):
+ *   - a strain rate that moves away (rate < 0) widens the gap, and its step
+ *     rate dt gap with it: from 8 at 1e-3 × 2 = 0.016 a cycle the gap grows
+ *     by 1 + |rate| dt a cycle and passes 25 (a step of 0.05) after
+ *     ln(25/8)/ln(1.002) = 570.3 cycles; the lid's last move is within the
+ *     limit, the one it would make next beyond it;
+ *   - a strain rate in a later stage, its lid moved by the stage before (so
+ *     not "as built"): 60 × 1e-3 × 7.99 = 0.48 a cycle, stopped at the
+ *     stage's first cycle with the lid where the first stage left it. */
+START_TEST(walls_step_guard_at_run_time)
+{
+    struct tfx *f;
+    ck_assert_int_eq(lid_scene(&f, "strain_rate = lid -2 floor"), BAL_OK);
+    f->sim->log[0].max_cycles = 2000;
+    ck_assert_int_eq(bal_sim_run(f->sim, NULL, NULL, &f->err), BAL_EUNSTABLE);
+    ck_assert_msg(t_contains(f->err.msg, "lid: wall 'lid' at step ") &&
+                      t_contains(f->err.msg, "its strain_rate would move it") &&
+                      t_contains(f->err.msg, "(lid:40: strain_rate)"),
+                  "%s", f->err.msg);
+    const double limit = 0.1 * 0.5, rate_dt = 2e-3;
+    ck_assert_msg(labs(f->sim->step - 571) <= 1, "stopped at step %ld", f->sim->step);
+    const double gap = f->sim->walls[1].p[1] - f->sim->walls[0].p[1];
+    ck_assert_double_gt(rate_dt * gap, limit);                /* the next move */
+    ck_assert_double_le(rate_dt * gap / (1 + rate_dt), limit); /* the last one */
+    tfx_release(f);
+
+    char two[256];
+    snprintf(two, sizeof two, "move = lid 0 -1 0\n[stage fast]\ncycles = 10\n"
+                              "strain_rate = lid 60 floor");
+    ck_assert_int_eq(lid_scene(&f, two), BAL_OK);
+    ck_assert_int_eq(bal_sim_run(f->sim, NULL, NULL, &f->err), BAL_EUNSTABLE);
+    ck_assert_msg(t_contains(f->err.msg, "wall 'lid' at step 10: its strain_rate") &&
+                      t_contains(f->err.msg, "(lid:43: strain_rate)"),
+                  "%s", f->err.msg);
+    ck_assert_int_eq(f->sim->step, 10);
+    ck_assert_int_eq(f->sim->log[1].cycles, 0);
+    ck_assert_double_eq_tol(f->sim->walls[1].p[1], 4 - 10 * 1e-3, 1e-12);
+}
+END_TEST
+
+/* A servo's span that closes during the run (issue 29, item 6): the lid's
+ * servo bears on the span between l and r, and in the same stage l moves
+ * towards r at 10 (1e-2 a cycle, within the step limit) from a gap of 7:
+ * once the gap is below the smallest radius 0.5 (after 650 cycles: 7 − 650
+ * × 1e-2 = 0.5, so at cycle 651) the run stops, naming the servo's wall and
+ * the span, before the stress force/span grows without bound. */
+START_TEST(walls_servo_span_closes)
+{
+    struct tfx *f;
+    ck_assert_int_eq(lid_scene(&f, "servo = lid 100 0.5 0 l r\nmove = l 10 0 0"), BAL_OK);
+    f->sim->log[0].max_cycles = 700;
+    ck_assert_int_eq(bal_sim_run(f->sim, NULL, NULL, &f->err), BAL_EUNSTABLE);
+    ck_assert_msg(t_contains(f->err.msg, "wall 'lid' at step ") &&
+                      t_contains(f->err.msg, "its servo's span gap(l, r) = ") &&
+                      t_contains(f->err.msg, "below the smallest disc radius 0.5") &&
+                      t_contains(f->err.msg, "(lid:40: servo)"),
+                  "%s", f->err.msg);
+    ck_assert_msg(labs(f->sim->step - 651) <= 1, "stopped at step %ld", f->sim->step);
+    const double span = bal_walls_gap(&f->sim->walls[2], &f->sim->walls[3], NULL);
+    ck_assert_double_lt(span, 0.5);
+    ck_assert_double_ge(span, 0.5 - 1e-2 - 1e-9);
+}
+END_TEST
+
 Suite *suite_walls(void)
 {
     Suite *s = suite_create("walls");
@@ -719,6 +847,9 @@ Suite *suite_walls(void)
     tcase_add_test(tc, walls_probes);
     tcase_add_test(tc, walls_servo_stop_rule);
     tcase_add_test(tc, walls_strain_rate);
+    tcase_add_test(tc, walls_step_limit);
+    tcase_add_test(tc, walls_step_guard_at_run_time);
+    tcase_add_test(tc, walls_servo_span_closes);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -23,6 +23,11 @@
  * the simulation for its caller to free whole.  All memory a run needs is
  * reserved here, or, for neighbour lists that outgrow their first size, in
  * a rebuild: the cycle never allocates.
+ *
+ * Kept whole (about 650 lines): the steps are one sequence, each reading
+ * what the one before made and leaving a half-built simulation for
+ * bal_sim_create to free; split, the order and that cleanup contract would
+ * be spread over files.  The discs themselves are laid out in specimen.c.
  */
 #include <float.h>
 #include <math.h>

@@ -42,7 +42,7 @@
  * generator is its section in the key table (scene_keys.c) and its struct,
  * one row there and its lay function here.
  *
- * Kept as one file (about 700 lines): the lay functions and the table that
+ * Kept as one file (about 790 lines): the lay functions and the table that
  * walks them are one responsibility, scene order, and the table needs every
  * lay function beside it; the grading curve's maths, which needs none of
  * it, is grading.c.

@@ -224,7 +224,7 @@ struct bal_pile_def {
  * size, with diameters from a grading curve given by area ("percent finer"
  * by area in 2D): the share of the discs' area in discs of diameter <= d is
  * 0, 0.1, 0.5, 0.6, 1 at dmin, d10, d50, d60, dmax, linear in between
- * (specimen.c); with box = 1, four walls NAME_bottom/_right/_top/_left on
+ * (grading.c; specimen.c places them); with box = 1, four walls NAME_bottom/_right/_top/_left on
  * the rectangle's sides, each reaching `overhang` beyond the corners. */
 struct bal_grains_def {
     char name[BAL_NAME_MAX];

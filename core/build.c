@@ -23,6 +23,11 @@
  * the simulation for its caller to free whole.  All memory a run needs is
  * reserved here, or, for neighbour lists that outgrow their first size, in
  * a rebuild: the cycle never allocates.
+ *
+ * Kept whole (about 650 lines): the steps are one sequence, each reading
+ * what the one before made and leaving a half-built simulation for
+ * bal_sim_create to free; split, the order and that cleanup contract would
+ * be spread over files.  The discs themselves are laid out in specimen.c.
  */
 #include <float.h>
 #include <math.h>
@@ -73,29 +78,8 @@ enum bal_status bal_build_settings(struct bal_sim *s, const struct bal_scene *sc
     const long n_total = bal_specimen_count(sc);
     if (n_total > BAL_MAX_DISCS) {
         /* The generator that passes the limit, for its line. */
-        long seen = sc->n_discs;
         char where[BAL_NAME_MAX + 600];
-        snprintf(where, sizeof where, "%s", sc->path);
-        for (int f = 0; f < sc->n_fills && seen <= BAL_MAX_DISCS; f++)
-            if ((seen += sc->fills[f].n) > BAL_MAX_DISCS)
-                snprintf(where, sizeof where, "%s:%d: n: [fill %s]", sc->path,
-                         sc->fills[f].key_line[bal_scene_key_index(BAL_SEC_FILL, "n")],
-                         sc->fills[f].name);
-        for (int p = 0; p < sc->n_piles && seen <= BAL_MAX_DISCS; p++)
-            if ((seen += bal_specimen_pile_count(&sc->piles[p])) > BAL_MAX_DISCS)
-                snprintf(where, sizeof where, "%s:%d: L: [pile %s]", sc->path,
-                         sc->piles[p].key_line[bal_scene_key_index(BAL_SEC_PILE, "L")],
-                         sc->piles[p].name);
-        for (int g = 0; g < sc->n_grains && seen <= BAL_MAX_DISCS; g++)
-            if ((seen += sc->grains[g].n) > BAL_MAX_DISCS)
-                snprintf(where, sizeof where, "%s:%d: n: [grains %s]", sc->path,
-                         sc->grains[g].key_line[bal_scene_key_index(BAL_SEC_GRAINS, "n")],
-                         sc->grains[g].name);
-        for (int i = 0; i < sc->n_imports && seen <= BAL_MAX_DISCS; i++)
-            if ((seen += sc->imports[i].n) > BAL_MAX_DISCS)
-                snprintf(where, sizeof where, "%s:%d: discs: [import %s]", sc->path,
-                         sc->imports[i].key_line[bal_scene_key_index(BAL_SEC_IMPORT, "discs")],
-                         sc->imports[i].name);
+        bal_specimen_count_origin(sc, BAL_MAX_DISCS, where, sizeof where);
         return bal_error(err, BAL_EINVAL, "%s: the scene has %ld discs; at most %ld", where,
                          n_total, BAL_MAX_DISCS);
     }

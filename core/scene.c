@@ -19,6 +19,11 @@
  * line by line; bal_scene_validate() then checks what needs the whole file
  * (scene_validate.c).  Every message names the file, the line and the key
  * and says what was expected.
+ *
+ * Kept whole (about 800 lines): storage of the sections, the value parsers,
+ * the name index and the line parser serve one reader, the text → struct
+ * step, which the file and --set paths share; the key table (scene_keys.c)
+ * and the whole-scene checks (scene_validate.c) are already apart.
  */
 #include <ctype.h>
 #include <errno.h>

@@ -15,41 +15,37 @@
  *           height where it touches the row below (struct bal_pile_def);
  *           with size_spread > 0, discs of random diameters on the same
  *           lattice (MLH Sec. 4.4; lay_pile_spread below).
- *   [grains] n discs from a grading curve, placed at random without
- *           overlap in a rectangle (below);
+ *   [grains] n discs from a grading curve (grading.c), placed at random
+ *           without overlap in a rectangle (lay_grains below);
  *   [import] the discs of a discs.tsv a run wrote, unchanged (read when the
  *           scene was parsed: import.c).
  *
- * The grading curve of [grains] is "percent finer" by area (in 2D, the
- * discs' area stands for the sieve's mass): F(d), the share of the discs'
- * area in discs of diameter <= d, is 0, 0.1, 0.5, 0.6, 1 at dmin, d10, d50,
- * d60, dmax and linear in between.  Diameters are drawn by number: a disc
- * of diameter d has area ∝ d², so the number density is n(d) ∝ F'(d)/d².
- * On a piece [a, b] of the curve with rise ΔF, F' = ΔF/(b − a) and the
- * piece holds the share ∝ ΔF/(b − a) ∫_a^b d⁻² dd = ΔF/(a b) of the
- * discs (also for a = b: a step of F, ΔF/a² discs of diameter a); within
- * it the number CDF is (1/a − 1/d)/(1/a − 1/b), inverted in closed form:
- *   d = 1 / (1/a − u (1/a − 1/b)),  u uniform in [0, 1).
- * One uniform picks the piece, one the diameter within it.  The numbers
- * come from GSL's gsl_rng_mt19937 seeded with the section's seed (the same
- * discs on every machine): first two per disc for the diameters, then two
- * per try for the places.  The discs are placed largest first (random
- * sequential addition: each at a uniform random place inside the region,
- * kept if it overlaps no disc placed before, tried up to `tries` times; a
- * cell grid of side dmax finds the neighbours), and numbered in that order.
- * Random sequential addition jams near an area fraction of 0.55 (equal
- * discs), so a dense specimen is placed loose in a tall region and then
- * compressed by its walls (the servo of walls.c).
+ * [grains] draws its numbers from GSL's gsl_rng_mt19937 seeded with the
+ * section's seed (the same discs on every machine): first two per disc for
+ * the diameters (bal_specimen_grading_diameter), then two per try for the
+ * places.  The discs are placed largest first (random sequential addition:
+ * each at a uniform random place inside the region, kept if it overlaps no
+ * disc placed before, tried up to `tries` times; a cell grid of side dmax
+ * finds the neighbours), and numbered in that order.  Random sequential
+ * addition jams near an area fraction of 0.55 (equal discs), so a dense
+ * specimen is placed loose in a tall region and then compressed by its
+ * walls (the servo of walls.c).
  *
  * Scene order — [disc] sections first, then each [fill], [pile], [grains]
  * and [import], each kind in file order — is the disc's stable id: outputs
- * are written in it, and messages name a disc by it.  The functions at the
- * end turn an id back into a name (FILL.k) and into the scene line that
- * placed the disc.
+ * are written in it, and messages name a disc by it.  The table
+ * `generators` near the end holds one row per generator kind (its section,
+ * count, lay function, the keys its messages name, its material, its
+ * random numbers); the count, the layout and the functions that turn an id
+ * back into a name (FILL.k), a probe's NAME.k into an id and an id into the
+ * scene line that placed the disc walk that table and name no kind.  A new
+ * generator is its section in the key table (scene_keys.c) and its struct,
+ * one row there and its lay function here.
  *
- * A new generator is a section in the key table, a count in
- * bal_specimen_count, a lay_* function called from bal_specimen_generate,
- * and its branch in the name and origin functions.
+ * Kept as one file (about 790 lines): the lay functions and the table that
+ * walks them are one responsibility, scene order, and the table needs every
+ * lay function beside it; the grading curve's maths, which needs none of
+ * it, is grading.c.
  */
 #include <math.h>
 #include <stdio.h>
@@ -88,20 +84,6 @@ long bal_specimen_pile_count(const struct bal_pile_def *p)
     long n = 0;
     for (long M = 0; pile_row_count(p, M) > 0; M++)
         n += pile_row_count(p, M);
-    return n;
-}
-
-long bal_specimen_count(const struct bal_scene *sc)
-{
-    long n = sc->n_discs;
-    for (int f = 0; f < sc->n_fills; f++)
-        n += sc->fills[f].n;
-    for (int p = 0; p < sc->n_piles; p++)
-        n += bal_specimen_pile_count(&sc->piles[p]);
-    for (int g = 0; g < sc->n_grains; g++)
-        n += sc->grains[g].n;
-    for (int i = 0; i < sc->n_imports; i++)
-        n += sc->imports[i].n;
     return n;
 }
 
@@ -148,8 +130,12 @@ static int lay_discs(const struct bal_scene *sc, struct bal_specimen *d, int k)
 }
 
 /* A [fill] lattice from index k on; returns the index after the last disc. */
-static int lay_fill(const struct bal_fill_def *fd, int mat, struct bal_specimen *d, int k)
+static int lay_fill(const struct bal_scene *sc, const void *section, int mat,
+                    struct bal_specimen *d, int k, struct bal_error *err)
 {
+    (void)sc;
+    (void)err; /* a lattice allocates nothing and cannot fail */
+    const struct bal_fill_def *fd = section;
     uint64_t rng = (uint64_t)fd->seed;
     const double pitch = 2 * fd->rmax;
     for (long q = 0; q < fd->n; q++, k++) {
@@ -168,9 +154,9 @@ static int lay_fill(const struct bal_fill_def *fd, int mat, struct bal_specimen 
     return k;
 }
 
-/* Lay out a pile (struct bal_pile_def documents the rules) into the arrays
- * from index k on; returns the index after the last disc. */
-static int lay_pile(const struct bal_pile_def *p, int mat, struct bal_specimen *d, int k)
+/* Lay out a pile of equal discs (struct bal_pile_def documents the rules)
+ * into the arrays from index k on; returns the index after the last disc. */
+static int lay_pile_equal(const struct bal_pile_def *p, int mat, struct bal_specimen *d, int k)
 {
     const double dd = p->d, r = 0.5 * dd;
     const double s0 = p->bottom == 1 ? dd * (1 + p->c) : dd;
@@ -238,7 +224,7 @@ static int lay_pile(const struct bal_pile_def *p, int mat, struct bal_specimen *
  *                 (separate_row), then the row at the lowest height where no
  *                 disc of it overlaps a disc below, as for equal discs.  With
  *                 equal discs no constraint binds and this is lay_pile's
- *                 layout; lay_pile itself still lays size_spread = 0, so the
+ *                 layout; lay_pile_equal still lays size_spread = 0, so the
  *                 monodisperse piles are unchanged bit for bit.
  *
  * The pile's base width and its x0 in run.json stay those of the
@@ -342,104 +328,22 @@ static int lay_pile_spread(const struct bal_pile_def *p, int mat, struct bal_spe
     return k;
 }
 
-/* The grading curve's points: diameters and shares finer by area. */
-static void grading_points(const struct bal_grains_def *g, double d[5], double F[5])
+/* A [pile]: equal discs, or with size_spread > 0 random diameters; returns
+ * the index after the last disc, or -1 with err filled. */
+static int lay_pile(const struct bal_scene *sc, const void *section, int mat,
+                    struct bal_specimen *d, int k, struct bal_error *err)
 {
-    const double dd[5] = {g->dmin, g->d10, g->d50, g->d60, g->dmax};
-    const double FF[5] = {0, 0.1, 0.5, 0.6, 1};
-    memcpy(d, dd, sizeof dd);
-    memcpy(F, FF, sizeof FF);
+    const struct bal_pile_def *p = section;
+    k = p->size_spread > 0 ? lay_pile_spread(p, mat, d, k) : lay_pile_equal(p, mat, d, k);
+    if (k < 0)
+        bal_error(err, BAL_ENOMEM, "%s:%d: [pile %s]: out of memory for its layout", sc->path,
+                  p->line, p->name);
+    return k;
 }
 
-double bal_specimen_grading_diameter(const struct bal_grains_def *g, double u1, double u2)
-{
-    double d[5], F[5], w[4], total = 0;
-    grading_points(g, d, F);
-    for (int k = 0; k < 4; k++) {
-        w[k] = (F[k + 1] - F[k]) / (d[k] * d[k + 1]); /* its share of the discs, by number */
-        total += w[k];
-    }
-    /* the piece: the first whose cumulative share passes u1 (the last, for
-     * a u1 that rounding carries past them all) */
-    int k = 0;
-    for (double acc = w[0] / total; k < 3 && !(u1 < acc); acc += w[++k] / total)
-        ;
-    const double a = d[k], b = d[k + 1];
-    if (!(b > a))
-        return a;
-    const double dia = 1 / (1 / a - u2 * (1 / a - 1 / b));
-    return dia < a ? a : dia > b ? b : dia; /* rounding at the ends */
-}
-
-double bal_specimen_grading_finer(const struct bal_grains_def *g, double dia)
-{
-    double d[5], F[5];
-    grading_points(g, d, F);
-    if (dia < d[0])
-        return 0;
-    for (int k = 0; k < 4; k++)
-        if (dia < d[k + 1])
-            return F[k] + (F[k + 1] - F[k]) * (dia - d[k]) / (d[k + 1] - d[k]);
-    return 1;
-}
-
-/* The spacing of doubles at a position of a [grains] region may be at most
- * this share of the smallest radius: an overlap of 1e-3 of the radius (a
- * stiff contact) is then resolved to 1e-3 of itself, and discs placed at
- * random are placed apart.  At origin = 1e300 the spacing is 1.5e284 and
- * every disc landed on the same point. */
-#define GRAINS_POSITION_RESOLUTION 1e-6
-
-int bal_specimen_grains_check(const struct bal_grains_def *g, const char **key, char *why,
-                              size_t size)
-{
-    const double r_min = 0.5 * g->dmin;
-    for (int a = 0; a < 2; a++) {
-        /* The side of the region farther from 0, where the doubles are
-         * widest apart. */
-        const double end = g->origin[a] + g->size[a];
-        const double far = fabs(end) > fabs(g->origin[a]) ? end : g->origin[a];
-        const double spacing = nextafter(fabs(far), INFINITY) - fabs(far);
-        const double at_origin = nextafter(fabs(g->origin[a]), INFINITY) - fabs(g->origin[a]);
-        if (spacing <= GRAINS_POSITION_RESOLUTION * r_min)
-            continue;
-        /* the origin's doing unless the origin alone is fine */
-        *key = at_origin <= GRAINS_POSITION_RESOLUTION * r_min ? "size" : "origin";
-        if (!isfinite(end))
-            snprintf(why, size, "[grains %s]: the region's far side %s = origin + size is "
-                     "beyond the largest double; expected a region nearer 0", g->name,
-                     a ? "y" : "x");
-        else
-            snprintf(why, size, "[grains %s]: the region reaches %s = %s, where doubles are "
-                     "%s apart, more than %g of the smallest radius dmin/2 = %s: positions "
-                     "there lose their precision (the discs would be placed on top of each "
-                     "other); expected a region nearer 0 or larger discs", g->name,
-                     a ? "y" : "x", BAL_NUM(far), BAL_NUM(spacing),
-                     GRAINS_POSITION_RESOLUTION, BAL_NUM(r_min));
-        return 1;
-    }
-    /* n discs of radius r_i >= r_min inside the region, apart: shrunk to
-     * r_min about their centres they still are, with the centres in the
-     * (size_x - dmin) x (size_y - dmin) rectangle at distances >= dmin.
-     * Oler's inequality (1961) bounds such a set of points: n <= (2/sqrt 3)
-     * A/dmin^2 + P/(2 dmin) + 1 (A, P the rectangle's area and perimeter),
-     * which is below n_max = 2 size_x size_y / (sqrt 3 dmin^2), the
-     * hexagonal packing fraction pi/(2 sqrt 3) of the region's area over
-     * the area of a disc of diameter dmin: n <= n_max for any grading (by
-     * at least 0.15 of a disc, far above the rounding of n_max up to
-     * n = 1e8).  (Random sequential addition jams long before, near 0.55.) */
-    const double n_max = 2 * g->size[0] * g->size[1] / (sqrt(3.0) * g->dmin * g->dmin);
-    if ((double)g->n > n_max) {
-        *key = "n";
-        snprintf(why, size, "[grains %s]: %ld discs of diameter >= dmin = %s cannot lie apart "
-                 "in the region %s x %s: at most %.0f can (the densest packing, hexagonal, "
-                 "covers pi/(2 sqrt 3) of the area: n <= 2 size_x size_y / (sqrt 3 dmin^2)); "
-                 "expected fewer discs or a larger region", g->name, g->n, BAL_NUM(g->dmin),
-                 BAL_NUM(g->size[0]), BAL_NUM(g->size[1]), floor(n_max));
-        return 1;
-    }
-    return 0;
-}
+/* ------------------------------------------------------------------ */
+/* Random placement from a grading curve (the curve itself: grading.c)  */
+/* ------------------------------------------------------------------ */
 
 static int descending(const void *a, const void *b)
 {
@@ -449,9 +353,10 @@ static int descending(const void *a, const void *b)
 
 /* A [grains] specimen (the file's header) from index k on; returns the index
  * after the last disc, or -1 with err filled. */
-static int lay_grains(const struct bal_scene *sc, const struct bal_grains_def *g, int mat,
+static int lay_grains(const struct bal_scene *sc, const void *section, int mat,
                       struct bal_specimen *d, int k, struct bal_error *err)
 {
+    const struct bal_grains_def *g = section;
     const long n = g->n;
     gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
     double *dia = malloc((size_t)n * sizeof *dia);
@@ -555,8 +460,12 @@ static int lay_grains(const struct bal_scene *sc, const struct bal_grains_def *g
 
 /* The discs of an [import] from index k on; returns the index after the
  * last. */
-static int lay_import(const struct bal_import_def *m, int mat, struct bal_specimen *d, int k)
+static int lay_import(const struct bal_scene *sc, const void *section, int mat,
+                      struct bal_specimen *d, int k, struct bal_error *err)
 {
+    (void)sc;
+    (void)err; /* the discs were read with the scene */
+    const struct bal_import_def *m = section;
     for (long q = 0; q < m->n; q++, k++) {
         const double *row = m->disc_data + q * BAL_IMPORT_COLUMNS;
         d->x[k] = row[BAL_IMPORT_X];
@@ -574,6 +483,143 @@ static int lay_import(const struct bal_import_def *m, int mat, struct bal_specim
         d->mat[k] = mat;
     }
     return k;
+}
+
+/* ------------------------------------------------------------------ */
+/* The generators                                                      */
+/* ------------------------------------------------------------------ */
+
+static long fill_count(const void *section)
+{
+    return ((const struct bal_fill_def *)section)->n;
+}
+
+static long pile_count(const void *section)
+{
+    return bal_specimen_pile_count(section);
+}
+
+static long grains_count(const void *section)
+{
+    return ((const struct bal_grains_def *)section)->n;
+}
+
+static long import_count(const void *section)
+{
+    return ((const struct bal_import_def *)section)->n;
+}
+
+/* " (line N of FILE)": the data file's line of disc k of an [import]. */
+static void import_detail(const void *section, long k, char *buf, size_t size)
+{
+    const struct bal_import_def *m = section;
+    snprintf(buf, size, " (line %d of %s)", m->disc_row[k], m->discs);
+}
+
+/* One generator kind: everything the walk from scene order back to the
+ * scene, the count and the layout need, so that none of them names a kind.
+ * Its sections are items of the scene's section arrays (bal_scene_section),
+ * which start with their name and header line and end with BAL_SECTION_TAIL. */
+struct generator {
+    enum bal_section_kind kind;
+    /* discs one section makes */
+    long (*count)(const void *section);
+    /* lay the section's discs from index k on with material index mat; the
+     * index after the last, or -1 with err filled */
+    int (*lay)(const struct bal_scene *sc, const void *section, int mat, struct bal_specimen *d,
+               int k, struct bal_error *err);
+    /* the key a message names for each enum bal_disc_prop of a disc it made
+     * (place, size, speed, spin), and the key that sets the count */
+    const char *prop_key[4];
+    const char *count_key;
+    size_t material;          /* offsetof the material's name in the section struct */
+    const char *rng;          /* the random numbers it draws (docs only) */
+    /* appended to a disc's origin, or NULL */
+    void (*origin_detail)(const void *section, long k, char *buf, size_t size);
+};
+
+/* The generators in scene order: after the [disc] sections (one disc each,
+ * not a generator), each row's sections in file order.  A new generator is
+ * its section in the key table (scene_keys.c) and its struct (ballast.h),
+ * one row here and its lay function.
+ *
+ * Two random-number generators, kept because the outputs must stay byte for
+ * byte: [fill] has drawn from SplitMix64 since it was written, [pile]'s
+ * size_spread and [grains] from GSL's mt19937.  Either stream is part of
+ * the catalogue's outputs (the dense benchmark is a [fill]; the polydisperse
+ * piles and the biaxial specimens are the others), so moving a generator to
+ * the other family would change every disc it lays.  Both are seeded by the
+ * section alone and give the same numbers on every machine. */
+static const struct generator generators[] = {
+    {BAL_SEC_FILL, fill_count, lay_fill, {"origin", "rmin", "vmax", "vmax"}, "n",
+     offsetof(struct bal_fill_def, material), "SplitMix64 (seed)", NULL},
+    {BAL_SEC_PILE, pile_count, lay_pile, {"origin", "d", "d", "d"}, "L",
+     offsetof(struct bal_pile_def, material), "gsl_rng_mt19937 (seed), with size_spread > 0",
+     NULL},
+    {BAL_SEC_GRAINS, grains_count, lay_grains, {"origin", "dmin", "n", "n"}, "n",
+     offsetof(struct bal_grains_def, material), "gsl_rng_mt19937 (seed)", NULL},
+    {BAL_SEC_IMPORT, import_count, lay_import, {"discs", "discs", "discs", "discs"}, "discs",
+     offsetof(struct bal_import_def, material), "none (the file's discs)", import_detail},
+};
+
+#define N_GENERATORS ((int)(sizeof generators / sizeof generators[0]))
+
+/* Where a disc of scene order id comes from: section `section` of
+ * generators[gen], its disc k; or gen = -1 for the [disc] section `section`
+ * (k = 0), or section = -1 past the last disc. */
+struct disc_place {
+    int gen;
+    int section;
+    long k;
+};
+
+static struct disc_place locate(const struct bal_scene *sc, long id)
+{
+    if (id < sc->n_discs)
+        return (struct disc_place){-1, (int)id, 0};
+    long k = id - sc->n_discs;
+    for (int g = 0; g < N_GENERATORS; g++) {
+        const int n_sec = bal_scene_count(sc, generators[g].kind);
+        for (int q = 0; q < n_sec; q++) {
+            const long n = generators[g].count(bal_scene_section(sc, generators[g].kind, q));
+            if (k < n)
+                return (struct disc_place){g, q, k};
+            k -= n;
+        }
+    }
+    return (struct disc_place){-1, -1, 0};
+}
+
+/* The line of key `key` of a section, or its header line when the key was
+ * left at its default (or given by --set). */
+static int key_line_of(void *item, enum bal_section_kind kind, const char *key)
+{
+    const int ki = bal_scene_key_index(kind, key);
+    const int line = ki >= 0 ? bal_scene_item_key_line(item, kind)[ki] : 0;
+    return line > 0 ? line : *bal_scene_item_line(item);
+}
+
+long bal_specimen_count(const struct bal_scene *sc)
+{
+    long n = sc->n_discs;
+    for (int g = 0; g < N_GENERATORS; g++)
+        for (int q = 0; q < bal_scene_count(sc, generators[g].kind); q++)
+            n += generators[g].count(bal_scene_section(sc, generators[g].kind, q));
+    return n;
+}
+
+void bal_specimen_count_origin(const struct bal_scene *sc, long limit, char *buf, size_t size)
+{
+    snprintf(buf, size, "%s", sc->path);
+    if (limit < sc->n_discs)
+        return;
+    const struct disc_place at = locate(sc, limit);
+    if (at.gen < 0)
+        return;
+    const struct generator *gen = &generators[at.gen];
+    void *item = bal_scene_section(sc, gen->kind, at.section);
+    snprintf(buf, size, "%s:%d: %s: [%s %s]", sc->path, key_line_of(item, gen->kind, gen->count_key),
+             gen->count_key, bal_scene_sections[gen->kind].name, bal_scene_item_name(item));
 }
 
 static double *alloc_doubles(size_t n, int *ok)
@@ -604,26 +650,16 @@ enum bal_status bal_specimen_generate(const struct bal_scene *sc, int n, struct 
     for (int i = 0; i < n; i++)
         d->row[i] = -1;
     int k = lay_discs(sc, d, 0);
-    for (int f = 0; f < sc->n_fills; f++)
-        k = lay_fill(&sc->fills[f], bal_scene_find(sc, BAL_SEC_MATERIAL, sc->fills[f].material),
-                     d, k);
-    for (int p = 0; p < sc->n_piles; p++) {
-        const struct bal_pile_def *pd = &sc->piles[p];
-        const int mat = bal_scene_find(sc, BAL_SEC_MATERIAL, pd->material);
-        k = pd->size_spread > 0 ? lay_pile_spread(pd, mat, d, k) : lay_pile(pd, mat, d, k);
-        if (k < 0)
-            return bal_error(err, BAL_ENOMEM, "%s:%d: [pile %s]: out of memory for its layout",
-                             sc->path, pd->line, pd->name);
+    for (int g = 0; g < N_GENERATORS; g++) {
+        const struct generator *gen = &generators[g];
+        for (int q = 0; q < bal_scene_count(sc, gen->kind); q++) {
+            const void *item = bal_scene_section(sc, gen->kind, q);
+            const int mat = bal_scene_find(sc, BAL_SEC_MATERIAL, (const char *)item + gen->material);
+            k = gen->lay(sc, item, mat, d, k, err);
+            if (k < 0)
+                return err->code;
+        }
     }
-    for (int g = 0; g < sc->n_grains; g++) {
-        k = lay_grains(sc, &sc->grains[g],
-                       bal_scene_find(sc, BAL_SEC_MATERIAL, sc->grains[g].material), d, k, err);
-        if (k < 0)
-            return err->code;
-    }
-    for (int i = 0; i < sc->n_imports; i++)
-        k = lay_import(&sc->imports[i],
-                       bal_scene_find(sc, BAL_SEC_MATERIAL, sc->imports[i].material), d, k);
     return BAL_OK;
 }
 
@@ -648,41 +684,15 @@ void bal_specimen_free(struct bal_specimen *d)
 
 void bal_specimen_disc_name(const struct bal_scene *sc, int id, char *buf, size_t size)
 {
-    if (id < sc->n_discs) {
-        snprintf(buf, size, "%s", sc->discs[id].name);
-        return;
-    }
-    long k = id - sc->n_discs;
-    for (int f = 0; f < sc->n_fills; f++) {
-        if (k < sc->fills[f].n) {
-            snprintf(buf, size, "%s.%ld", sc->fills[f].name, k);
-            return;
-        }
-        k -= sc->fills[f].n;
-    }
-    for (int p = 0; p < sc->n_piles; p++) {
-        const long n = bal_specimen_pile_count(&sc->piles[p]);
-        if (k < n) {
-            snprintf(buf, size, "%s.%ld", sc->piles[p].name, k);
-            return;
-        }
-        k -= n;
-    }
-    for (int g = 0; g < sc->n_grains; g++) {
-        if (k < sc->grains[g].n) {
-            snprintf(buf, size, "%s.%ld", sc->grains[g].name, k);
-            return;
-        }
-        k -= sc->grains[g].n;
-    }
-    for (int i = 0; i < sc->n_imports; i++) {
-        if (k < sc->imports[i].n) {
-            snprintf(buf, size, "%s.%ld", sc->imports[i].name, k);
-            return;
-        }
-        k -= sc->imports[i].n;
-    }
-    snprintf(buf, size, "?%d", id);
+    const struct disc_place at = locate(sc, id);
+    if (at.section < 0)
+        snprintf(buf, size, "?%d", id);
+    else if (at.gen < 0)
+        snprintf(buf, size, "%s", sc->discs[at.section].name);
+    else
+        snprintf(buf, size, "%s.%ld",
+                 bal_scene_item_name(bal_scene_section(sc, generators[at.gen].kind, at.section)),
+                 at.k);
 }
 
 long bal_specimen_find_disc(const struct bal_scene *sc, const char *name, char *why, size_t size)
@@ -702,20 +712,17 @@ long bal_specimen_find_disc(const struct bal_scene *sc, const char *name, char *
     const long k = strtol(dot + 1, &end, 10);
     long first = sc->n_discs, found = -1, count = 0;
     const char *kind = NULL, *also = NULL;
-    for (int pass = 0; pass < 4; pass++) {
-        const int n_sec = pass == 0 ? sc->n_fills : pass == 1 ? sc->n_piles
-                        : pass == 2 ? sc->n_grains : sc->n_imports;
-        for (int q = 0; q < n_sec; q++) {
-            const char *nm = pass == 0 ? sc->fills[q].name : pass == 1 ? sc->piles[q].name
-                           : pass == 2 ? sc->grains[q].name : sc->imports[q].name;
-            const long n = pass == 0 ? sc->fills[q].n : pass == 1 ? bal_specimen_pile_count(&sc->piles[q])
-                         : pass == 2 ? sc->grains[q].n : sc->imports[q].n;
-            const char *kd = pass == 0 ? "fill" : pass == 1 ? "pile" : pass == 2 ? "grains" : "import";
+    for (int g = 0; g < N_GENERATORS; g++) {
+        const enum bal_section_kind sec = generators[g].kind;
+        for (int q = 0; q < bal_scene_count(sc, sec); q++) {
+            void *item = bal_scene_section(sc, sec, q);
+            const char *nm = bal_scene_item_name(item);
+            const long n = generators[g].count(item);
             if (strlen(nm) == len && strncmp(nm, name, len) == 0) {
                 if (kind)
-                    also = kd;
+                    also = bal_scene_sections[sec].name;
                 else {
-                    kind = kd;
+                    kind = bal_scene_sections[sec].name;
                     found = first;
                     count = n;
                 }
@@ -724,9 +731,15 @@ long bal_specimen_find_disc(const struct bal_scene *sc, const char *name, char *
         }
     }
     if (!kind) {
+        /* "[fill], [pile], [grains] or [import]": the table's kinds */
+        char kinds[256] = "";
+        size_t used = 0;
+        for (int g = 0; g < N_GENERATORS && used < sizeof kinds; g++)
+            used += (size_t)snprintf(kinds + used, sizeof kinds - used, "%s[%s]",
+                                     g == 0 ? "" : g == N_GENERATORS - 1 ? " or " : ", ",
+                                     bal_scene_sections[generators[g].kind].name);
         snprintf(why, size, "no disc or wall named '%s' (NAME.k names the k-th disc of the "
-                 "generator NAME: no [fill], [pile], [grains] or [import] is named '%s')", name,
-                 gen);
+                 "generator NAME: no %s is named '%s')", name, kinds, gen);
         return -1;
     }
     if (also) {
@@ -745,72 +758,30 @@ long bal_specimen_find_disc(const struct bal_scene *sc, const char *name, char *
 void bal_specimen_disc_origin(const struct bal_scene *sc, int id, enum bal_disc_prop prop,
                               char *buf, size_t size)
 {
-    /* The key of each property in a [disc], a [fill] and a [pile] section. */
-    static const char *const keys[][3] = {
-        [BAL_DISC_PLACE] = {"x", "origin", "origin"},
-        [BAL_DISC_SIZE] = {"r", "rmin", "d"},
-        [BAL_DISC_SPEED] = {"v", "vmax", "d"},
-        [BAL_DISC_SPIN] = {"omega", "vmax", "d"},
+    /* The key of each property in a [disc] section (the generators': their rows). */
+    static const char *const disc_keys[] = {
+        [BAL_DISC_PLACE] = "x", [BAL_DISC_SIZE] = "r", [BAL_DISC_SPEED] = "v",
+        [BAL_DISC_SPIN] = "omega",
     };
-    if (id < sc->n_discs) {
-        const struct bal_disc_def *d = &sc->discs[id];
-        const char *key = keys[prop][0];
-        const int ki = bal_scene_key_index(BAL_SEC_DISC, key);
-        const int line = ki >= 0 && d->key_line[ki] > 0 ? d->key_line[ki] : d->line;
-        snprintf(buf, size, "%s:%d: %s: disc %s", sc->path, line, key, d->name);
+    const struct disc_place at = locate(sc, id);
+    if (at.section < 0) {
+        snprintf(buf, size, "%s: disc %d", sc->path, id);
         return;
     }
-    long k = id - sc->n_discs;
-    for (int f = 0; f < sc->n_fills; f++, k -= sc->fills[f - 1].n) {
-        const struct bal_fill_def *fd = &sc->fills[f];
-        if (k >= fd->n)
-            continue;
-        const char *key = keys[prop][1];
-        const int ki = bal_scene_key_index(BAL_SEC_FILL, key);
-        const int line = ki >= 0 && fd->key_line[ki] > 0 ? fd->key_line[ki] : fd->line;
-        snprintf(buf, size, "%s:%d: %s: disc %s.%ld of [fill %s]", sc->path, line, key, fd->name,
-                 k, fd->name);
+    if (at.gen < 0) {
+        struct bal_disc_def *d = &sc->discs[at.section];
+        const char *key = disc_keys[prop];
+        snprintf(buf, size, "%s:%d: %s: disc %s", sc->path, key_line_of(d, BAL_SEC_DISC, key),
+                 key, d->name);
         return;
     }
-    for (int p = 0; p < sc->n_piles; p++) {
-        const struct bal_pile_def *pd = &sc->piles[p];
-        const long n = bal_specimen_pile_count(pd);
-        if (k >= n) {
-            k -= n;
-            continue;
-        }
-        const char *key = keys[prop][2];
-        const int ki = bal_scene_key_index(BAL_SEC_PILE, key);
-        const int line = ki >= 0 && pd->key_line[ki] > 0 ? pd->key_line[ki] : pd->line;
-        snprintf(buf, size, "%s:%d: %s: disc %s.%ld of [pile %s]", sc->path, line, key, pd->name,
-                 k, pd->name);
-        return;
-    }
-    for (int g = 0; g < sc->n_grains; g++) {
-        const struct bal_grains_def *gd = &sc->grains[g];
-        if (k >= gd->n) {
-            k -= gd->n;
-            continue;
-        }
-        const char *key = prop == BAL_DISC_SIZE ? "dmin" : prop == BAL_DISC_PLACE ? "origin" : "n";
-        const int ki = bal_scene_key_index(BAL_SEC_GRAINS, key);
-        const int line = ki >= 0 && gd->key_line[ki] > 0 ? gd->key_line[ki] : gd->line;
-        snprintf(buf, size, "%s:%d: %s: disc %s.%ld of [grains %s]", sc->path, line, key, gd->name,
-                 k, gd->name);
-        return;
-    }
-    for (int i = 0; i < sc->n_imports; i++) {
-        const struct bal_import_def *m = &sc->imports[i];
-        if (k >= m->n) {
-            k -= m->n;
-            continue;
-        }
-        /* the scene's line of the file, and the file's line of the disc */
-        const int ki = bal_scene_key_index(BAL_SEC_IMPORT, "discs");
-        const int line = ki >= 0 && m->key_line[ki] > 0 ? m->key_line[ki] : m->line;
-        snprintf(buf, size, "%s:%d: discs: disc %s.%ld of [import %s] (line %d of %s)", sc->path,
-                 line, m->name, k, m->name, m->disc_row[k], m->discs);
-        return;
-    }
-    snprintf(buf, size, "%s: disc %d", sc->path, id);
+    const struct generator *gen = &generators[at.gen];
+    void *item = bal_scene_section(sc, gen->kind, at.section);
+    const char *key = gen->prop_key[prop];
+    const char *nm = bal_scene_item_name(item);
+    const int used = snprintf(buf, size, "%s:%d: %s: disc %s.%ld of [%s %s]", sc->path,
+                              key_line_of(item, gen->kind, key), key, nm, at.k,
+                              bal_scene_sections[gen->kind].name, nm);
+    if (gen->origin_detail && used >= 0 && (size_t)used < size)
+        gen->origin_detail(item, at.k, buf + used, size - (size_t)used);
 }

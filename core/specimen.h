@@ -27,6 +27,11 @@ struct bal_specimen {
 /* Discs the scene makes: its [disc] sections and what its generators lay
  * (may exceed BAL_MAX_DISCS: the builder refuses that). */
 long bal_specimen_count(const struct bal_scene *sc);
+/* "FILE:LINE: KEY: [KIND NAME]" of the key that sets the count of the
+ * generator whose discs carry the scene past `limit` discs (the one that
+ * makes disc `limit` in scene order), or FILE alone when none does (for the
+ * builder's message when a scene makes too many discs). */
+void bal_specimen_count_origin(const struct bal_scene *sc, long limit, char *buf, size_t size);
 /* Number of rows and of discs a [pile] generates. */
 long bal_specimen_pile_rows(const struct bal_pile_def *p);
 long bal_specimen_pile_count(const struct bal_pile_def *p);
@@ -38,7 +43,7 @@ void bal_specimen_free(struct bal_specimen *d);
 
 /* The diameter of a [grains] grading curve for the uniforms u1 (which piece
  * of the curve) and u2 (where in it), u1, u2 in [0, 1): the inverse of the
- * number distribution whose area distribution is the curve (specimen.c). */
+ * number distribution whose area distribution is the curve (grading.c). */
 double bal_specimen_grading_diameter(const struct bal_grains_def *g, double u1, double u2);
 /* The curve itself: the share of the area in discs of diameter <= d. */
 double bal_specimen_grading_finer(const struct bal_grains_def *g, double d);
@@ -47,7 +52,7 @@ double bal_specimen_grading_finer(const struct bal_grains_def *g, double d);
  * to blame in *key ("n", "origin" or "size") and why in `why`: more discs
  * of diameter dmin than the densest packing puts in the region, or a
  * region where the spacing of doubles is not small against the smallest
- * radius (specimen.c).  Validation asks it, before anything is drawn. */
+ * radius (grading.c).  Validation asks it, before anything is drawn. */
 int bal_specimen_grains_check(const struct bal_grains_def *g, const char **key, char *why,
                               size_t size);
 

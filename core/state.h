@@ -12,8 +12,9 @@
  * sums the pair loop adds to (force and moment; the dashpots' share) keep a
  * disc's three together, so that in a packing larger than the cache the
  * loop has fewer streams to wait on.  `id[i]` is the disc's index in scene
- * order (discs of [disc] sections first, then those of each [fill] and
- * [pile]: specimen.c); outputs are written in that order.  A re-sort
+ * order (discs of [disc] sections first, then those of each generator in
+ * the order of specimen.c's table: [fill], [pile], [grains], [import]);
+ * outputs are written in that order.  A re-sort
  * renumbers the discs and the keys of the candidate lists with them
  * (new2old).
  *

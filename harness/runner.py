@@ -31,6 +31,10 @@ Killed outright (SIGKILL): every run dies with the harness (harness/children.py)
 the reports lock until it has (harness/lock.py), so a `--resume` at once is safe.  When the
 harness cannot prepare or record a run folder (disk full, read-only), the run fails with
 Outcome.io_error set, its half-written record removed; the command exits with status 3.
+
+Kept whole (about 710 lines): one responsibility, launching runs and recording them, with
+one registry of running processes (Running) that the launch, the interrupt handling, the
+batch and its progress lines share; apart, each piece would reach into the others' state.
 """
 import hashlib
 import json

@@ -165,6 +165,7 @@ int main(void)
     srunner_add_suite(sr, suite_contacts());
     srunner_add_suite(sr, suite_walls());
     srunner_add_suite(sr, suite_integrate());
+    srunner_add_suite(sr, suite_sim());
     srunner_add_suite(sr, suite_timestep());
     srunner_add_suite(sr, suite_grid());
     srunner_add_suite(sr, suite_measure());

@@ -37,6 +37,7 @@ Suite *suite_scene(void);
 Suite *suite_contacts(void);
 Suite *suite_walls(void);
 Suite *suite_integrate(void);
+Suite *suite_sim(void);
 Suite *suite_timestep(void);
 Suite *suite_grid(void);
 Suite *suite_measure(void);

@@ -1,7 +1,11 @@
 """The biaxial family (harness/families/biaxial.py) on synthetic runs with known answers
 (biaxial_fakes.py): stresses, strains against hand values, the start of the shearing, the
 mobilised, peak and residual friction angles, the envelope's slope and intercept, and the
-clear EvalErrors of what cannot be evaluated."""
+clear EvalErrors of what cannot be evaluated.
+
+Kept whole (about 660 lines): the tests of one family module, all on the same fixtures (the
+synthetic store of runs and its expected values); split, those fixtures would move to a
+conftest.py that only these tests read."""
 import json
 import math
 import shutil

@@ -801,3 +801,31 @@ enum bal_status bal_scene_set(struct bal_scene *s, const char *assignment,
         return where_error(err, w, key, "%s", "expected a value after '='");
     return assign(item, (enum bal_section_kind)k, key, value, w, err);
 }
+
+/* ------------------------------------------------------------------ */
+/* Keys that other keys make unused                                    */
+/* ------------------------------------------------------------------ */
+
+/* `ballast info`'s "unused" lines (the rules are scene_keys.c's table), in
+ * the table's order, each section in file
+ * order; the key as --set names it (settings.KEY, KIND.NAME.KEY). */
+void bal_scene_print_unused(const struct bal_scene *s, FILE *out)
+{
+    for (size_t r = 0; r < bal_scene_n_unused; r++) {
+        const struct bal_unused_rule *u = &bal_scene_unused[r];
+        const struct bal_section_info *sec = &bal_scene_sections[u->section];
+        const int ki = bal_scene_key_index(u->section, u->key);
+        if (ki < 0) /* a rule naming no key (check_scene.c tests the table) */
+            continue;
+        for (int i = 0; i < bal_scene_count(s, u->section); i++) {
+            void *item = bal_scene_section(s, u->section, i);
+            if (!(*bal_scene_item_given(item, u->section) & (1u << ki)) || !u->holds(s, item))
+                continue;
+            if (sec->named)
+                fprintf(out, "unused         %s.%s.%s (%s)\n", sec->name, bal_scene_item_name(item),
+                        u->key, u->why);
+            else
+                fprintf(out, "unused         %s.%s (%s)\n", sec->name, u->key, u->why);
+        }
+    }
+}

@@ -14,7 +14,6 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "scene.h"
 #include "scene_keys.h"
 
 #define BIG DBL_MAX
@@ -533,29 +532,6 @@ void bal_scene_print_keys(FILE *out)
             fprintf(out, "| `%s` | %s | %s | %s | %s |\n", key->name, type,
                     key->def ? (*key->def ? key->def : "(none)") : (key->required ? "required" : "(none)"),
                     shown, key->doc);
-        }
-    }
-}
-
-/* `ballast info`'s "unused" lines, in the table's order, each section in file
- * order; the key as --set names it (settings.KEY, KIND.NAME.KEY). */
-void bal_scene_print_unused(const struct bal_scene *s, FILE *out)
-{
-    for (size_t r = 0; r < bal_scene_n_unused; r++) {
-        const struct bal_unused_rule *u = &bal_scene_unused[r];
-        const struct bal_section_info *sec = &bal_scene_sections[u->section];
-        const int ki = bal_scene_key_index(u->section, u->key);
-        if (ki < 0) /* a rule naming no key (check_scene.c tests the table) */
-            continue;
-        for (int i = 0; i < bal_scene_count(s, u->section); i++) {
-            void *item = bal_scene_section(s, u->section, i);
-            if (!(*bal_scene_item_given(item, u->section) & (1u << ki)) || !u->holds(s, item))
-                continue;
-            if (sec->named)
-                fprintf(out, "unused         %s.%s.%s (%s)\n", sec->name, bal_scene_item_name(item),
-                        u->key, u->why);
-            else
-                fprintf(out, "unused         %s.%s (%s)\n", sec->name, u->key, u->why);
         }
     }
 }

@@ -374,7 +374,7 @@ START_TEST(scene_unused_rules_name_keys)
         const struct bal_unused_rule *u = &bal_scene_unused[r];
         ck_assert_msg(bal_scene_key_index(u->section, u->key) >= 0, "rule %zu: no key '%s' in [%s]", r,
                       u->key, bal_scene_sections[u->section].name);
-        ck_assert_ptr_nonnull(u->holds);
+        ck_assert_msg(u->holds != NULL, "rule %zu: no condition", r);
         ck_assert_ptr_nonnull(u->why);
     }
     /* Listed: a key given (in the file or by --set) that a rule holds for,

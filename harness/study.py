@@ -9,7 +9,8 @@ last value of every series.tsv column) in every run, and for each quantity repor
   * d_k = q_{k+1} - q_k, the differences between successive levels;
   * the pairwise observed orders p_k = log(|d_k| / |d_{k+1}|) / log(r), r = 1/f, and the
     least-squares order (slope of log|d_k| against log h_k);
-  * a verdict (thresholds below) and, when it converges, the Richardson limit
+  * a verdict (thresholds below; differences that change sign are never extrapolated:
+    a convergent power law's differences keep one sign) and, when it converges, the Richardson limit
     q* = q_finest + d_last / (r^p - 1) with p the finest pairwise order, and each level's
     error |q_k - q*| / |q*|.
 
@@ -106,6 +107,12 @@ def analyse(hs, qs, factor):
                    text=f"not converging: pairwise orders {listed}; a refinement by {r:g} must cut the "
                         f"difference by at least {r:g}^{P_MIN:g} (order > {P_MIN:g}): noise or chaos, "
                         "no extrapolation")
+        return out
+    if any((a > 0) != (b > 0) for a, b in zip(d, d[1:])):
+        out.update(verdict="asymptotic?",
+                   text=f"not yet in the asymptotic range: the differences change sign (pairwise orders "
+                        f"{listed}): the error is not a smooth power of h here (a phase effect within "
+                        "the step, or noise); no extrapolation")
         return out
     if max(orders) - min(orders) > ORDER_AGREE:
         out.update(verdict="asymptotic?",

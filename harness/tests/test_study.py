@@ -266,3 +266,13 @@ def test_the_analysis_of_exact_power_laws_and_of_noise():
     assert study.advise(hs, noisy, 1e-2) is None
     same = study.analyse(hs, [2.0] * 4, 0.5)
     assert same["verdict"] == "independent"
+
+
+def test_every_expression_function_is_documented_for_users():
+    """docs/your-scene.md lists every function a quantity may call (the language's own and every
+    family's), energy() included."""
+    from harness import expressions
+    text = (REPO / "docs" / "your-scene.md").read_text()
+    names = list(expressions.OWN) + [n for ns in expressions.registered().values() for n in ns]
+    missing = [n for n in names if f"`{n}(" not in text and f" `{n}(" not in text and f"{n}(" not in text]
+    assert not missing, f"undocumented: {missing}"

@@ -106,7 +106,7 @@ def analyse(hs, qs, factor):
         out.update(verdict="not converging",
                    text=f"not converging: pairwise orders {listed}; a refinement by {r:g} must cut the "
                         f"difference by at least {r:g}^{P_MIN:g} (order > {P_MIN:g}): noise or chaos, "
-                        "no extrapolation")
+                        f"no extrapolation; the levels spread over {spread(qs)}")
         return out
     if any((a > 0) != (b > 0) for a, b in zip(d, d[1:])):
         out.update(verdict="asymptotic?",
@@ -125,6 +125,13 @@ def analyse(hs, qs, factor):
     out.update(verdict="converging", order=p, limit=limit, errors=errors,
                text=f"converging at order {p:.3g} (pairwise {listed}; least squares {out['order_lsq']:.3g})")
     return out
+
+
+def spread(qs):
+    """max - min of the levels' values, and relative to the largest |q|: what a user can count on
+    when the quantity does not converge."""
+    width, top = max(qs) - min(qs), max(abs(q) for q in qs)
+    return f"{width:.3g}" + (f" ({width / top:.2g} of |q|)" if top > 0 else "")
 
 
 def advise(hs, analysis, target):

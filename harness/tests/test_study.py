@@ -3,6 +3,7 @@ self-convergence in dt, its advice checked against CLOSED FORMS computed here fr
 (never from ballast's output), a chaotic many-disc scene detected as not converging, and a
 study writing only under its own new folder."""
 import math
+import re
 import os
 import subprocess
 import sys
@@ -276,3 +277,28 @@ def test_every_expression_function_is_documented_for_users():
     names = list(expressions.OWN) + [n for ns in expressions.registered().values() for n in ns]
     missing = [n for n in names if f"`{n}(" not in text and f" `{n}(" not in text and f"{n}(" not in text]
     assert not missing, f"undocumented: {missing}"
+
+
+def page_block(text, name):
+    inner = text.split(f"<!-- {name}: begin -->", 1)[1].split(f"<!-- {name}: end -->", 1)[0]
+    return re.search(r"```[a-z]*\n(.*?)```", inner, re.S).group(1)
+
+
+def seconds_masked(text):
+    return re.sub(r", \S+ s\)", ", - s)", text)
+
+
+def test_the_worked_study_runs_as_the_page_says(tmp_path):
+    """docs/your-scene.md's worked study, run as written (HOME pointed at a temporary folder): its
+    scene, its command, and the lines it quotes (the wall-clock seconds masked)."""
+    text = (REPO / "docs" / "your-scene.md").read_text()
+    (tmp_path / "roll").mkdir()
+    (tmp_path / "roll" / "roll.scene").write_text(page_block(text, "your-scene"))
+    command = page_block(text, "your-scene-command").strip()
+    done = subprocess.run(["sh", "-c", command], cwd=REPO, capture_output=True, text=True, timeout=300,
+                          env={**os.environ, "HOME": str(tmp_path)})
+    assert done.returncode == 0, done.stderr
+    shown = [line for line in done.stdout.splitlines() if re.match(r"^ *last\(", line)]
+    assert seconds_masked("\n".join(shown)) == seconds_masked(page_block(text, "your-scene-output").rstrip("\n")), \
+        "docs/your-scene.md quotes other lines than the study prints: rerun its command and update the page"
+    assert (tmp_path / "roll" / "study" / "study.md").is_file()

@@ -340,6 +340,8 @@ def parser():
     stu.add_argument("--levels", type=int, default=4, help="number of levels (default 4, at least 3)")
     stu.add_argument("--target", type=float, action="append", metavar="REL",
                      help="repeatable: advise the largest h for |q - q*|/|q*| <= REL, and check it by a run")
+    stu.add_argument("--stability", action="store_true",
+                     help="also bisect the largest stable step (stability.py), printed beside the advice")
     stu.add_argument("--out", type=Path, default=None, metavar="DIR",
                      help="the study's folder (default reports/studies/<scene-stem>-<n>, n the next free)")
     _runs(stu)

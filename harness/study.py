@@ -29,7 +29,9 @@ the scene's text; `ballast info` reports only the step).
 
 Outputs go to reports/studies/<scene-stem>-<n>/ (n the next free number) or --out DIR, never
 over an earlier study: runs/<label>/ (one run folder each), study.tsv, study.md and, when
-gnuplot works, error.svg (error against h, log-log; error.gp beside it).  --resume continues
+gnuplot works, error.svg (error against h, log-log; error.gp beside it).  --stability adds
+the largest stable step of the scene at its own settings (stability.py's bisection, its
+trials under stability/), printed beside the estimate and the advised steps.  --resume continues
 an interrupted study in its folder (the newest <scene-stem>-<n>, or --out DIR), keeping every
 complete run of the same identity (runner.py).
 """
@@ -40,7 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import core_info, files
+from . import core_info, files, stability
 from .compare import evaluate
 from .errors import CatalogueError, EvalError, RunProblem
 from .runner import Job, run_all
@@ -266,8 +268,23 @@ def study(args, reports_root, out=sys.stdout):
         if notes[expr]:
             analyses[expr]["text"] += f": {notes[expr]}"
     advice = advice_rows(args, scene, folder, key, extra, hs, quantities, analyses, costs, out)
-    write_outputs(folder, scene, key, hs, quantities, values, analyses, costs, advice, args, out)
+    limit = stability_limit(args, scene, folder, out) if getattr(args, "stability", False) else None
+    write_outputs(folder, scene, key, hs, quantities, values, analyses, costs, advice, args, out, limit)
     return 0
+
+
+def stability_limit(args, scene, folder, out):
+    """The largest stable step of the scene at its own settings, by stability.py's bisection
+    (stages given in cycles or in time keep their simulated time), its trials under
+    folder/stability.  A line of text: the limit beside the estimate."""
+    print("stability: bisecting the largest stable step", file=out)
+    lim = stability.measure_all(args.bin, [stability.Target("study", scene.stem, scene, [])], folder / "stability",
+                                1, out=out, resume=args.resume)[0]
+    if not math.isfinite(lim.limit):
+        return f"stability: not measured ({lim.note or 'no stable step found'})"
+    return (f"stability: largest stable dt {lim.limit * lim.estimate:.6g} = {lim.limit:.4g} x the estimate "
+            f"{lim.estimate:.6g} (first unstable {lim.unstable * lim.estimate:.6g}: {lim.cause or '-'}); "
+            f"the scene's own dt {lim.dt_case:.6g}")
 
 
 def advice_rows(args, scene, folder, key, extra, hs, quantities, analyses, costs, out):
@@ -310,7 +327,7 @@ def num(x, fmt=".6g"):
     return "-" if x is None else format(x, fmt)
 
 
-def write_outputs(folder, scene, key, hs, quantities, values, analyses, costs, advice, args, out):
+def write_outputs(folder, scene, key, hs, quantities, values, analyses, costs, advice, args, out, limit=None):
     lines = ["\t".join(TSV_COLUMNS)]
     for expr in quantities:
         a, qs = analyses[expr], values[expr]
@@ -330,6 +347,8 @@ def write_outputs(folder, scene, key, hs, quantities, values, analyses, costs, a
     if advice:
         files.write_text(folder / "advice.tsv", "\n".join(alines) + "\n")
     text = terminal_table(key, hs, quantities, values, analyses, costs, advice)
+    if limit:
+        text += "\n" + limit
     print(text, file=out)
     figure = draw(folder, key, hs, quantities, analyses)
     md = [f"# Study of {scene.name}", "", f"Scene: `{scene}`. Refined: `{key}` = "

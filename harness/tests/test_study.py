@@ -302,3 +302,19 @@ def test_the_worked_study_runs_as_the_page_says(tmp_path):
     assert seconds_masked("\n".join(shown)) == seconds_masked(page_block(text, "your-scene-output").rstrip("\n")), \
         "docs/your-scene.md quotes other lines than the study prints: rerun its command and update the page"
     assert (tmp_path / "roll" / "study" / "study.md").is_file()
+
+
+def test_stability_is_bisected_beside_the_advice(tmp_path):
+    """--stability on the undamped linear collision (its stage given in time): the largest stable
+    step lies below the leapfrog's bound 2/omega0 (omega0^2 = k/m12: no step past it is stable)
+    and above half of it, and its trials stay in the study's folder."""
+    scene = write_scene(tmp_path, 1, 7000, 0, 2 ** -9)
+    out = tmp_path / "study"
+    done = harness(["study", str(scene), "--out", str(out), "-j", "2", "--quantity", GAP, "--target", "1e-2",
+                    "--stability"])
+    assert done.returncode == 0, done.stderr
+    m = re.search(r"^stability: largest stable dt (\S+) = ", done.stdout, re.M)
+    assert m, done.stdout
+    bound = 2 / math.sqrt(7000 / M12)
+    assert bound / 2 < float(m.group(1)) < bound
+    assert (out / "stability").is_dir() and "stability: largest stable dt" in (out / "study.md").read_text()

@@ -160,9 +160,10 @@ def test_advice_meets_the_closed_form_and_is_not_needlessly_small(name, tmp_path
 
 
 def test_damped_restitution_is_detected_as_not_smooth_in_dt(tmp_path):
-    """The spring-dashpot's restitution: the dashpot force jumps at separation, whose phase within
-    the step changes with dt, so r(dt) is not a smooth power of dt at the steps a 1e-3 target
-    needs: the study must say so (no extrapolation, no advice), not extrapolate a wrong limit."""
+    """The spring-dashpot's restitution is not a smooth power of dt at the steps a 1e-3 target
+    needs (its differences change sign between 2^-14 and 2^-15; likely the dashpot force's jump
+    at separation, at a phase within the step that changes with dt): the study must say so (no
+    extrapolation, no advice), not extrapolate a wrong limit."""
     scene = write_scene(tmp_path, 1, 7000, 40, 2 ** -11)
     out = tmp_path / "study"
     done = harness(["study", str(scene), "--out", str(out), "-j", "2", "--quantity", RESTITUTION,

@@ -1,5 +1,5 @@
 """The command line: python3 -m harness {list,run,check,report,validate,rebaseline,sweep,cost,
-stability,export,job,gather}.
+stability,study,export,job,gather}.
 
 Each command is a small function that loads the catalogue and references, picks the
 cases, and hands over to runner, gate, report or rebaseline.  Exit statuses besides 0 and
@@ -25,6 +25,7 @@ from pathlib import Path
 
 from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_root
 from . import catalogue, export, extremes, files, references, stability
+from . import study as studies
 from . import families  # noqa: F401 -- registers every case family's expression functions
 from . import sweep as sweeps
 from . import sweep_grid
@@ -187,6 +188,14 @@ def cmd_cost(args):
     sweeps.run_declared(selected(args, all_cases), checks, args.bin, args.jobs, runs_root(),
                         reports_root() / "sweeps", sys.stdout, functools.partial(run_all, resume=args.resume))
     return 0
+
+
+def cmd_study(args):
+    """Self-convergence of any scene file, with accuracy advice (study.py); writes under
+    reports/studies/<scene-stem>-<n>/ or --out DIR."""
+    return studies.study(args, reports_root(), sys.stdout)
+
+
 def cmd_export(args):
     """The selected cases' runs as a GNU parallel job list and a Slurm array (export.py)."""
     cases = selected(args, load_cases())
@@ -315,6 +324,27 @@ def parser():
     stab.add_argument("--extremes-only", action="store_true", help="only the probes of cases/extremes")
     stab.add_argument("--no-extremes", action="store_true", help="only the catalogue's limits")
     stab.add_argument("--one-per-case", action="store_true", help="only the first DEM variant of each case")
+    stu = _command(sub, "study", cmd_study,
+                   "run any scene file at a refined key (the step by default), give each quantity's observed "
+                   "order, Richardson limit and error, and advise the step for a target accuracy "
+                   "(docs/your-scene.md)")
+    stu.add_argument("scene", metavar="SCENE", help="a scene file, anywhere (no case needed)")
+    stu.add_argument("--quantity", action="append", metavar="EXPR",
+                     help="repeatable: an expression over the run's outputs (default: the final energies "
+                          "and each series column's last value)")
+    stu.add_argument("--refine", default="settings.dt", metavar="KEY", help="the key refined (default settings.dt)")
+    stu.add_argument("--base", type=float, default=None, metavar="V",
+                     help="the coarsest value of the refined key (default: the scene's step, from ballast info; "
+                          "needed for any other key)")
+    stu.add_argument("--factor", type=float, default=0.5, help="each level's h over the last's (default 0.5)")
+    stu.add_argument("--levels", type=int, default=4, help="number of levels (default 4, at least 3)")
+    stu.add_argument("--target", type=float, action="append", metavar="REL",
+                     help="repeatable: advise the largest h for |q - q*|/|q*| <= REL, and check it by a run")
+    stu.add_argument("--stability", action="store_true",
+                     help="also bisect the largest stable step (stability.py), printed beside the advice")
+    stu.add_argument("--out", type=Path, default=None, metavar="DIR",
+                     help="the study's folder (default reports/studies/<scene-stem>-<n>, n the next free)")
+    _runs(stu)
     exp = _command(sub, "export", cmd_export,
                    "write the selected cases' runs as a GNU parallel job list and a Slurm job-array "
                    "script into DIR (docs/ensembles.md)", writes=False)

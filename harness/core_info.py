@@ -25,7 +25,7 @@ from .errors import CatalogueError
 OUTPUT_LINE = re.compile(r"^output every\s+(\d+) cycles$", re.M)
 STAGE_LINE = re.compile(r"^stage\s+(\S+) (\d+) cycles (\S+) s \((time|cycles)\)$", re.M)
 UNUSED_LINE = re.compile(r"^unused\s+(\S+) \((.*)\)$", re.M)
-NUMBERS = (("estimate", "dt estimate"), ("single", "dt single"), ("dt", "dt used"))
+NUMBERS = (("estimate", "dt estimate"), ("single", "dt single"), ("dt", "dt used"), ("fraction", "dt fraction"))
 QUERY_TIMEOUT = 120      # seconds: `ballast info` builds the scene once (0.5 s for the largest)
 
 
@@ -34,7 +34,7 @@ def command(binary, scene, sets):
 
 
 def parse(text):
-    """{estimate, single, dt: floats (nan when absent), output_every: cycles (None when absent),
+    """{estimate, single, dt, fraction: floats (nan when absent), output_every: cycles (None when absent),
     stages: [(name, cycles, seconds, given_in)], unused: {key: why}} of the output of `ballast info`; a CatalogueError without 'dt used'."""
     values = {}
     for key, name in NUMBERS:

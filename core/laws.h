@@ -37,15 +37,16 @@
  * A kernel takes the contact's kinematics (struct bal_kin), its pair law
  * (struct bal_pair_law) and its own slice of history, and returns a force;
  * it reads no simulation state, so the loop that calls it decides layout,
- * threads and accumulation.  The disc–disc loop (contacts.c) calls it in
+ * threads and accumulation.  The disc–disc loop (pair_loop.c) calls it in
  * variants compiled without the kernels a scene switches off, so a scene
  * without friction or damping never runs their code or touches their
- * history; the disc–wall loop calls every kernel (walls are few).
+ * history; the disc–wall loop (wall_loop.c) calls every kernel (walls are
+ * few).
  *
  * Adding a sub-model: one kernel here (with the stored energy of its spring,
  * if it has one, for the audit), one history column in struct bal_pairs
  * (state.h) with its reserve/merge lines (pairs.c), and one switch: a flag
- * the disc–disc loop is specialised on (PAIR_VARIANT in contacts.c) and the
+ * the disc–disc loop is specialised on (PAIR_VARIANT in pair_loop.c) and the
  * disc–wall loop tests.
  *
  * Sign conventions are those of ballast.h (C&S Figs 2–3): ṅ = (ẋ − ẏ)·e > 0

@@ -8,7 +8,7 @@
  * only when the scene needs it.  The disc–disc list numbers a pair by its
  * discs' array slots (i < j); the disc–wall list by the disc's slot and the
  * wall's index.  Columns grow only in a rebuild (grid.c), never in the
- * contact loops (contacts.c), which read and write them in place.
+ * contact loops (pair_loop.c, wall_loop.c), which read and write them in place.
  *
  * The disc–disc loop runs in chunks of BAL_PAIRS_CHUNK candidates and keeps
  * one friction sum per chunk (struct bal_par); that array is sized with the

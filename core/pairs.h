@@ -10,7 +10,7 @@
 
 #include "state.h"
 
-/* Candidates per chunk of the disc–disc loop (contacts.c), each chunk with
+/* Candidates per chunk of the disc–disc loop (pair_loop.c), each chunk with
  * its own friction sum (par.chunk_sums). */
 #define BAL_PAIRS_CHUNK 256
 

@@ -3,7 +3,7 @@
  * parts, with the few inline helpers that read it.  Every module of the
  * step includes it; it has no functions of its own to call, so it sits
  * below them all.  The behaviour lives in the modules, each with its own
- * header (pairs.h, grid.h, contacts.h, walls.h, integrate.h, ...).  Not
+ * header (pairs.h, grid.h, pair_loop.h, wall_loop.h, walls.h, ...).  Not
  * part of the public API; the Check tests and the benchmark include it.
  *
  * Layout.  Discs are struct-of-arrays in cell order: sorted along a
@@ -99,7 +99,7 @@ struct bal_wall {
     double fn_s_sum;       /* Σ F_n s, s = position of the contact along e from P */
     double dash_f[2], dash_m; /* the contact dashpots' share of f and of the moment about P
                             * (only in damped scenes, and in stages with a controller
-                            * acting every cycle: contacts.c) */
+                            * acting every cycle: wall_loop.c) */
     double disp;           /* largest displacement of any of its points since rebuild */
     double f_prev[2], moment_prev; /* f and moment of the cycle before (energy audit) */
 };
@@ -179,7 +179,7 @@ struct bal_probe_ref {
 };
 
 /* Several threads in one cycle (OpenMP), with results bitwise those of one
- * thread (contacts.c, integrate.c):
+ * thread (pair_loop.c and threads.c, integrate.c):
  * - the disc–disc list is cut into ranges of whole chunks, one per thread.
  *   Range t adds directly to the sums of the discs above zone[t], the
  *   highest j of the ranges before it, which no earlier range touches; what
@@ -204,7 +204,7 @@ struct bal_par {
     struct bal_sum_log *log[BAL_MAX_THREADS];
     long log_n[BAL_MAX_THREADS], log_cap[BAL_MAX_THREADS];
     double *chunk_sums;          /* per chunk of candidates: the friction loss */
-    int32_t *chunk_top;          /* per chunk: its highest j (bal_par_plan, once a list) */
+    int32_t *chunk_top;          /* per chunk: its highest j (bal_threads_plan, once a list) */
     double *chunk_roll;          /* ... and the rolling loss (only with rolling) */
     long chunk_cap;
     double *block_sums;          /* per block of discs, 2 each: a pass's sums (integrate.c) */

@@ -18,7 +18,7 @@
  * wall, as settings.integrator chooses a law of motion).  When the stage
  * begins, `start` takes the parameters of the wall's line; a wall the stage
  * does not name is at rest and has no controller.  In every cycle, once
- * the discs' forces on the walls are known (bal_contacts_walls) and the
+ * the discs' forces on the walls are known (bal_wall_loop_run) and the
  * audit has priced this cycle's wall motion with the velocity it moved with
  * (bal_energy_walls), bal_walls_control lets each controller with a
  * `control` function set its wall's V and ω for the next cycle; the next

@@ -45,7 +45,7 @@ double bal_walls_gap(const struct bal_wall *a, const struct bal_wall *b, double 
 /* Stage g begins: each wall it names gets its controller and parameters;
  * the others are at rest, with none. */
 void bal_walls_stage(struct bal_sim *s, const struct bal_stage_def *g);
-/* After the wall forces of the cycle (bal_contacts_walls) and the audit of
+/* After the wall forces of the cycle (bal_wall_loop_run) and the audit of
  * the walls' work (bal_energy_walls): every controller that acts per cycle
  * sets its wall's velocity for the next cycle. */
 void bal_walls_control(struct bal_sim *s);

@@ -921,7 +921,7 @@ START_TEST(contacts_one_material_law)
 END_TEST
 
 /* The same comparison for the loop that runs two contacts at a time with
- * SSE2 (contacts.c, linear_shear_pairs: power law with nu = 1, tangential
+ * SSE2 (pair_loop.c, linear_shear_pairs: power law with nu = 1, tangential
  * spring, no damping, one material): one material takes it, the twin
  * materials the general scalar loop, and positions, velocities, force
  * sums, every contact's F_n, F_s and flags and the friction loss of the

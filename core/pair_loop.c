@@ -1,10 +1,11 @@
 /*
- * contacts.c — the loops that run the force–displacement law (the kernels of
- * laws.h) at every contact, over the candidate lists of pairs.c (Cundall &
- * Strack eqs 8–19, 24–28; Matuttis, Luding & Herrmann eqs 2–3).
+ * pair_loop.c — the disc–disc loop: the force–displacement law (the kernels
+ * of laws.h) at every contact of the candidate list of pairs.c, once per
+ * cycle, and the table of its variants (Cundall & Strack eqs 8–19, 24–28;
+ * Matuttis, Luding & Herrmann eqs 2–3).  The disc–wall loop is
+ * wall_loop.c's; how the list is shared between threads, threads.c's.
  *
- * For a contact between bodies x and y (x = the lower index; for a disc–wall
- * contact x is the disc and y the wall):
+ * For a contact between discs x and y (x = the lower index):
  *
  *   e  = (y − x)/D, t = (e2, −e1)                          C&S eqs (9)–(10)
  *   ṅ  = (ẋ − ẏ)·e                                          eq. (12)
@@ -33,25 +34,27 @@
  *
  * Velocities are those at t_{N−1/2} (C&S eqs 26–27 note the half step).
  *
- * Both loops compute the kinematics (e, ṅ, ṡ, δ) and call the chain of
- * kernels in laws.h, normal → damping → tangential: the law is written once.
- * The disc–disc loop is compiled in one variant per combination of the
- * normal law and the optional sub-models (MOD_* bits: tangential, damping;
- * PAIR_VARIANT), and one is chosen when the simulation is created, so a
- * scene without friction or damping never runs their code or touches their
- * history.  Within a variant, a scene of one material, and one of one
- * material with the linear power law, get loops of their own (no test of
- * the material or of ν at each contact).
+ * Variants.  The loop is compiled once per combination of the normal law
+ * and the optional sub-models (MOD_* bits: tangential, damping, rolling;
+ * PAIR_VARIANT, twelve in all), and one is chosen when the simulation is
+ * created (bal_pair_loop_select), so a scene without friction or damping
+ * never runs their code or touches their history.  Within a variant, a
+ * scene of one material, and one of one material with the linear power
+ * law, get loops of their own (no test of the material or of ν at each
+ * contact).
  *
- * The disc–disc loop takes the list in chunks of 256 candidates, in three
+ * Passes.  The list is taken in chunks of BAL_PAIRS_CHUNK candidates, three
  * passes each: which candidates touch (no branch on the answer), then D and
  * e of the touching ones two at a time (SSE2: the same IEEE results), then
  * the chain of kernels at each contact, in the list's order, so the force
  * sums add the same terms in the same order as one pass would
- * (docs/benchmarks.md, speed round two).  The commonest law (power law with
- * ν = 1, tangential spring, no damping or rolling, one material) takes its
- * contacts two at a time in the third pass, D and e included
- * (linear_shear_pairs: the kernels' operations lane by lane, the same bits).
+ * (docs/benchmarks.md, speed round two).  The chain is one_contact(), what
+ * a contact adds to the sums add_side().
+ *
+ * Two at a time.  The commonest law (power law with ν = 1, tangential
+ * spring, no damping or rolling, one material) takes its contacts two at a
+ * time in the third pass, D and e included (linear_shear_pairs: the
+ * kernels' operations lane by lane, the same bits).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -60,17 +63,9 @@
 #include <emmintrin.h>
 #endif
 
-#include "contacts.h"
+#include "pair_loop.h"
 #include "pairs.h"
-#include "walls.h"
-
-/* ------------------------------------------------------------------ */
-/* Disc–disc force–displacement law                                    */
-/* ------------------------------------------------------------------ */
-
-/* Candidates per chunk of the pair loop (below; pairs.c sizes the per-chunk
- * sums). */
-#define CLEAR_CHUNK BAL_PAIRS_CHUNK
+#include "threads.h"
 
 /* D = sqrt(D²) and e = (dx, dy)/D of the n touching contacts of a chunk,
  * in place (q holds D², then D; ex, ey hold dx, dy, then e): two contacts
@@ -124,96 +119,137 @@ clear_sums(double *restrict f, float *restrict dsh, int from, int to, const int 
     }
 }
 
-/* ------------------------------------------------------------------ */
-/* Threads                                                             */
-/* ------------------------------------------------------------------ */
-
-/* Ranges shorter than this many chunks are not worth a thread. */
-#define PAR_MIN_CHUNKS 16
-
-/* Chunks of a list of n candidates. */
-static inline long chunks_of(long n) { return (n + CLEAR_CHUNK - 1) / CLEAR_CHUNK; }
-
-static int grow_log(struct bal_par *par, int t, long need)
-{
-    if (need <= par->log_cap[t])
-        return 1;
-    const long cap = need + need / 2 + 64;
-    struct bal_sum_log *q = realloc(par->log[t], (size_t)cap * sizeof *q);
-    if (!q)
-        return 0;
-    par->log[t] = q;
-    par->log_cap[t] = cap;
-    return 1;
-}
-
-/* Cut the disc–disc list into ranges of whole chunks with about as many
- * candidates each, and size what they need: once per list (a rebuild).  If
- * memory runs out, one range (the serial loop needs nothing more than the
- * chunk sums, reserved with the list). */
-void bal_par_plan(struct bal_sim *s)
-{
-    struct bal_par *par = &s->par;
-    const struct bal_pairs *p = &s->pp;
-    const long chunks = chunks_of(p->n);
-    /* Each chunk's highest j, which the loop clears the sums up to: the
-     * list is the same until the next rebuild, so it is found once here
-     * rather than by a scan of the chunk every cycle. */
-    for (long k = 0; k < chunks; k++) {
-        const long c1 = (k + 1) * CLEAR_CHUNK < p->n ? (k + 1) * CLEAR_CHUNK : p->n;
-        int32_t top = -1;
-        for (long c = k * CLEAR_CHUNK; c < c1; c++)
-            top = p->j[c] > top ? p->j[c] : top;
-        par->chunk_top[k] = top;
-    }
-    int ranges = par->threads;
-    if (ranges > chunks / PAR_MIN_CHUNKS)
-        ranges = (int)(chunks / PAR_MIN_CHUNKS);
-    if (ranges < 1)
-        ranges = 1;
-    par->start[0] = 0;
-    for (int t = 1; t < ranges; t++)
-        par->start[t] = chunks * t / ranges * CLEAR_CHUNK;
-    par->start[ranges] = p->n;
-    par->zone[0] = -1;
-    par->planned = s->rebuilds;
-    par->ranges = 1;
-    if (ranges == 1)
-        return; /* no zones, no logs: no pass over the list */
-    int seen = -1; /* the highest j of the ranges so far */
-    for (int t = 0; t < ranges; t++) {
-        const int zone = seen;
-        par->zone[t] = zone;
-        long logged = 0;
-        for (long c = par->start[t]; c < par->start[t + 1]; c++) {
-            logged += (p->i[c] <= zone) + (p->j[c] <= zone);
-            seen = p->j[c] > seen ? p->j[c] : seen;
-        }
-        if (t > 0 && !grow_log(par, t, logged)) {
-            par->start[1] = p->n; /* one range after all */
-            return;
-        }
-    }
-    par->ranges = ranges;
-}
-
-void bal_par_free(struct bal_par *par)
-{
-    for (int t = 0; t < BAL_MAX_THREADS; t++)
-        free(par->log[t]);
-    free(par->chunk_sums);
-    free(par->chunk_top);
-    free(par->chunk_roll);
-    free(par->block_sums);
-    memset(par, 0, sizeof *par);
-}
-
 /* Where a run of chunks left off. */
 struct range_state {
     long c0;     /* the next chunk */
     int cleared; /* the sums of discs 0..cleared are started (or not this range's) */
     int over;    /* an overlap past the sieve */
 };
+
+/* ------------------------------------------------------------------ */
+/* One contact                                                         */
+/* ------------------------------------------------------------------ */
+
+/* What one contact adds to its discs' sums: −(fx, fy) to x's force and
+ * +(fx, fy) to y's (Fig. 3), tqi and tqj to their moments, and the
+ * dashpots' share of each (for the energy audit; float, as s->dash). */
+struct contact_sums {
+    double fx, fy, tqi, tqj;
+    float dfx, dfy, dtqi, dtqj;
+};
+
+/* The chain of laws.h at touching contact c of discs i < j, from its
+ * kinematics (k: δ and ṅ; e = (ex, ey); the relative velocity (rvx, rvy)):
+ * normal → damping → tangential → rolling, each kernel only where the
+ * variant (mods) has it.  Updates the contact's history in place, adds its
+ * losses to *lost_fric and *lost_roll, returns what it adds to the sums. */
+static inline __attribute__((always_inline)) struct contact_sums
+one_contact(const struct bal_law_params *P, const struct bal_pair_law *L, const int mods,
+            struct bal_kin k, long c, int i, int j, double ex, double ey, double rvx, double rvy,
+            const double *restrict r, const double *restrict w, double *restrict pfn,
+            double *restrict pfs, double *restrict pmr, double *restrict ptr,
+            uint8_t *restrict pflags, double *lost_fric, double *lost_roll)
+{
+    const int shear = (mods & MOD_SHEAR) != 0, damp = (mods & MOD_DAMP) != 0;
+    const int roll = (mods & MOD_ROLL) != 0;
+    const double fn = bal_law_normal(P, L, &k, pfn[c]);
+    pfn[c] = fn;
+    double ftn = fn, fts = 0, dn = 0, ds = 0;
+    /* A contact's lost rolling resistance (Model 2) lasts while it does. */
+    uint8_t flags = roll ? (uint8_t)(BAL_PAIR_TOUCHING | (pflags[c] & BAL_PAIR_BROKEN))
+                         : BAL_PAIR_TOUCHING;
+    if (damp) {
+        dn = bal_law_normal_dashpot(P, L, &k);
+        ftn += dn;
+    }
+    if (shear && L->shear) {
+        const double tx = ey, ty = -ex;
+        k.sdot = rvx * tx + rvy * ty - (w[i] * r[i] + w[j] * r[j]);
+        const double fs = bal_law_tangential(P, L, &k, fn, pfs[c], lost_fric, &flags);
+        pfs[c] = fs;
+        fts = fs;
+        if (damp && !(flags & BAL_PAIR_SLIDING)) {
+            ds = bal_law_shear_dashpot(L, &k);
+            fts += ds;
+        }
+    }
+    /* The couple on y, +(M + M_d); on x the opposite (JYH eq. 52). */
+    double mr = 0, md = 0;
+    if (roll && L->rolling > 0) {
+        const struct bal_roll R = bal_law_roll_of(L, bal_law_common_radius(r[i], r[j]));
+        const double wrel = w[i] - w[j];
+        const double dtheta = wrel * P->dt;
+        ptr[c] += dtheta;
+        mr = bal_law_rolling(P, R, fn, dtheta, pmr[c], lost_roll, &flags);
+        pmr[c] = mr;
+        if (damp) {
+            md = bal_law_rolling_dashpot(P, L, R, k.delta, wrel);
+            mr += md;
+        }
+    }
+    pflags[c] = flags;
+    struct contact_sums a;
+    /* Force on y is +(ftn e + fts t); on x the opposite (Fig. 3). */
+    a.fx = ftn * ex + fts * ey;
+    a.fy = ftn * ey - fts * ex;
+    /* The moments on x and y: the shear force's, and the couple. */
+    a.tqi = roll ? fts * r[i] - mr : fts * r[i];
+    a.tqj = roll ? fts * r[j] + mr : fts * r[j];
+    a.dfx = a.dfy = a.dtqi = a.dtqj = 0;
+    if (damp) {
+        /* the dashpots' share, for their work at t_N (energy.c) */
+        a.dfx = (float)(dn * ex + ds * ey);
+        a.dfy = (float)(dn * ey - ds * ex);
+        a.dtqi = (float)(roll ? ds * r[i] - md : ds * r[i]);
+        a.dtqj = (float)(roll ? ds * r[j] + md : ds * r[j]);
+    }
+    return a;
+}
+
+/* Add one side of a contact to disc k's sums: x's (minus: the force
+ * subtracted) or y's.  In a range that logs (a range after the first on
+ * several threads: struct bal_par), a disc of its zone gets a log entry
+ * instead, replayed after the loop (threads.c); a − b is a + (−b) exactly,
+ * so the replay adds the same (but for the sign of a NaN: a run with one
+ * stops anyway). */
+static inline __attribute__((always_inline)) void
+add_side(double *restrict f, float *restrict dsh, int k, const int minus,
+         const struct contact_sums *a, double tq, float dtq, const int mods, const int logged,
+         int zone, struct bal_sum_log *restrict log, long *n_log)
+{
+    const int shear = (mods & MOD_SHEAR) != 0, damp = (mods & MOD_DAMP) != 0;
+    if (logged && k <= zone) {
+        log[(*n_log)++] = minus ? (struct bal_sum_log){-a->fx, -a->fy, tq, -a->dfx, -a->dfy, dtq, k}
+                                : (struct bal_sum_log){a->fx, a->fy, tq, a->dfx, a->dfy, dtq, k};
+        return;
+    }
+    double *restrict fk = f + 3 * (size_t)k;
+    if (minus) {
+        fk[0] -= a->fx;
+        fk[1] -= a->fy;
+    } else {
+        fk[0] += a->fx;
+        fk[1] += a->fy;
+    }
+    if (shear)
+        fk[2] += tq;
+    if (damp) {
+        float *restrict dk = dsh + 3 * (size_t)k;
+        if (minus) {
+            dk[0] -= a->dfx;
+            dk[1] -= a->dfy;
+        } else {
+            dk[0] += a->dfx;
+            dk[1] += a->dfy;
+        }
+        if (shear)
+            dk[2] += dtq;
+    }
+}
+
+/* ------------------------------------------------------------------ */
+/* Two contacts at a time                                              */
+/* ------------------------------------------------------------------ */
 
 #if defined(__SSE2__)
 /* Pass 3 of the commonest loop (linear power law, tangential spring, no
@@ -318,13 +354,17 @@ linear_shear_pairs(struct bal_sim *restrict s, long c0, const int32_t *restrict 
 }
 #endif
 
+/* ------------------------------------------------------------------ */
+/* A range of the list                                                 */
+/* ------------------------------------------------------------------ */
+
 /* A range of the disc–disc list (all of it on one thread; see struct
  * bal_par in state.h for several).  The loop starts the cycle's force sums.
- * It runs in chunks of CLEAR_CHUNK candidates; before a chunk, the sums of
- * every disc up to the chunk's highest j are zeroed (pairs are sorted by i
- * and j > i, so no disc above the highest j seen has been touched yet), the
- * rest at the end.  The sums' lines are then fetched once, by the loop that
- * fills them, and not also by a clearing pass of their own, which in a
+ * It runs in chunks of BAL_PAIRS_CHUNK candidates; before a chunk, the sums
+ * of every disc up to the chunk's highest j are zeroed (pairs are sorted by
+ * i and j > i, so no disc above the highest j seen has been touched yet),
+ * the rest at the end.  The sums' lines are then fetched once, by the loop
+ * that fills them, and not also by a clearing pass of their own, which in a
  * packing larger than the cache cost a trip to memory per line.  The order
  * of the additions is unchanged.  (Clearing inside the per-pair loop, at
  * each new highest j, made the 20 000-disc benchmark 25 % slower: the
@@ -334,10 +374,13 @@ linear_shear_pairs(struct bal_sim *restrict s, long c0, const int32_t *restrict 
  * Range t never writes the sums of the discs up to zone = par.zone[t]
  * directly (the ranges before it clear them, possibly at the same time):
  * it logs what it adds to them (`logged` chunks: those whose first i is in
- * the zone).  The last range clears the sums no candidate reached.  Each chunk's friction loss goes to par.chunk_sums.
+ * the zone; threads.c).  The last range clears the sums no candidate
+ * reached.  Each chunk's friction loss goes to par.chunk_sums.
  *
  * range_chunks: the chunks of range t from st.c0 on, while their first i is
- * in the zone (`logged`), or to the end of the range. */
+ * in the zone (`logged`), or to the end of the range.  Each chunk runs the
+ * three passes of the header; the third is one_contact() and add_side() at
+ * each touching contact, or linear_shear_pairs() where the variant allows. */
 static inline __attribute__((always_inline)) struct range_state
 range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int mods,
              const int logged, const int linear, const int one)
@@ -381,11 +424,18 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
     const int zone = logged ? s->par.zone[t] : -1;
     struct bal_sum_log *restrict log = logged ? s->par.log[t] : NULL;
     long n_log = logged ? s->par.log_n[t] : 0;
+    /* Two at a time: the commonest law, in the chunks that do not log. */
+#if defined(__SSE2__)
+    const int pairs = mods == (MOD_POWER | MOD_SHEAR) && linear && one && !logged &&
+                      one_law->shear;
+#else
+    const int pairs = 0;
+#endif
     int cleared = st.cleared, over = st.over;
     long c0 = st.c0;
-    for (; c0 < end && (!logged || pi[c0] <= zone); c0 += CLEAR_CHUNK) {
-        const long c1 = c0 + CLEAR_CHUNK < pn ? c0 + CLEAR_CHUNK : pn;
-        const int top = chunk_top[c0 / CLEAR_CHUNK];
+    for (; c0 < end && (!logged || pi[c0] <= zone); c0 += BAL_PAIRS_CHUNK) {
+        const long c1 = c0 + BAL_PAIRS_CHUNK < pn ? c0 + BAL_PAIRS_CHUNK : pn;
+        const int top = chunk_top[c0 / BAL_PAIRS_CHUNK];
         if (top > cleared) {
             clear_sums(f, dsh, cleared + 1, top, damp);
             cleared = top;
@@ -394,8 +444,8 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
         /* Pass 1: which candidates touch (eq. 8).  A short loop without
          * branches on the answer; the touching ones are gathered, with
          * their dx, dy and D^2, for the two passes below. */
-        int32_t tc[CLEAR_CHUNK + 1];
-        double tdx[CLEAR_CHUNK + 1], tdy[CLEAR_CHUNK + 1], tq[CLEAR_CHUNK + 1];
+        int32_t tc[BAL_PAIRS_CHUNK + 1];
+        double tdx[BAL_PAIRS_CHUNK + 1], tdy[BAL_PAIRS_CHUNK + 1], tq[BAL_PAIRS_CHUNK + 1];
         int nt = 0;
         for (long c = c0; c < c1; c++) {
             const int i = pi[c], j = pj[c];
@@ -424,15 +474,9 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
             }
         }
         /* Pass 2: D and e of the touching ones, several per instruction
-         * (the pairs of the loop for the commonest law take theirs in
-         * pass 3, and the last one, if odd, here). */
+         * (the contacts taken two at a time take theirs in pass 3, and the
+         * last one, if odd, here). */
         int q0 = 0;
-#if defined(__SSE2__)
-        const int pairs = mods == (MOD_POWER | MOD_SHEAR) && linear && one && !logged &&
-                          one_law->shear;
-#else
-        const int pairs = 0;
-#endif
         if (!pairs)
             unit_vectors(tq, tdx, tdy, nt);
         else if (nt & 1)
@@ -452,118 +496,18 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
             struct bal_kin k;
             k.ndot = rvx * ex + rvy * ey;
             k.delta = rs - dist;
+            k.sdot = 0; /* set by one_contact where the tangential kernel runs */
             over |= k.delta > budget; /* a first sieve; bal_energy_overlap judges each pair */
-
-            /* The chain of laws.h: normal -> damping -> tangential -> rolling. */
-            const double fn = bal_law_normal(&P, L, &k, pfn[c]);
-            pfn[c] = fn;
-            double ftn = fn, fts = 0, dn = 0, ds = 0;
-            /* A contact's lost rolling resistance (Model 2) lasts while it does. */
-            uint8_t flags = roll ? (uint8_t)(BAL_PAIR_TOUCHING | (pflags[c] & BAL_PAIR_BROKEN))
-                                 : BAL_PAIR_TOUCHING;
-            if (damp) {
-                dn = bal_law_normal_dashpot(&P, L, &k);
-                ftn += dn;
-            }
-            if (shear && L->shear) {
-                const double tx = ey, ty = -ex;
-                k.sdot = rvx * tx + rvy * ty - (w[i] * r[i] + w[j] * r[j]);
-                const double fs = bal_law_tangential(&P, L, &k, fn, pfs[c], &lost_fric, &flags);
-                pfs[c] = fs;
-                fts = fs;
-                if (damp && !(flags & BAL_PAIR_SLIDING)) {
-                    ds = bal_law_shear_dashpot(L, &k);
-                    fts += ds;
-                }
-            }
-            /* The couple on y, +(M + M_d); on x the opposite (JYH eq. 52). */
-            double mr = 0, md = 0;
-            if (roll && L->rolling > 0) {
-                const struct bal_roll R = bal_law_roll_of(L, bal_law_common_radius(r[i], r[j]));
-                const double wrel = w[i] - w[j];
-                const double dtheta = wrel * P.dt;
-                ptr[c] += dtheta;
-                mr = bal_law_rolling(&P, R, fn, dtheta, pmr[c], &lost_roll, &flags);
-                pmr[c] = mr;
-                if (damp) {
-                    md = bal_law_rolling_dashpot(&P, L, R, k.delta, wrel);
-                    mr += md;
-                }
-            }
-            pflags[c] = flags;
-            /* The moments on x and y: the shear force's, and the couple. */
-            const double tqi = roll ? fts * r[i] - mr : fts * r[i];
-            const double tqj = roll ? fts * r[j] + mr : fts * r[j];
-            const float dtqi = (float)(roll ? ds * r[i] - md : ds * r[i]);
-            const float dtqj = (float)(roll ? ds * r[j] + md : ds * r[j]);
-
-            /* Force on y is +(ftn e + fts t); on x the opposite (Fig. 3). */
-            const double fcx = ftn * ex + fts * ey;
-            const double fcy = ftn * ey - fts * ex;
-            if (logged && (i <= zone || j <= zone)) {
-                float dcx = 0, dcy = 0;
-                if (damp) {
-                    dcx = (float)(dn * ex + ds * ey);
-                    dcy = (float)(dn * ey - ds * ex);
-                }
-                /* a - b is a + (-b) exactly, so the replay adds the same
-                 * (but for the sign of a NaN: a run with one stops anyway) */
-                if (i <= zone)
-                    log[n_log++] = (struct bal_sum_log){-fcx, -fcy, tqi, -dcx, -dcy, dtqi, i};
-                else {
-                    f[3 * i] -= fcx;
-                    f[3 * i + 1] -= fcy;
-                    if (shear)
-                        f[3 * i + 2] += tqi;
-                    if (damp) {
-                        dsh[3 * i] -= dcx;
-                        dsh[3 * i + 1] -= dcy;
-                        if (shear)
-                            dsh[3 * i + 2] += dtqi;
-                    }
-                }
-                if (j <= zone)
-                    log[n_log++] = (struct bal_sum_log){fcx, fcy, tqj, dcx, dcy, dtqj, j};
-                else {
-                    f[3 * j] += fcx;
-                    f[3 * j + 1] += fcy;
-                    if (shear)
-                        f[3 * j + 2] += tqj;
-                    if (damp) {
-                        dsh[3 * j] += dcx;
-                        dsh[3 * j + 1] += dcy;
-                        if (shear)
-                            dsh[3 * j + 2] += dtqj;
-                    }
-                }
-                continue;
-            }
-            double *restrict fi = f + 3 * (size_t)i, *restrict fj = f + 3 * (size_t)j;
-            fi[0] -= fcx;
-            fi[1] -= fcy;
-            fj[0] += fcx;
-            fj[1] += fcy;
-            if (shear) {
-                fi[2] += tqi;
-                fj[2] += tqj;
-            }
-            if (damp) {
-                /* the dashpots' share, for their work at t_N (energy.c) */
-                const float dcx = (float)(dn * ex + ds * ey), dcy = (float)(dn * ey - ds * ex);
-                dsh[3 * i] -= dcx;
-                dsh[3 * i + 1] -= dcy;
-                dsh[3 * j] += dcx;
-                dsh[3 * j + 1] += dcy;
-                if (shear) {
-                    dsh[3 * i + 2] += dtqi;
-                    dsh[3 * j + 2] += dtqj;
-                }
-            }
+            const struct contact_sums a =
+                one_contact(&P, L, mods, k, c, i, j, ex, ey, rvx, rvy, r, w, pfn, pfs, pmr, ptr,
+                            pflags, &lost_fric, &lost_roll);
+            add_side(f, dsh, i, 1, &a, a.tqi, a.dtqi, mods, logged, zone, log, &n_log);
+            add_side(f, dsh, j, 0, &a, a.tqj, a.dtqj, mods, logged, zone, log, &n_log);
         }
         if (shear)
-            chunk_sums[c0 / CLEAR_CHUNK] = lost_fric;
+            chunk_sums[c0 / BAL_PAIRS_CHUNK] = lost_fric;
         if (roll)
-            chunk_roll[c0 / CLEAR_CHUNK] = lost_roll;
+            chunk_roll[c0 / BAL_PAIRS_CHUNK] = lost_roll;
     }
     if (logged)
         s->par.log_n[t] = n_log;
@@ -603,57 +547,45 @@ pair_range(struct bal_sim *restrict s, int t, const int mods)
     s->par.over[t] = st.over;
 }
 
-
 /* The whole list: its ranges, on as many threads, then the logs replayed in
- * range order and the chunks' friction losses added in order. */
+ * range order (threads.c) and the chunks' losses added in order. */
 static inline __attribute__((always_inline)) void
 pair_loop(struct bal_sim *restrict s, void (*on_threads)(struct bal_sim *), const int mods)
 {
-    const int shear = (mods & MOD_SHEAR) != 0, damp = (mods & MOD_DAMP) != 0;
     struct bal_par *par = &s->par;
     if (par->planned != s->rebuilds)
-        bal_par_plan(s);
+        bal_threads_plan(s);
     const int ranges = par->ranges;
     if (ranges == 1)
         pair_range(s, 0, mods);
     else
         on_threads(s);
-    double *restrict f = s->f;
-    float *restrict dsh = s->dash;
     int over = par->over[0];
-    for (int t = 1; t < ranges; t++) {
-        over |= par->over[t];
-        const struct bal_sum_log *restrict log = par->log[t];
-        for (long e = 0; e < par->log_n[t]; e++) {
-            const int k = log[e].k;
-            f[3 * k] += log[e].fx;
-            f[3 * k + 1] += log[e].fy;
-            if (shear)
-                f[3 * k + 2] += log[e].tq;
-            if (damp) {
-                dsh[3 * k] += log[e].dfx;
-                dsh[3 * k + 1] += log[e].dfy;
-                if (shear)
-                    dsh[3 * k + 2] += log[e].dtq;
-            }
-        }
+    if (ranges > 1) {
+        for (int t = 1; t < ranges; t++)
+            over |= par->over[t];
+        bal_threads_replay(s, (mods & MOD_SHEAR) != 0, (mods & MOD_DAMP) != 0);
     }
-    if (shear) {
+    const long chunks = bal_pairs_chunks(s->pp.n);
+    if (mods & MOD_SHEAR) {
         double lost_fric = 0;
-        const long chunks = chunks_of(s->pp.n);
         for (long k = 0; k < chunks; k++)
             lost_fric += par->chunk_sums[k];
         s->audit.d_friction += lost_fric;
     }
     if (mods & MOD_ROLL) {
         double lost_roll = 0;
-        const long chunks = chunks_of(s->pp.n);
         for (long k = 0; k < chunks; k++)
             lost_roll += par->chunk_roll[k];
         s->audit.d_rolling += lost_roll;
     }
     s->over_budget |= over;
 }
+
+/* ------------------------------------------------------------------ */
+/* The variants                                                        */
+/* ------------------------------------------------------------------ */
+
 /* Each variant with its parallel region in a function of its own: in the
  * same function, the region's shared variables cost the serial loop 10 %
  * (the compiler no longer keeps them in registers). */
@@ -681,7 +613,7 @@ pair_loop(struct bal_sim *restrict s, void (*on_threads)(struct bal_sim *), cons
 #ifdef BAL_BARE
 PAIR_VARIANT(loop_pow, MOD_POWER)
 
-bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping, int rolling)
+bal_pair_loop_fn bal_pair_loop_select(int normal_law, int shear, int damping, int rolling)
 {
     (void)normal_law, (void)shear, (void)damping, (void)rolling;
     return loop_pow;
@@ -702,7 +634,7 @@ PAIR_VARIANT(loop_pow_sdr, MOD_POWER | MOD_SHEAR | MOD_DAMP | MOD_ROLL)
 
 /* Rolling only with the tangential kernel: the caller asks for shear when
  * it asks for rolling (build.c), so the table has no variant without. */
-bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping, int rolling)
+bal_pair_loop_fn bal_pair_loop_select(int normal_law, int shear, int damping, int rolling)
 {
     static const bal_pair_loop_fn table[16] = {
         loop_inc,   loop_pow,   loop_inc_s,  loop_pow_s,  loop_inc_d, loop_pow_d,
@@ -713,132 +645,3 @@ bal_pair_loop_fn bal_contacts_select(int normal_law, int shear, int damping, int
     return table[mods];
 }
 #endif
-
-/* ------------------------------------------------------------------ */
-/* Disc–wall contacts                                                  */
-/* ------------------------------------------------------------------ */
-
-/* The wall is body y: its "radius" is zero and the velocity of its contact
- * point V + ω × (c − P) replaces ẏ and θ̇_y R_y of eqs (11)–(13).  Walls are
- * few and so are their contacts; one generic loop serves every law. */
-void bal_contacts_walls(struct bal_sim *s)
-{
-    struct bal_pairs *p = &s->pw;
-    const struct bal_law_params P = bal_law_params_of(s);
-    for (int k = 0; k < s->n_walls; k++) {
-        struct bal_wall *W = &s->walls[k];
-        W->f[0] = W->f[1] = W->moment = W->fn_sum = W->fn_s_sum = 0;
-        W->dash_f[0] = W->dash_f[1] = W->dash_m = 0;
-    }
-    double lost_fric = 0, lost_roll = 0, wall_dash = 0;
-    const int roll = p->rolling;
-    /* the dashpots' resultant per wall, for walls whose controller sets
-     * their velocity every cycle (walls.c); not kept otherwise */
-    const int track_dash = s->walls_controlled != 0;
-    for (long c = 0; c < p->n; c++) {
-        const int i = p->i[c];
-        struct bal_wall *W = &s->walls[p->j[c]];
-        double cx, cy;
-        const double d2 = bal_walls_closest(W, s->x[i], s->y[i], &cx, &cy);
-        const double ri = s->r[i];
-        if (d2 >= ri * ri) {
-            p->fn[c] = p->fs[c] = p->dn[c] = p->ds[c] = 0;
-            p->flags[c] = 0;
-            if (roll) {
-                p->mr[c] = p->tr[c] = 0;
-                if (p->dm)
-                    p->dm[c] = 0;
-            }
-            continue;
-        }
-        const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + W->material];
-        double ex, ey;
-        const double dist = sqrt(d2);
-        if (dist > 0) {
-            ex = (cx - s->x[i]) / dist;
-            ey = (cy - s->y[i]) / dist;
-        } else {
-            /* Centre exactly on the wall: push along the wall's normal. */
-            ex = -W->e[1];
-            ey = W->e[0];
-        }
-        const double tx = ey, ty = -ex;
-        const double wvx = W->v[0] - W->omega * (cy - W->p[1]);
-        const double wvy = W->v[1] + W->omega * (cx - W->p[0]);
-        const double rvx = s->vx[i] - wvx, rvy = s->vy[i] - wvy;
-        struct bal_kin k;
-        k.ndot = rvx * ex + rvy * ey;
-        k.sdot = rvx * tx + rvy * ty - s->w[i] * ri;
-        k.delta = ri - dist;
-        if (k.delta > s->overlap_sieve)
-            s->over_budget = 1;
-
-        /* The chain of laws.h, every kernel: with the damping off its
-         * coefficients are zero.  A frictionless, cohesionless pair carries
-         * no shear force and no shear dashpot, as in the disc–disc loop. */
-        const double fn = bal_law_normal(&P, L, &k, p->fn[c]);
-        const double dn = bal_law_normal_dashpot(&P, L, &k);
-        uint8_t flags = roll ? (uint8_t)(BAL_PAIR_TOUCHING | (p->flags[c] & BAL_PAIR_BROKEN))
-                             : BAL_PAIR_TOUCHING;
-        const double fs = L->shear ? bal_law_tangential(&P, L, &k, fn, p->fs[c], &lost_fric, &flags)
-                                   : 0.0;
-        const double ds = (!L->shear || (flags & BAL_PAIR_SLIDING)) ? 0.0
-                                                                     : bal_law_shear_dashpot(L, &k);
-        /* Rolling against a wall: the common radius is 2 r (JYH eq. 11b),
-         * the relative rotation the disc's against the wall's. */
-        double mr = 0, md = 0;
-        if (roll && L->rolling > 0) {
-            const struct bal_roll R = bal_law_roll_of(L, 2 * ri);
-            const double wrel = s->w[i] - W->omega;
-            const double dtheta = wrel * P.dt;
-            p->tr[c] += dtheta;
-            mr = bal_law_rolling(&P, R, fn, dtheta, p->mr[c], &lost_roll, &flags);
-            p->mr[c] = mr;
-            if (p->dm) {
-                md = bal_law_rolling_dashpot(&P, L, R, k.delta, wrel);
-                p->dm[c] = md;
-            }
-        }
-        if (s->dash) {
-            /* the dashpots' share on the disc, and their power on the wall
-             * side (its velocity is prescribed): energy.c */
-            s->dash[3 * i] -= (float)(dn * ex + ds * tx);
-            s->dash[3 * i + 1] -= (float)(dn * ey + ds * ty);
-            s->dash[3 * i + 2] += (float)(roll ? ds * ri - md : ds * ri);
-            wall_dash += dn * (wvx * ex + wvy * ey) + ds * (wvx * tx + wvy * ty);
-            if (roll)
-                wall_dash += md * W->omega;
-            /* ... and their resultant on the wall, for a controller that
-             * changes the wall's velocity (walls.c, bal_walls_control) */
-            if (track_dash) {
-                const double dfx = dn * ex + ds * tx, dfy = dn * ey + ds * ty;
-                W->dash_f[0] += dfx;
-                W->dash_f[1] += dfy;
-                W->dash_m += (cx - W->p[0]) * dfy - (cy - W->p[1]) * dfx + (roll ? md : 0);
-            }
-        }
-        p->fn[c] = fn;
-        p->fs[c] = fs;
-        p->dn[c] = dn;
-        p->ds[c] = ds;
-        p->flags[c] = flags;
-
-        const double ftn = fn + dn, fts = fs + ds;
-        const double fcx = ftn * ex + fts * tx;
-        const double fcy = ftn * ey + fts * ty;
-        s->f[3 * i] -= fcx;
-        s->f[3 * i + 1] -= fcy;
-        s->f[3 * i + 2] += roll ? fts * ri - (mr + md) : fts * ri;
-        W->f[0] += fcx;
-        W->f[1] += fcy;
-        W->moment += (cx - W->p[0]) * fcy - (cy - W->p[1]) * fcx;
-        if (roll)
-            W->moment += mr + md; /* the couple on the wall */
-        const double along = (cx - W->p[0]) * W->e[0] + (cy - W->p[1]) * W->e[1];
-        W->fn_sum += ftn;
-        W->fn_s_sum += ftn * along;
-    }
-    s->audit.wall_dash = wall_dash;
-    s->audit.d_friction += lost_fric;
-    s->audit.d_rolling += lost_roll;
-}

@@ -53,8 +53,14 @@
  *
  * Two at a time.  The commonest law (power law with ν = 1, tangential
  * spring, no damping or rolling, one material) takes its contacts two at a
- * time in the third pass, D and e included (linear_shear_pairs: the
- * kernels' operations lane by lane, the same bits).
+ * time in the third pass, D and e included (two_at_a_time): the kernels are
+ * the _x2 twins of those the one-contact chain calls, compiled from the
+ * same source (laws_lanes.h), so the same bits, and an edit of a kernel
+ * reaches both.  The sums and the friction losses are then added contact by
+ * contact in the list's order.  Every variant's loop is held to its
+ * one-contact run byte for byte (check_contacts.c,
+ * contacts_every_variant_same_at_both_widths), and the catalogue's case
+ * `coulomb` checks eq. (19) on scenes that run it.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -124,6 +130,7 @@ struct range_state {
     long c0;     /* the next chunk */
     int cleared; /* the sums of discs 0..cleared are started (or not this range's) */
     int over;    /* an overlap past the sieve */
+    long wide;   /* contacts run two at a time */
 };
 
 /* ------------------------------------------------------------------ */
@@ -251,19 +258,23 @@ add_side(double *restrict f, float *restrict dsh, int k, const int minus,
 /* Two contacts at a time                                              */
 /* ------------------------------------------------------------------ */
 
-#if defined(__SSE2__)
+#if defined(BAL_X2)
 /* Pass 3 of the commonest loop (linear power law, tangential spring, no
  * damping or rolling, one material, no logging) two contacts at a time:
- * the same operations as the kernels of laws.h, lane by lane, so the same
- * bits; the force sums are then added contact by contact in the list's
- * order, and the losses of sliding contacts too.  Returns the contacts done (nt rounded
- * down to even); the loop below does the last. */
+ * the same kinematics as the one-contact pass, lane by lane, and the _x2
+ * kernels of laws_lanes.h, so the same bits; the force sums are then added
+ * contact by contact in the list's order, and the losses of sliding
+ * contacts too.  Returns the contacts done (nt rounded down to even); the
+ * one-contact pass does the last. */
 static inline __attribute__((always_inline)) int
-linear_shear_pairs(struct bal_sim *restrict s, long c0, const int32_t *restrict tc,
-                   const double *restrict tq, const double *restrict tdx,
-                   const double *restrict tdy, int nt, double budget, int *over,
-                   double *lost_fric)
+two_at_a_time(struct bal_sim *restrict s, const struct bal_law_params *params, long c0,
+              const int32_t *restrict tc, const double *restrict tq, const double *restrict tdx,
+              const double *restrict tdy, int nt, double budget, int *over, double *lost_fric)
 {
+    /* The law's parameters in locals: through pointers, the compiler
+     * reloaded (and broadcast) each one after every store to the sums. */
+    const struct bal_law_params P_ = *params, *P = &P_;
+    const struct bal_pair_law L_ = *s->disc_law, *L = &L_;
     const struct bal_pairs *p = &s->pp;
     const int32_t *restrict pi = p->i, *restrict pj = p->j;
     double *restrict pfn = p->fn, *restrict pfs = p->fs;
@@ -271,83 +282,65 @@ linear_shear_pairs(struct bal_sim *restrict s, long c0, const int32_t *restrict 
     const double *restrict r = s->r, *restrict vx = s->vx, *restrict vy = s->vy;
     const double *restrict w = s->w;
     double *restrict f = s->f;
-    const struct bal_pair_law *L = s->disc_law;
-    const __m128d kn = _mm_set1_pd(L->kn), ks = _mm_set1_pd(L->ks);
-    const __m128d tanp = _mm_set1_pd(L->tan_phi), coh = _mm_set1_pd(L->cohesion);
-    const __m128d dt = _mm_set1_pd(s->dt), bud = _mm_set1_pd(budget);
-    const __m128d sign = _mm_set1_pd(-0.0);
     int ov = 0;
     const int n2 = nt & ~1;
     for (int q = 0; q < n2; q += 2) {
         const long ca = c0 + tc[q], cb = c0 + tc[q + 1];
         const int ia = pi[ca], ja = pj[ca], ib = pi[cb], jb = pj[cb];
-        const __m128d ri = _mm_set_pd(r[ib], r[ia]), rj = _mm_set_pd(r[jb], r[ja]);
-        const __m128d rs = _mm_add_pd(ri, rj);
+        const bal_v2 ri = {r[ia], r[ib]}, rj = {r[ja], r[jb]};
         /* D and e here rather than in pass 2 (the same operations) */
-        const __m128d dist = _mm_sqrt_pd(_mm_loadu_pd(tq + q));
-        const __m128d ex = _mm_div_pd(_mm_loadu_pd(tdx + q), dist);
-        const __m128d ey = _mm_div_pd(_mm_loadu_pd(tdy + q), dist);
-        const __m128d rvx = _mm_sub_pd(_mm_set_pd(vx[ib], vx[ia]), _mm_set_pd(vx[jb], vx[ja]));
-        const __m128d rvy = _mm_sub_pd(_mm_set_pd(vy[ib], vy[ia]), _mm_set_pd(vy[jb], vy[ja]));
-        const __m128d delta = _mm_sub_pd(rs, dist);
-        ov |= _mm_movemask_pd(_mm_cmpgt_pd(delta, bud));
-        const __m128d fn = _mm_mul_pd(kn, delta);
-        /* ṡ = (rvx t_x + rvy t_y) − (ω_i r_i + ω_j r_j), t = (e_y, −e_x) */
-        const __m128d ty = _mm_xor_pd(ex, sign);
-        const __m128d wr = _mm_add_pd(_mm_mul_pd(_mm_set_pd(w[ib], w[ia]), ri),
-                                      _mm_mul_pd(_mm_set_pd(w[jb], w[ja]), rj));
-        const __m128d sdot = _mm_sub_pd(_mm_add_pd(_mm_mul_pd(rvx, ey), _mm_mul_pd(rvy, ty)), wr);
-        __m128d fs = _mm_add_pd(_mm_set_pd(pfs[cb], pfs[ca]), _mm_mul_pd(_mm_mul_pd(ks, sdot), dt));
-        const __m128d fmax = _mm_add_pd(_mm_mul_pd(fn, tanp), coh);
-        const int slide = _mm_movemask_pd(_mm_cmpgt_pd(_mm_andnot_pd(sign, fs), fmax));
-        double fsa, fsb, fna = _mm_cvtsd_f64(fn), fnb = _mm_cvtsd_f64(_mm_unpackhi_pd(fn, fn));
+        const bal_v2 dist = bal_v2_sqrt(_mm_loadu_pd(tq + q));
+        const bal_v2 ex = _mm_loadu_pd(tdx + q) / dist, ey = _mm_loadu_pd(tdy + q) / dist;
+        const bal_v2 rvx = (bal_v2){vx[ia], vx[ib]} - (bal_v2){vx[ja], vx[jb]};
+        const bal_v2 rvy = (bal_v2){vy[ia], vy[ib]} - (bal_v2){vy[ja], vy[jb]};
+        struct bal_kin_x2 k;
+        k.ndot = rvx * ex + rvy * ey;
+        k.delta = (ri + rj) - dist;
+        ov |= bal_v2_bits(k.delta > budget);
+
+        /* The chain: normal -> tangential (one_contact's, lane by lane). */
+        const bal_v2 fn = bal_law_normal_x2(P, L, &k, (bal_v2){pfn[ca], pfn[cb]});
+        const bal_v2 tx = ey, ty = -ex;
+        k.sdot = rvx * tx + rvy * ty - ((bal_v2){w[ia], w[ib]} * ri + (bal_v2){w[ja], w[jb]} * rj);
+        bal_v2 loss;
+        bal_v2m slid;
+        const bal_v2 fs = bal_law_shear_x2(P, L, &k, fn, (bal_v2){pfs[ca], pfs[cb]}, &loss, &slid);
         uint8_t fla = BAL_PAIR_TOUCHING, flb = BAL_PAIR_TOUCHING;
+        const int slide = bal_v2_bits(slid);
         if (slide) {
-            /* bal_law_tangential's cap, lane by lane: the loss
-             * F_max (|F_s| − F_max)/k_s of each sliding contact, added in
-             * order, and F_s = copysign(F_max, F_s) */
-            const __m128d afs = _mm_andnot_pd(sign, fs);
-            const __m128d loss = _mm_div_pd(_mm_mul_pd(fmax, _mm_sub_pd(afs, fmax)), ks);
-            const __m128d capped = _mm_or_pd(_mm_andnot_pd(sign, fmax), _mm_and_pd(sign, fs));
+            /* the slip's losses, contact by contact in the list's order */
             if (slide & 1) {
-                *lost_fric += _mm_cvtsd_f64(loss);
+                *lost_fric += loss[0];
                 fla |= BAL_PAIR_SLIDING;
             }
             if (slide & 2) {
-                *lost_fric += _mm_cvtsd_f64(_mm_unpackhi_pd(loss, loss));
+                *lost_fric += loss[1];
                 flb |= BAL_PAIR_SLIDING;
             }
-            const __m128d m = _mm_cmpgt_pd(afs, fmax);
-            fs = _mm_or_pd(_mm_and_pd(m, capped), _mm_andnot_pd(m, fs));
-            fsa = _mm_cvtsd_f64(fs);
-            fsb = _mm_cvtsd_f64(_mm_unpackhi_pd(fs, fs));
-        } else {
-            fsa = _mm_cvtsd_f64(fs);
-            fsb = _mm_cvtsd_f64(_mm_unpackhi_pd(fs, fs));
         }
-        pfn[ca] = fna;
-        pfn[cb] = fnb;
-        pfs[ca] = fsa;
-        pfs[cb] = fsb;
+        pfn[ca] = fn[0];
+        pfn[cb] = fn[1];
+        pfs[ca] = fs[0];
+        pfs[cb] = fs[1];
         pflags[ca] = fla;
         pflags[cb] = flb;
         /* moments F_s r, and the force +(F_n e + F_s t) on j */
-        const __m128d tqi = _mm_mul_pd(fs, ri), tqj = _mm_mul_pd(fs, rj);
-        const __m128d fcx = _mm_add_pd(_mm_mul_pd(fn, ex), _mm_mul_pd(fs, ey));
-        const __m128d fcy = _mm_sub_pd(_mm_mul_pd(fn, ey), _mm_mul_pd(fs, ex));
+        const bal_v2 tqi = fs * ri, tqj = fs * rj;
+        const bal_v2 fcx = fn * ex + fs * ey;
+        const bal_v2 fcy = fn * ey - fs * ex;
         /* (F_x, F_y) of each contact as one pair of lanes: the same
          * additions to the same sums, in the same order */
         const __m128d fa_ = _mm_unpacklo_pd(fcx, fcy), fb_ = _mm_unpackhi_pd(fcx, fcy);
         double *restrict fa = f + 3 * (size_t)ia, *restrict fja = f + 3 * (size_t)ja;
         _mm_storeu_pd(fa, _mm_sub_pd(_mm_loadu_pd(fa), fa_));
         _mm_storeu_pd(fja, _mm_add_pd(_mm_loadu_pd(fja), fa_));
-        fa[2] += _mm_cvtsd_f64(tqi);
-        fja[2] += _mm_cvtsd_f64(tqj);
+        fa[2] += tqi[0];
+        fja[2] += tqj[0];
         double *restrict fb = f + 3 * (size_t)ib, *restrict fjb = f + 3 * (size_t)jb;
         _mm_storeu_pd(fb, _mm_sub_pd(_mm_loadu_pd(fb), fb_));
         _mm_storeu_pd(fjb, _mm_add_pd(_mm_loadu_pd(fjb), fb_));
-        fb[2] += _mm_cvtsd_f64(_mm_unpackhi_pd(tqi, tqi));
-        fjb[2] += _mm_cvtsd_f64(_mm_unpackhi_pd(tqj, tqj));
+        fb[2] += tqi[1];
+        fjb[2] += tqj[1];
     }
     *over |= ov != 0;
     return n2;
@@ -380,7 +373,7 @@ linear_shear_pairs(struct bal_sim *restrict s, long c0, const int32_t *restrict 
  * range_chunks: the chunks of range t from st.c0 on, while their first i is
  * in the zone (`logged`), or to the end of the range.  Each chunk runs the
  * three passes of the header; the third is one_contact() and add_side() at
- * each touching contact, or linear_shear_pairs() where the variant allows. */
+ * each touching contact, or two_at_a_time() where the variant allows. */
 static inline __attribute__((always_inline)) struct range_state
 range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int mods,
              const int logged, const int linear, const int one)
@@ -424,15 +417,16 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
     const int zone = logged ? s->par.zone[t] : -1;
     struct bal_sum_log *restrict log = logged ? s->par.log[t] : NULL;
     long n_log = logged ? s->par.log_n[t] : 0;
-    /* Two at a time: the commonest law, in the chunks that do not log. */
-#if defined(__SSE2__)
+    /* Two at a time: the commonest law, in the chunks that do not log,
+     * unless a test asks for one contact at a time (par.one_lane). */
+#if defined(BAL_X2)
     const int pairs = mods == (MOD_POWER | MOD_SHEAR) && linear && one && !logged &&
-                      one_law->shear;
+                      one_law->shear && !s->par.one_lane;
 #else
     const int pairs = 0;
 #endif
     int cleared = st.cleared, over = st.over;
-    long c0 = st.c0;
+    long c0 = st.c0, wide = st.wide;
     for (; c0 < end && (!logged || pi[c0] <= zone); c0 += BAL_PAIRS_CHUNK) {
         const long c1 = c0 + BAL_PAIRS_CHUNK < pn ? c0 + BAL_PAIRS_CHUNK : pn;
         const int top = chunk_top[c0 / BAL_PAIRS_CHUNK];
@@ -482,9 +476,11 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
         else if (nt & 1)
             unit_vectors(tq + nt - 1, tdx + nt - 1, tdy + nt - 1, 1);
         /* Pass 3: the law at each touching contact, in the list's order. */
-#if defined(__SSE2__)
-        if (pairs)
-            q0 = linear_shear_pairs(s, c0, tc, tq, tdx, tdy, nt, budget, &over, &lost_fric);
+#if defined(BAL_X2)
+        if (pairs) {
+            q0 = two_at_a_time(s, &P, c0, tc, tq, tdx, tdy, nt, budget, &over, &lost_fric);
+            wide += q0;
+        }
 #endif
         for (int q = q0; q < nt; q++) {
             const long c = c0 + tc[q];
@@ -511,7 +507,7 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
     }
     if (logged)
         s->par.log_n[t] = n_log;
-    return (struct range_state){c0, cleared, over};
+    return (struct range_state){c0, cleared, over, wide};
 }
 
 /* The chunks of a range that log (at its start; only ranges after the
@@ -527,7 +523,7 @@ logged_chunks(struct bal_sim *restrict s, int t, struct range_state st, const in
 static inline __attribute__((always_inline)) void
 pair_range(struct bal_sim *restrict s, int t, const int mods)
 {
-    struct range_state st = {s->par.start[t], s->par.zone[t], 0};
+    struct range_state st = {s->par.start[t], s->par.zone[t], 0, 0};
     s->par.log_n[t] = 0;
     if (t > 0)
         st = logged_chunks(s, t, st, mods);
@@ -545,6 +541,7 @@ pair_range(struct bal_sim *restrict s, int t, const int mods)
     if (t == s->par.ranges - 1)
         clear_sums(s->f, s->dash, st.cleared + 1, s->n - 1, (mods & MOD_DAMP) != 0);
     s->par.over[t] = st.over;
+    s->par.two_lane[t] += st.wide;
 }
 
 /* The whole list: its ranges, on as many threads, then the logs replayed in

@@ -208,6 +208,9 @@ struct bal_par {
     double *chunk_roll;          /* ... and the rolling loss (only with rolling) */
     long chunk_cap;
     double *block_sums;          /* per block of discs, 2 each: a pass's sums (integrate.c) */
+    int one_lane;                /* 1: the pair loop runs every contact one at a time, never
+                                  * two (tests compare the widths; pair_loop.c) */
+    long two_lane[BAL_MAX_THREADS]; /* contacts range t has run two at a time, since creation */
 };
 #define BAL_DISC_BLOCK 4096          /* discs per block */
 

@@ -206,6 +206,17 @@ static inline double bal_law_normal_energy(const struct bal_law_params *P,
     return L->kn * P->delta0 * P->delta0 * pow(delta / P->delta0, P->nu + 1) / (P->nu + 1);
 }
 
+/* The normal spring's tangent stiffness dF_n/dδ at δ/δ0 = ratio: k_n for the
+ * incremental law and the linear power law, ν k_n (δ/δ0)^(ν−1) otherwise.
+ * The stress servo's gain (walls.c) and the step estimate (timestep.c). */
+static inline double bal_law_normal_stiffness(const struct bal_law_params *P,
+                                              const struct bal_pair_law *L, double ratio)
+{
+    if (P->normal_law != BAL_NORMAL_POWER || P->nu == 1.0)
+        return L->kn;
+    return P->nu * L->kn * pow(ratio, P->nu - 1);
+}
+
 /* --------------------------------------------------------------- damping */
 
 /* The coefficient γ_n (δ/δ0)^ψ of MLH eq. (3). */

@@ -20,10 +20,12 @@
  * Contacts.  Two flat candidate lists, disc–disc and disc–wall, each sorted
  * by key = (lo << 32) | hi (pair_key(); not stored: it is i and j).  A
  * candidate carries the contact's history (F_n for the incremental law,
- * F_s) in parallel arrays; a candidate whose bodies do not overlap has zero
- * history.  When the neighbour list is rebuilt, the new candidate list is
- * merged with the old one in one linear pass, so history survives rebuilds
- * (pairs.c, grid.c).
+ * F_s, the rolling M and θ_r; the wall list also its dashpot forces) in
+ * parallel arrays, each only where the scene needs it; a candidate whose
+ * bodies do not overlap has zero history.  The contact loops (pair_loop.c,
+ * wall_loop.c) read and write them in place; when the neighbour list is
+ * rebuilt, the new candidate list is merged with the old one in one linear
+ * pass, so history survives rebuilds (grid.c, install: the only merge).
  */
 #ifndef BAL_STATE_H
 #define BAL_STATE_H
@@ -100,6 +102,9 @@ struct bal_wall {
     double dash_f[2], dash_m; /* the contact dashpots' share of f and of the moment about P
                             * (only in damped scenes, and in stages with a controller
                             * acting every cycle: wall_loop.c) */
+    double stiffness;      /* Σ dF_n/dδ of its contacts (laws.h, bal_law_normal_stiffness):
+                            * the servo's K (only in stages with a controller acting every
+                            * cycle: wall_loop.c; at a servo's start, walls.c) */
     double disp;           /* largest displacement of any of its points since rebuild */
     double f_prev[2], moment_prev; /* f and moment of the cycle before (energy audit) */
 };

@@ -17,7 +17,8 @@
  * and the reports read: the resultant force and moment of its contacts
  * (C&S Table 1), Σ F_n and Σ F_n s (s along the wall), and, in a stage
  * whose controller acts every cycle (walls.c), the dashpots' share of the
- * resultant.  Walls are few and so are their contacts: one generic loop serves
+ * resultant and the contacts' normal stiffness Σ dF_n/dδ (the servo's
+ * gain).  Walls are few and so are their contacts: one generic loop serves
  * every law, with every kernel (a switched-off one has zero parameters).
  */
 #include <math.h>
@@ -33,12 +34,14 @@ void bal_wall_loop_run(struct bal_sim *s)
         struct bal_wall *W = &s->walls[k];
         W->f[0] = W->f[1] = W->moment = W->fn_sum = W->fn_s_sum = 0;
         W->dash_f[0] = W->dash_f[1] = W->dash_m = 0;
+        W->stiffness = 0;
     }
     double lost_fric = 0, lost_roll = 0, wall_dash = 0;
     const int roll = p->rolling;
-    /* the dashpots' resultant per wall, for walls whose controller sets
-     * their velocity every cycle (walls.c); not kept otherwise */
-    const int track_dash = s->walls_controlled != 0;
+    /* the dashpots' resultant and the contacts' stiffness per wall, for
+     * walls whose controller sets their velocity every cycle (walls.c); not
+     * kept otherwise */
+    const int track = s->walls_controlled != 0;
     for (long c = 0; c < p->n; c++) {
         const int i = p->i[c];
         struct bal_wall *W = &s->walls[p->j[c]];
@@ -114,7 +117,7 @@ void bal_wall_loop_run(struct bal_sim *s)
                 wall_dash += md * W->omega;
             /* ... and their resultant on the wall, for a controller that
              * changes the wall's velocity (walls.c, bal_walls_control) */
-            if (track_dash) {
+            if (track) {
                 const double dfx = dn * ex + ds * tx, dfy = dn * ey + ds * ty;
                 W->dash_f[0] += dfx;
                 W->dash_f[1] += dfy;
@@ -141,6 +144,9 @@ void bal_wall_loop_run(struct bal_sim *s)
         const double along = (cx - W->p[0]) * W->e[0] + (cy - W->p[1]) * W->e[1];
         W->fn_sum += ftn;
         W->fn_s_sum += ftn * along;
+        /* the servo's gain: dF_n/dδ of the wall's contacts (walls.c) */
+        if (track)
+            W->stiffness += bal_law_normal_stiffness(&P, L, fmax(k.delta, 0) / P.delta0);
     }
     s->audit.wall_dash = wall_dash;
     s->audit.d_friction += lost_fric;

@@ -11,6 +11,9 @@
 
 /* Closest point of wall w to (x, y); returns squared distance. */
 double bal_walls_closest(const struct bal_wall *w, double x, double y, double *cx, double *cy);
+/* The overlap of a disc of radius r at (x, y) with wall w: r less the
+ * distance to the wall's closest point (negative: a gap). */
+double bal_walls_overlap(const struct bal_wall *w, double x, double y, double r);
 /* Unit normal from (x, y) to the closest point of wall w (the wall's own
  * normal when the point lies on it); returns the distance. */
 double bal_walls_normal(const struct bal_wall *w, double x, double y, double *ex, double *ey);

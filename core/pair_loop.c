@@ -373,7 +373,12 @@ two_at_a_time(struct bal_sim *restrict s, const struct bal_law_params *params, l
  * range_chunks: the chunks of range t from st.c0 on, while their first i is
  * in the zone (`logged`), or to the end of the range.  Each chunk runs the
  * three passes of the header; the third is one_contact() and add_side() at
- * each touching contact, or two_at_a_time() where the variant allows. */
+ * each touching contact, or two_at_a_time() where the variant allows.
+ * Kept whole (about 130 lines, a third of them the columns and parameters
+ * read into locals): with pass 1 as an inline function of its own, the
+ * compiled loops ran 3 % more instructions (callgrind: loop_inc_sd 1.157e9
+ * against 1.124e9 on the dense scene's 5 000 discs for 3 000 cycles,
+ * loop_pow_s 3.4 % more on the same packing with the linear law). */
 static inline __attribute__((always_inline)) struct range_state
 range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int mods,
              const int logged, const int linear, const int one)

@@ -26,6 +26,32 @@
 #include "wall_loop.h"
 #include "walls.h"
 
+/* What touching contact c of disc i with wall W adds to their sums: the
+ * force +(ftn e + fts t) on the wall and its opposite on the disc (C&S
+ * Fig. 3), the shear force's moment on the disc, the rolling couple
+ * M + M_d (−(M + M_d) on the disc, + on the wall: JYH eq. 52), the moment
+ * about P on the wall, and the wall's Σ F_n and Σ F_n s (s along the wall
+ * from P); (cx, cy) is the contact point on the wall. */
+static inline __attribute__((always_inline)) void
+add_forces(struct bal_sim *s, struct bal_wall *W, int i, double ex, double ey, double cx,
+           double cy, double ftn, double fts, double mr, double md, const int roll)
+{
+    const double tx = ey, ty = -ex, ri = s->r[i];
+    const double fcx = ftn * ex + fts * tx;
+    const double fcy = ftn * ey + fts * ty;
+    s->f[3 * i] -= fcx;
+    s->f[3 * i + 1] -= fcy;
+    s->f[3 * i + 2] += roll ? fts * ri - (mr + md) : fts * ri;
+    W->f[0] += fcx;
+    W->f[1] += fcy;
+    W->moment += (cx - W->p[0]) * fcy - (cy - W->p[1]) * fcx;
+    if (roll)
+        W->moment += mr + md; /* the couple on the wall */
+    const double along = (cx - W->p[0]) * W->e[0] + (cy - W->p[1]) * W->e[1];
+    W->fn_sum += ftn;
+    W->fn_s_sum += ftn * along;
+}
+
 void bal_wall_loop_run(struct bal_sim *s)
 {
     struct bal_pairs *p = &s->pw;
@@ -129,21 +155,7 @@ void bal_wall_loop_run(struct bal_sim *s)
         p->dn[c] = dn;
         p->ds[c] = ds;
         p->flags[c] = flags;
-
-        const double ftn = fn + dn, fts = fs + ds;
-        const double fcx = ftn * ex + fts * tx;
-        const double fcy = ftn * ey + fts * ty;
-        s->f[3 * i] -= fcx;
-        s->f[3 * i + 1] -= fcy;
-        s->f[3 * i + 2] += roll ? fts * ri - (mr + md) : fts * ri;
-        W->f[0] += fcx;
-        W->f[1] += fcy;
-        W->moment += (cx - W->p[0]) * fcy - (cy - W->p[1]) * fcx;
-        if (roll)
-            W->moment += mr + md; /* the couple on the wall */
-        const double along = (cx - W->p[0]) * W->e[0] + (cy - W->p[1]) * W->e[1];
-        W->fn_sum += ftn;
-        W->fn_s_sum += ftn * along;
+        add_forces(s, W, i, ex, ey, cx, cy, fn + dn, fs + ds, mr, md, roll);
         /* the servo's gain: dF_n/dδ of the wall's contacts (walls.c) */
         if (track)
             W->stiffness += bal_law_normal_stiffness(&P, L, fmax(k.delta, 0) / P.delta0);

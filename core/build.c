@@ -35,7 +35,7 @@
 #include <string.h>
 
 #include "build.h"
-#include "contacts.h"
+#include "pair_loop.h"
 #include "grid.h"
 #include "pairs.h"
 #include "scene.h"
@@ -571,8 +571,8 @@ enum bal_status bal_build_lists(struct bal_sim *s, struct bal_error *err)
     s->pw.shear = 1;
     s->pw.damping = 1;
     s->pw.rolling = (uint8_t)s->has_rolling;
-    s->pair_loop = bal_contacts_select(s->normal_law, s->has_shear || s->has_rolling,
-                                       s->has_damping, s->has_rolling);
+    s->pair_loop = bal_pair_loop_select(s->normal_law, s->has_shear || s->has_rolling,
+                                        s->has_damping, s->has_rolling);
     if (bal_grid_rebuild(s, err))
         return s->crowded ? crowded_at_start(s, s->crowded - 1, err) : err->code;
     return check_overlaps(s, err);

@@ -256,7 +256,7 @@ static enum bal_status add_contact(const struct bal_sim *s, struct work *w, long
             nx = (cx - s->x[i]) / dist;
             ny = (cy - s->y[i]) / dist;
         } else {
-            /* Centre on the wall: its normal, as the contact law does (contacts.c). */
+            /* Centre on the wall: its normal, as the contact law does (wall_loop.c). */
             nx = -W->e[1];
             ny = W->e[0];
         }

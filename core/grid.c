@@ -16,7 +16,7 @@
  * counting sort.  For each disc i, in index order, its candidates j > i are
  * gathered and sorted by j, which leaves the whole list sorted by key
  * (i << 32 | j) without a global sort; the history of the old list is then
- * carried over by one linear merge (contacts.c).
+ * carried over by one linear merge (match_old and install, below).
  *
  * Memory: a rebuild writes the new list into a scratch of keys and pair
  * indices and carries the history over one column at a time, so it needs

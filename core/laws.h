@@ -38,16 +38,22 @@
  * A kernel takes the contact's kinematics (struct bal_kin), its pair law
  * (struct bal_pair_law) and its own slice of history, and returns a force;
  * it reads no simulation state, so the loop that calls it decides layout,
- * threads and accumulation.  The disc–disc loop (contacts.c) calls it in
+ * threads and accumulation.  The disc–disc loop (pair_loop.c) calls it in
  * variants compiled without the kernels a scene switches off, so a scene
  * without friction or damping never runs their code or touches their
- * history; the disc–wall loop calls every kernel (walls are few).
+ * history; the disc–wall loop (wall_loop.c) calls every kernel (walls are
+ * few).  The kernels the disc–disc loop also runs two contacts at a time
+ * (normal, tangential) are written once for both widths, in laws_lanes.h
+ * (see "the kernels of both widths" below): an edit there reaches every
+ * loop.
  *
  * Adding a sub-model: one kernel here (with the stored energy of its spring,
  * if it has one, for the audit), one history column in struct bal_pairs
- * (state.h) with its reserve/merge lines (pairs.c), and one switch: a flag
- * the disc–disc loop is specialised on (PAIR_VARIANT in contacts.c) and the
- * disc–wall loop tests.
+ * (state.h) with its reserve line (pairs.c) and its gather line in the
+ * rebuild's merge (grid.c, install), and one switch: a flag the disc–disc
+ * loop is specialised on (a MOD_* bit and its PAIR_VARIANT rows in
+ * pair_loop.c) and the disc–wall loop tests.  A kernel that a two-lane loop
+ * is to run goes into laws_lanes.h, written with its lane operations.
  *
  * Sign conventions are those of ballast.h (C&S Figs 2–3): ṅ = (ẋ − ẏ)·e > 0
  * closes the contact; F_n + D_n and F_s + D_s act on x along −e and −t.
@@ -91,31 +97,105 @@ struct bal_kin {
 #define BAL_PAIR_ROLLING 4u  /* Model 1: the rolling moment is at its cap M_0 */
 #define BAL_PAIR_BROKEN 8u   /* Model 2: the contact has lost its rolling resistance */
 
+/* ------------------------------------------------- the kernels of both widths */
+
+/* The kernels the disc–disc loop also runs two contacts at a time (the
+ * normal law, the shear spring and its Coulomb cap) are written once, in
+ * laws_lanes.h, on an abstract real BAL_R with a few lane operations, and
+ * compiled here twice: for one contact (BAL_R = double: bal_law_normal,
+ * bal_law_shear, ...) and, where SSE2 exists (every x86-64), for two
+ * (BAL_R = bal_v2, a GCC vector of two doubles: bal_law_normal_x2, ...).
+ * The operations are IEEE's, lane by lane, so the two widths give the same
+ * bits (-ffp-contract=off; core/tests/check_contacts.c holds every variant
+ * of the loop to it), and an edit of a kernel moves both. */
+
+/* One contact: the lane operations are the scalar ones. */
+#define BAL_R double
+#define BAL_M int                          /* a comparison's result */
+#define BAL_KIN struct bal_kin
+#define BAL_W(name) name                   /* the kernel's name at this width */
+#define BAL_SPLAT(x) (x)                   /* a constant in every lane */
+#define BAL_ANY(m) (m)                     /* is the mask set in some lane? */
+#define BAL_SELECT(m, a, b) ((m) ? (a) : (b))
+#define BAL_ABS(x) fabs(x)
+#define BAL_COPYSIGN(mag, sgn) copysign(mag, sgn)
+#define BAL_SQRT(x) sqrt(x)
+#define BAL_POW(x, e) pow(x, e)
+#include "laws_lanes.h"
+#undef BAL_R
+#undef BAL_M
+#undef BAL_KIN
+#undef BAL_W
+#undef BAL_SPLAT
+#undef BAL_ANY
+#undef BAL_SELECT
+#undef BAL_ABS
+#undef BAL_COPYSIGN
+#undef BAL_SQRT
+#undef BAL_POW
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#define BAL_X2 1 /* the two-lane kernels exist */
+
+/* Two contacts: two doubles in one SSE2 register (GCC's vector extension:
+ * + − × / and the comparisons act lane by lane; a comparison gives a mask
+ * of all-ones or zero per lane). */
+typedef __m128d bal_v2;
+typedef long long bal_v2m __attribute__((vector_size(16)));
+
+/* The kinematics of two touching contacts (struct bal_kin, lane by lane). */
+struct bal_kin_x2 {
+    bal_v2 delta, ndot, sdot;
+};
+
+static inline bal_v2 bal_v2_splat(double x) { return (bal_v2){x, x}; }
+/* the mask's lanes as bits 0 and 1 of an int, and whether any is set */
+static inline int bal_v2_bits(bal_v2m m) { return _mm_movemask_pd((__m128d)m); }
+static inline int bal_v2_any(bal_v2m m) { return bal_v2_bits(m) != 0; }
+static inline bal_v2 bal_v2_select(bal_v2m m, bal_v2 a, bal_v2 b)
+{
+    return (bal_v2)((m & (bal_v2m)a) | (~m & (bal_v2m)b));
+}
+static inline bal_v2m bal_v2_sign(void) { return (bal_v2m)bal_v2_splat(-0.0); }
+static inline bal_v2 bal_v2_abs(bal_v2 x) { return (bal_v2)(~bal_v2_sign() & (bal_v2m)x); }
+/* |mag| with the sign of sgn, as copysign */
+static inline bal_v2 bal_v2_copysign(bal_v2 mag, bal_v2 sgn)
+{
+    return (bal_v2)((~bal_v2_sign() & (bal_v2m)mag) | (bal_v2_sign() & (bal_v2m)sgn));
+}
+static inline bal_v2 bal_v2_sqrt(bal_v2 x) { return _mm_sqrt_pd(x); }
+static inline bal_v2 bal_v2_pow(bal_v2 x, double e) { return (bal_v2){pow(x[0], e), pow(x[1], e)}; }
+
+#define BAL_R bal_v2
+#define BAL_M bal_v2m
+#define BAL_KIN struct bal_kin_x2
+#define BAL_W(name) name##_x2
+#define BAL_SPLAT(x) bal_v2_splat(x)
+#define BAL_ANY(m) bal_v2_any(m)
+#define BAL_SELECT(m, a, b) bal_v2_select(m, a, b)
+#define BAL_ABS(x) bal_v2_abs(x)
+#define BAL_COPYSIGN(mag, sgn) bal_v2_copysign(mag, sgn)
+#define BAL_SQRT(x) bal_v2_sqrt(x)
+#define BAL_POW(x, e) bal_v2_pow(x, e)
+#include "laws_lanes.h"
+#undef BAL_R
+#undef BAL_M
+#undef BAL_KIN
+#undef BAL_W
+#undef BAL_SPLAT
+#undef BAL_ANY
+#undef BAL_SELECT
+#undef BAL_ABS
+#undef BAL_COPYSIGN
+#undef BAL_SQRT
+#undef BAL_POW
+#endif /* __SSE2__ */
+
 /* ---------------------------------------------------------------- normal */
 
-/* k_n δ0 (δ/δ0)^ν, with the common exponents written out (pow costs ten
- * times a product). */
-static inline double bal_law_power_force(double kn, double delta, double delta0, double nu)
-{
-    if (nu == 1.0)
-        return kn * delta;
-    if (nu == 1.5)
-        return kn * delta * sqrt(delta / delta0);
-    if (nu == 2.0)
-        return kn * delta * (delta / delta0);
-    return kn * delta0 * pow(delta / delta0, nu);
-}
-
-/* F_n at t_N from its history fn_prev (incremental law) or from δ. */
-static inline double bal_law_normal(const struct bal_law_params *P, const struct bal_pair_law *L,
-                                    const struct bal_kin *k, double fn_prev)
-{
-    if (P->normal_law == BAL_NORMAL_INCREMENTAL) {
-        const double fn = fn_prev + L->kn * k->ndot * P->dt;
-        return fn < 0 ? 0 : fn;
-    }
-    return bal_law_power_force(L->kn, k->delta, P->delta0, P->nu);
-}
+/* bal_law_power_force (k_n δ0 (δ/δ0)^ν) and bal_law_normal (F_n at t_N):
+ * laws_lanes.h, below. */
 
 /* The energy the normal spring stores: F_n²/(2 k_n) for the incremental law,
  * ∫ F_n dδ = k_n δ0² (δ/δ0)^(ν+1)/(ν+1) for the power law. */
@@ -125,6 +205,17 @@ static inline double bal_law_normal_energy(const struct bal_law_params *P,
     if (P->normal_law == BAL_NORMAL_INCREMENTAL)
         return fn * fn / (2 * L->kn);
     return L->kn * P->delta0 * P->delta0 * pow(delta / P->delta0, P->nu + 1) / (P->nu + 1);
+}
+
+/* The normal spring's tangent stiffness dF_n/dδ at δ/δ0 = ratio: k_n for the
+ * incremental law and the linear power law, ν k_n (δ/δ0)^(ν−1) otherwise.
+ * The stress servo's gain (walls.c) and the step estimate (timestep.c). */
+static inline double bal_law_normal_stiffness(const struct bal_law_params *P,
+                                              const struct bal_pair_law *L, double ratio)
+{
+    if (P->normal_law != BAL_NORMAL_POWER || P->nu == 1.0)
+        return L->kn;
+    return P->nu * L->kn * pow(ratio, P->nu - 1);
 }
 
 /* --------------------------------------------------------------- damping */
@@ -158,17 +249,18 @@ static inline double bal_law_shear_dashpot(const struct bal_pair_law *L, const s
 /* ------------------------------------------------------------ tangential */
 
 /* F_s at t_N from its history fs_prev, capped at the Coulomb limit of the
- * elastic F_n (eq. 19).  A capped spring gives up (|F_s| − F_max)/k_s of
- * slip against F_max: added to *lost; the contact is flagged sliding. */
+ * elastic F_n (eq. 19): bal_law_shear (laws_lanes.h, below), with the slip's
+ * loss F_max (|F_s| − F_max)/k_s added to *lost and the contact flagged
+ * sliding where the cap acts. */
 static inline double bal_law_tangential(const struct bal_law_params *P,
                                         const struct bal_pair_law *L, const struct bal_kin *k,
                                         double fn, double fs_prev, double *lost, uint8_t *flags)
 {
-    double fs = fs_prev + L->ks * k->sdot * P->dt;
-    const double fmax = fn * L->tan_phi + L->cohesion;
-    if (fabs(fs) > fmax) {
-        *lost += fmax * (fabs(fs) - fmax) / L->ks;
-        fs = copysign(fmax, fs);
+    double loss;
+    int slid;
+    const double fs = bal_law_shear(P, L, k, fn, fs_prev, &loss, &slid);
+    if (slid) {
+        *lost += loss;
         *flags |= BAL_PAIR_SLIDING;
     }
     return fs;

@@ -19,7 +19,7 @@
  * Dashpot forces of the last cycle: the disc–wall list stores them; the
  * disc–disc loop does not (16 bytes a candidate), so reports recompute them
  * from the geometry at t_N and the velocities the law read (integrate.c
- * recovers them), with the law's own expressions (contacts.c), as the cycle
+ * recovers them), with the law's own kernels (laws.h), as the cycle
  * computed them.
  *
  * Elastic energy: the energy stored in the contact springs.  For the
@@ -30,7 +30,6 @@
 #include <math.h>
 #include <string.h>
 
-#include "contacts.h"
 #include "integrate.h"
 #include "measure.h"
 #include "pairs.h"

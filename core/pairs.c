@@ -8,7 +8,7 @@
  * only when the scene needs it.  The disc–disc list numbers a pair by its
  * discs' array slots (i < j); the disc–wall list by the disc's slot and the
  * wall's index.  Columns grow only in a rebuild (grid.c), never in the
- * contact loops (contacts.c), which read and write them in place.
+ * contact loops (pair_loop.c, wall_loop.c), which read and write them in place.
  *
  * The disc–disc loop runs in chunks of BAL_PAIRS_CHUNK candidates and keeps
  * one friction sum per chunk (struct bal_par); that array is sized with the
@@ -111,34 +111,6 @@ long bal_pairs_find(const struct bal_pairs *p, uint64_t key)
     return lo < p->n && pair_key(p, lo) == key ? lo : -1;
 }
 
-/* Copy the history of every contact of `old` whose key is also in `fresh`.
- * Both lists are sorted by key, so one linear pass suffices.  Contacts of
- * `fresh` that are new start with zero history. */
-void bal_pairs_merge_history(struct bal_pairs *fresh, const struct bal_pairs *old)
-{
-    long a = 0;
-    for (long c = 0; c < fresh->n; c++) {
-        const uint64_t k = pair_key(fresh, c);
-        while (a < old->n && pair_key(old, a) < k)
-            a++;
-        const int same = a < old->n && pair_key(old, a) == k;
-        fresh->fn[c] = same ? old->fn[a] : 0;
-        fresh->flags[c] = same ? old->flags[a] : 0;
-        if (fresh->shear)
-            fresh->fs[c] = same ? old->fs[a] : 0;
-        if (fresh->damping) {
-            fresh->dn[c] = same ? old->dn[a] : 0;
-            fresh->ds[c] = same ? old->ds[a] : 0;
-        }
-        if (fresh->rolling) {
-            fresh->mr[c] = same ? old->mr[a] : 0;
-            fresh->tr[c] = same ? old->tr[a] : 0;
-            if (fresh->damping)
-                fresh->dm[c] = same ? old->dm[a] : 0;
-        }
-    }
-}
-
 long bal_pairs_find_contact(const struct bal_sim *s, int a_wall, int a, int b_wall, int b,
                             const struct bal_pairs **list)
 {
@@ -160,10 +132,9 @@ double bal_pairs_overlap(const struct bal_sim *s, int walls, long c, double *rmi
     const struct bal_pairs *p = walls ? &s->pw : &s->pp;
     const int i = p->i[c], j = p->j[c];
     if (walls) {
-        double cx, cy;
         *rmin = s->r[i];
         *law = &s->law[s->mat[i] * s->n_mat + s->walls[j].material];
-        return s->r[i] - sqrt(bal_walls_closest(&s->walls[j], s->x[i], s->y[i], &cx, &cy));
+        return bal_walls_overlap(&s->walls[j], s->x[i], s->y[i], s->r[i]);
     }
     *rmin = fmin(s->r[i], s->r[j]);
     *law = &s->law[s->mat[i] * s->n_mat + s->mat[j]];

@@ -10,7 +10,7 @@
 
 #include "state.h"
 
-/* Candidates per chunk of the disc–disc loop (contacts.c), each chunk with
+/* Candidates per chunk of the disc–disc loop (pair_loop.c), each chunk with
  * its own friction sum (par.chunk_sums). */
 #define BAL_PAIRS_CHUNK 256
 
@@ -26,9 +26,6 @@ void bal_pairs_free(struct bal_pairs *p);
 enum bal_status bal_pairs_reserve_chunks(struct bal_sim *s);
 /* Position of `key` in the sorted list p, or -1 (binary search). */
 long bal_pairs_find(const struct bal_pairs *p, uint64_t key);
-/* Copy the history of the pairs of `old` that are also in `fresh`; the new
- * ones start from zero (one linear pass over both sorted lists). */
-void bal_pairs_merge_history(struct bal_pairs *fresh, const struct bal_pairs *old);
 
 /* Candidate index of the contact between two bodies (for each, whether it
  * is a wall and its slot or index), or -1; *list receives its list. */

@@ -16,8 +16,8 @@
  *                  (walls.c); are the candidate lists still whole (grid.c)?
  *   2. neighbours  rebuild them if the skin is used up, now and then
  *                  re-sorting the discs into cell order (grid.c)
- *   3. contacts    force–displacement law at t_N from v_{N−1/2} (contacts.c)
- *   4. walls       the disc–wall contacts (contacts.c); their work (energy.c);
+ *   3. contacts    force–displacement law at t_N from v_{N−1/2} (pair_loop.c)
+ *   4. walls       the disc–wall contacts (wall_loop.c); their work (energy.c);
  *                  each wall's controller sets its next velocity (walls.c)
  *   5. motion      v_{N+1/2} from the force sums (integrate.c)
  *   6. audit       the losses of this cycle; the overlap guard (energy.c)
@@ -41,13 +41,14 @@
 #include <time.h>
 
 #include "build.h"
-#include "contacts.h"
 #include "energy.h"
 #include "grid.h"
 #include "integrate.h"
 #include "measure.h"
 #include "pairs.h"
 #include "specimen.h"
+#include "threads.h"
+#include "wall_loop.h"
 #include "walls.h"
 
 /* How often (in cycles) the run checks that the state is finite between
@@ -119,7 +120,7 @@ void bal_sim_free(struct bal_sim *s)
     bal_pairs_free(&s->pw);
     bal_grid_scratch_free(&s->rs);
     bal_integrate_free(s);
-    bal_par_free(&s->par);
+    bal_threads_free(&s->par);
     free(s);
 }
 
@@ -191,7 +192,7 @@ static enum bal_status cycle(struct bal_sim *s, struct bal_error *err)
     s->timers.contacts += t1 - t0;
     /* 4. walls: their contacts, the work of their motion, then their
      * controllers set the velocity of their next move */
-    bal_contacts_walls(s);
+    bal_wall_loop_run(s);
     bal_energy_walls(s);
     bal_walls_control(s);
     t0 = seconds_now();

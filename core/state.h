@@ -3,7 +3,7 @@
  * parts, with the few inline helpers that read it.  Every module of the
  * step includes it; it has no functions of its own to call, so it sits
  * below them all.  The behaviour lives in the modules, each with its own
- * header (pairs.h, grid.h, contacts.h, walls.h, integrate.h, ...).  Not
+ * header (pairs.h, grid.h, pair_loop.h, wall_loop.h, walls.h, ...).  Not
  * part of the public API; the Check tests and the benchmark include it.
  *
  * Layout.  Discs are struct-of-arrays in cell order: sorted along a
@@ -21,10 +21,12 @@
  * Contacts.  Two flat candidate lists, disc–disc and disc–wall, each sorted
  * by key = (lo << 32) | hi (pair_key(); not stored: it is i and j).  A
  * candidate carries the contact's history (F_n for the incremental law,
- * F_s) in parallel arrays; a candidate whose bodies do not overlap has zero
- * history.  When the neighbour list is rebuilt, the new candidate list is
- * merged with the old one in one linear pass, so history survives rebuilds
- * (pairs.c, grid.c).
+ * F_s, the rolling M and θ_r; the wall list also its dashpot forces) in
+ * parallel arrays, each only where the scene needs it; a candidate whose
+ * bodies do not overlap has zero history.  The contact loops (pair_loop.c,
+ * wall_loop.c) read and write them in place; when the neighbour list is
+ * rebuilt, the new candidate list is merged with the old one in one linear
+ * pass, so history survives rebuilds (grid.c, install: the only merge).
  */
 #ifndef BAL_STATE_H
 #define BAL_STATE_H
@@ -100,7 +102,10 @@ struct bal_wall {
     double fn_s_sum;       /* Σ F_n s, s = position of the contact along e from P */
     double dash_f[2], dash_m; /* the contact dashpots' share of f and of the moment about P
                             * (only in damped scenes, and in stages with a controller
-                            * acting every cycle: contacts.c) */
+                            * acting every cycle: wall_loop.c) */
+    double stiffness;      /* Σ dF_n/dδ of its contacts (laws.h, bal_law_normal_stiffness):
+                            * the servo's K (only in stages with a controller acting every
+                            * cycle: wall_loop.c; at a servo's start, walls.c) */
     double disp;           /* largest displacement of any of its points since rebuild */
     double f_prev[2], moment_prev; /* f and moment of the cycle before (energy audit) */
 };
@@ -180,7 +185,7 @@ struct bal_probe_ref {
 };
 
 /* Several threads in one cycle (OpenMP), with results bitwise those of one
- * thread (contacts.c, integrate.c):
+ * thread (pair_loop.c and threads.c, integrate.c):
  * - the disc–disc list is cut into ranges of whole chunks, one per thread.
  *   Range t adds directly to the sums of the discs above zone[t], the
  *   highest j of the ranges before it, which no earlier range touches; what
@@ -205,10 +210,13 @@ struct bal_par {
     struct bal_sum_log *log[BAL_MAX_THREADS];
     long log_n[BAL_MAX_THREADS], log_cap[BAL_MAX_THREADS];
     double *chunk_sums;          /* per chunk of candidates: the friction loss */
-    int32_t *chunk_top;          /* per chunk: its highest j (bal_par_plan, once a list) */
+    int32_t *chunk_top;          /* per chunk: its highest j (bal_threads_plan, once a list) */
     double *chunk_roll;          /* ... and the rolling loss (only with rolling) */
     long chunk_cap;
     double *block_sums;          /* per block of discs, 2 each: a pass's sums (integrate.c) */
+    int one_lane;                /* 1: the pair loop runs every contact one at a time, never
+                                  * two (tests compare the widths; pair_loop.c) */
+    long two_lane[BAL_MAX_THREADS]; /* contacts range t has run two at a time, since creation */
 };
 #define BAL_DISC_BLOCK 4096          /* discs per block */
 

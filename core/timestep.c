@@ -173,22 +173,22 @@ static int list_add(struct dt_list *l, int a, int b, int wall_mat, double nx, do
     return 0;
 }
 
-/* The normal stiffness of a pair.  For the power law, dF/dδ = ν k_n (δ/δ0)^(ν−1):
- * taken at δ = δ0 unless the scene's energy bounds the overlap.  In a scene
- * that nothing feeds (no gravity, no moving wall, no overlap at the start)
- * no contact can store more than the kinetic energy E at the start, so
+/* The normal stiffness of a pair: its tangent stiffness dF/dδ (laws.h; for
+ * the power law ν k_n (δ/δ0)^(ν−1)) taken at δ = δ0 unless the scene's
+ * energy bounds the overlap.  In a scene that nothing feeds (no gravity, no
+ * moving wall, no overlap at the start) no contact can store more than the
+ * kinetic energy E at the start, so
  * k_n δ0² (δ/δ0)^(ν+1)/(ν+1) ≤ E bounds δ/δ0 — below 1 for a gentle
  * collision (the estimate was 3 times too cautious for the catalogue's
  * Hertz collisions), above 1 for a violent one (where δ0 was unsafe). */
 static double pair_kn(const struct bal_sim *s, const struct bal_pair_law *L)
 {
-    if (s->normal_law != BAL_NORMAL_POWER)
-        return L->kn;
     double ratio = 1;
-    if (s->nu != 1 && s->start_energy > 0)
+    if (s->normal_law == BAL_NORMAL_POWER && s->nu != 1 && s->start_energy > 0)
         ratio = pow((s->nu + 1) * s->start_energy / (L->kn * s->delta0 * s->delta0),
                     1 / (s->nu + 1));
-    return s->nu * L->kn * pow(ratio, s->nu - 1);
+    const struct bal_law_params P = bal_law_params_of(s);
+    return bal_law_normal_stiffness(&P, L, ratio);
 }
 
 static double pair_beta(const struct bal_sim *s, const struct bal_pair_law *L)

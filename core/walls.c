@@ -18,7 +18,7 @@
  * wall, as settings.integrator chooses a law of motion).  When the stage
  * begins, `start` takes the parameters of the wall's line; a wall the stage
  * does not name is at rest and has no controller.  In every cycle, once
- * the discs' forces on the walls are known (bal_contacts_walls) and the
+ * the discs' forces on the walls are known (bal_wall_loop_run) and the
  * audit has priced this cycle's wall motion with the velocity it moved with
  * (bal_energy_walls), bal_walls_control lets each controller with a
  * `control` function set its wall's V and ω for the next cycle; the next
@@ -47,7 +47,8 @@
  *                discs with the speed
  *                  v = α (σ_t − σ) L / (K Δt),   |v| ≤ vmax,
  *                K = Σ k_n of its touching contacts (the tangent stiffness
- *                ν k_n (δ/δ0)^(ν−1) under the power law).  A wall with no
+ *                ν k_n (δ/δ0)^(ν−1) under the power law, laws.h), summed by
+ *                the wall loop (wall_loop.c) with the force.  A wall with no
  *                contact (K = 0, σ = 0) approaches at vmax; vmax = 0 takes
  *                BAL_SERVO_CAP_SHARE of the smallest radius per step.
  *                Stability.  Take the wall as a massless controller on
@@ -110,9 +111,9 @@
  *      parameters (at validation, with the line's key), `start` takes them
  *      from w->move when the stage begins (the other walls are resolved in
  *      w->other), `control` sets w->v and w->omega from the wall's
- *      resultant of this cycle (w->f, w->moment, w->fn_sum), its state
- *      (w->p, w->alpha) and the simulation's (s->dt, the other walls, the
- *      contacts).  Per-wall state it keeps between cycles is a field of
+ *      resultant of this cycle (w->f, w->moment, w->fn_sum, w->stiffness:
+ *      wall_loop.c), its state (w->p, w->alpha) and the simulation's
+ *      (s->dt, the other walls, the contacts).  Per-wall state it keeps between cycles is a field of
  *      struct bal_wall (state.h).
  * Walls that never move pay nothing: the stage leaves them without a
  * controller, bal_walls_move skips a wall at rest, and a stage in which no
@@ -130,7 +131,6 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "pairs.h"
 #include "scene_keys.h"
 #include "walls.h"
 
@@ -179,6 +179,12 @@ double bal_walls_step(const struct bal_wall *w, double vx, double vy, double ome
 {
     const double hmax = fmax(fabs(w->h1), fabs(w->h2));
     return hypot(vx, vy) * dt + fabs(omega) * hmax * dt;
+}
+
+double bal_walls_overlap(const struct bal_wall *w, double x, double y, double r)
+{
+    double cx, cy;
+    return r - sqrt(bal_walls_closest(w, x, y, &cx, &cy));
 }
 
 double bal_walls_normal(const struct bal_wall *w, double x, double y, double *ex, double *ey)
@@ -298,11 +304,13 @@ double bal_walls_gap(const struct bal_wall *a, const struct bal_wall *b, double 
 #define BAL_SERVO_CAP_SHARE 1e-3
 
 /* servo: the stress its contacts bear over its span, and the speed that
- * removes the share `gain` of the error in one cycle (the header). */
+ * removes the share `gain` of the error in one cycle (the header).  K is
+ * w->stiffness: in every cycle of the stage the wall loop's (wall_loop.c),
+ * which visits each of the wall's contacts anyway; when the stage begins,
+ * contact_stiffness's. */
 static void servo_control(struct bal_sim *s, struct bal_wall *w)
 {
     const struct bal_move_def *mv = w->move;
-    const int k = (int)(w - s->walls);
     const double span = bal_walls_gap(&s->walls[w->other[0]], &s->walls[w->other[1]], NULL);
     if (!span_ok(s, span))
         trip(s, w, BAL_WALL_FAULT_SPAN); /* the span walls closed on each other */
@@ -310,23 +318,7 @@ static void servo_control(struct bal_sim *s, struct bal_wall *w)
      * within the cycle (the header), and vanishes at rest. */
     const double force = -((w->f[0] - w->dash_f[0]) * w->toward[0] +
                            (w->f[1] - w->dash_f[1]) * w->toward[1]);
-    double stiffness = 0;
-    const struct bal_pairs *p = &s->pw;
-    for (long c = 0; c < p->n; c++) {
-        if (p->j[c] != k || !(p->flags[c] & BAL_PAIR_TOUCHING))
-            continue;
-        /* The overlap with this wall, from the wall's own geometry (the
-         * same arithmetic as bal_pairs_overlap, without calling back up
-         * into pairs.c, which calls bal_walls_closest). */
-        const int i = p->i[c];
-        double cx, cy;
-        const double delta = s->r[i] - sqrt(bal_walls_closest(w, s->x[i], s->y[i], &cx, &cy));
-        const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + w->material];
-        /* dF_n/dδ: k_n, or ν k_n (δ/δ0)^(ν−1) under the power law */
-        stiffness += s->normal_law == BAL_NORMAL_POWER && s->nu != 1.0
-                         ? s->nu * L->kn * pow(fmax(delta, 0) / s->delta0, s->nu - 1)
-                         : L->kn;
-    }
+    const double stiffness = w->stiffness;
     w->stress = span > 0 ? force / span : 0;
     w->stress_error = fabs(w->stress - mv->sigma) / mv->sigma;
     double speed = w->vcap; /* no contact: approach at the cap */
@@ -336,6 +328,27 @@ static void servo_control(struct bal_sim *s, struct bal_wall *w)
     w->v[0] = speed * w->toward[0];
     w->v[1] = speed * w->toward[1];
     w->omega = 0;
+}
+
+/* Σ dF_n/dδ of wall w's touching contacts (flagged by the last wall loop),
+ * at their overlaps now, in the list's order, as the wall loop sums it: for
+ * a servo's first speed, before any cycle of its stage has run the wall
+ * loop with it. */
+static double contact_stiffness(const struct bal_sim *s, const struct bal_wall *w)
+{
+    const int k = (int)(w - s->walls);
+    const struct bal_law_params P = bal_law_params_of(s);
+    const struct bal_pairs *p = &s->pw;
+    double stiffness = 0;
+    for (long c = 0; c < p->n; c++) {
+        if (p->j[c] != k || !(p->flags[c] & BAL_PAIR_TOUCHING))
+            continue;
+        const int i = p->i[c];
+        const double delta = bal_walls_overlap(w, s->x[i], s->y[i], s->r[i]);
+        const struct bal_pair_law *L = &s->law[s->mat[i] * s->n_mat + w->material];
+        stiffness += bal_law_normal_stiffness(&P, L, fmax(delta, 0) / P.delta0);
+    }
+    return stiffness;
 }
 
 static void servo_start(struct bal_sim *s, struct bal_wall *w)
@@ -354,6 +367,7 @@ static void servo_start(struct bal_sim *s, struct bal_wall *w)
     w->toward[1] = side < 0 ? -ny : ny;
     w->vcap = w->move->vmax > 0 ? w->move->vmax : BAL_SERVO_CAP_SHARE * s->r_min / s->dt;
     w->stress_error = INFINITY;
+    w->stiffness = contact_stiffness(s, w);
     servo_control(s, w);
 }
 

@@ -11,6 +11,9 @@
 
 /* Closest point of wall w to (x, y); returns squared distance. */
 double bal_walls_closest(const struct bal_wall *w, double x, double y, double *cx, double *cy);
+/* The overlap of a disc of radius r at (x, y) with wall w: r less the
+ * distance to the wall's closest point (negative: a gap). */
+double bal_walls_overlap(const struct bal_wall *w, double x, double y, double r);
 /* Unit normal from (x, y) to the closest point of wall w (the wall's own
  * normal when the point lies on it); returns the distance. */
 double bal_walls_normal(const struct bal_wall *w, double x, double y, double *ex, double *ey);
@@ -68,7 +71,7 @@ enum bal_status bal_walls_fault(const struct bal_sim *s, struct bal_error *err);
 /* Stage g begins: each wall it names gets its controller and parameters;
  * the others are at rest, with none. */
 void bal_walls_stage(struct bal_sim *s, const struct bal_stage_def *g);
-/* After the wall forces of the cycle (bal_contacts_walls) and the audit of
+/* After the wall forces of the cycle (bal_wall_loop_run) and the audit of
  * the walls' work (bal_energy_walls): every controller that acts per cycle
  * sets its wall's velocity for the next cycle. */
 void bal_walls_control(struct bal_sim *s);

@@ -28,7 +28,7 @@ Phases (callgrind's inclusive cost of the functions cycle() calls, sim.c):
   positions:  bal_integrate_positions, bal_walls_move, bal_grid_due
   neighbours: bal_grid_rebuild, bal_grid_reorder, bal_integrate_reordered
   contacts:   the pair loop (loop_pow_s for these scenes, any loop_* found)
-  walls:      bal_contacts_walls, bal_energy_walls, bal_walls_control
+  walls:      bal_wall_loop_run, bal_energy_walls, bal_walls_control
   velocities: bal_integrate_velocities
   outputs:    the rest of the collected cycles (the energy audit of every
               cycle, bal_energy_guard every 256 cycles, the phase timers)
@@ -66,7 +66,7 @@ PHASES = {
     "positions": ["bal_integrate_positions", "bal_walls_move", "bal_grid_due"],
     "neighbours": ["bal_grid_rebuild", "bal_grid_reorder", "bal_integrate_reordered"],
     "contacts": [],   # loop_* (the pair loop variant), found by name
-    "walls": ["bal_contacts_walls", "bal_energy_walls", "bal_walls_control"],
+    "walls": ["bal_wall_loop_run", "bal_energy_walls", "bal_walls_control"],
     "velocities": ["bal_integrate_velocities"],
 }
 TIMERS = ["positions", "neighbours", "contacts", "walls", "velocities"]
@@ -191,7 +191,7 @@ def fmt(x, digits=3):
     return f"{x:.{digits}g}"
 
 
-# Floating-point operations of the pair loop of these scenes (loop_pow_s, contacts.c and
+# Floating-point operations of the pair loop of these scenes (loop_pow_s, pair_loop.c and
 # laws.h, counted from the C source; -ffp-contract=off and no -ffast-math keep every one):
 #   every candidate pair: dx, dy, r_i + r_j, dx^2 + dy^2, (r_i + r_j)^2        7
 #   every contact: sqrt 1, e = d/D 2 div, v_i - v_j 2, delta 1, F_n = k_n delta 1,

@@ -920,13 +920,13 @@ START_TEST(contacts_one_material_law)
 }
 END_TEST
 
-/* The same comparison for the loop that runs two contacts at a time with
- * SSE2 (contacts.c, linear_shear_pairs: power law with nu = 1, tangential
- * spring, no damping, one material): one material takes it, the twin
- * materials the general scalar loop, and positions, velocities, force
- * sums, every contact's F_n, F_s and flags and the friction loss of the
- * energy audit must agree bit for bit, through contacts that slide (the
- * scene of the test above, undamped and with the linear power law). */
+/* The same comparison for the loop that runs two contacts at a time
+ * (pair_loop.c, two_at_a_time: power law with nu = 1, tangential spring, no
+ * damping, one material): one material takes it, the twin materials the
+ * general one-contact loop, and positions, velocities, force sums, every
+ * contact's F_n, F_s and flags and the friction loss of the energy audit
+ * must agree bit for bit, through contacts that slide (the scene of the
+ * test above, undamped and with the linear power law). */
 START_TEST(contacts_pairs_of_contacts_match_the_scalar_law)
 {
     struct tfx *one = tfx_newf("one", one_mat_fmt, "normal_law = power\nnu = 1");
@@ -957,6 +957,176 @@ START_TEST(contacts_pairs_of_contacts_match_the_scalar_law)
     ck_assert(memcmp(a->pp.flags, b->pp.flags, (size_t)a->pp.n) == 0);
     ck_assert(memcmp(&a->audit.d_friction, &b->audit.d_friction, sizeof(double)) == 0);
     ck_assert(a->audit.d_friction > 0);
+}
+END_TEST
+
+/* ------------------------------------------------------------------ */
+/* The two widths of the pair loop                                     */
+/* ------------------------------------------------------------------ */
+
+/* Every array a cycle writes, byte for byte, in two simulations of the same
+ * scene; `what` names them in a failure. */
+static void same_state(const struct bal_sim *a, const struct bal_sim *b, const char *what)
+{
+    const size_t n = (size_t)a->n * sizeof(double);
+    ck_assert_int_eq(a->n, b->n);
+    ck_assert_msg(memcmp(a->x, b->x, n) == 0 && memcmp(a->y, b->y, n) == 0 &&
+                      memcmp(a->th, b->th, n) == 0, "%s: positions differ", what);
+    ck_assert_msg(memcmp(a->vx, b->vx, n) == 0 && memcmp(a->vy, b->vy, n) == 0 &&
+                      memcmp(a->w, b->w, n) == 0, "%s: velocities differ", what);
+    ck_assert_msg(memcmp(a->f, b->f, 3 * n) == 0, "%s: force sums differ", what);
+    if (a->dash)
+        ck_assert_msg(memcmp(a->dash, b->dash, 3 * (size_t)a->n * sizeof(float)) == 0,
+                      "%s: dashpot sums differ", what);
+    ck_assert_int_eq(a->pp.n, b->pp.n);
+    const size_t m = (size_t)a->pp.n * sizeof(double);
+    ck_assert_msg(memcmp(a->pp.fn, b->pp.fn, m) == 0, "%s: F_n history differs", what);
+    if (a->pp.fs)
+        ck_assert_msg(memcmp(a->pp.fs, b->pp.fs, m) == 0, "%s: F_s history differs", what);
+    if (a->pp.mr)
+        ck_assert_msg(memcmp(a->pp.mr, b->pp.mr, m) == 0 && memcmp(a->pp.tr, b->pp.tr, m) == 0,
+                      "%s: rolling history differs", what);
+    ck_assert_msg(memcmp(a->pp.flags, b->pp.flags, (size_t)a->pp.n) == 0, "%s: flags differ",
+                  what);
+    ck_assert_msg(memcmp(&a->audit, &b->audit, sizeof a->audit) == 0,
+                  "%s: the energy audit's sums differ", what);
+}
+
+/* Contacts the pair loop has run two at a time since creation. */
+static long two_lane(const struct bal_sim *s)
+{
+    long n = 0;
+    for (int t = 0; t < BAL_MAX_THREADS; t++)
+        n += s->par.two_lane[t];
+    return n;
+}
+
+/* A falling packing of 400 discs in a box (the one of contacts_one_material_law): the
+ * settings (normal law, dashpots), the grains' friction, cohesion and rolling δ. */
+static const char *const widths_fmt =
+    "[settings]\ndt = 5e-4\ngravity = 0 -60\n%s\n"
+    "[material grain]\nkn = 1e5\nks = 7e4\nfriction = %g\ncohesion = %g\ndensity = 1\n"
+    "rolling = %g\n"
+    "[material box]\nkn = 3e5\nks = 1e5\nfriction = 0.2\n"
+    "[fill pack]\nn = 400\ncolumns = 20\nrmin = 0.5\nrmax = 0.75\nseed = 3\nbox = 1\n"
+    "headroom = 2\nvmax = 2\nmaterial = grain\nwall_material = box\n[stage s]\ncycles = 100000\n";
+
+/* The scene run WIDTHS_CYCLES cycles, with the loop's widest width allowed
+ * (one_lane = 0) or one contact at a time (one_lane = 1). */
+#define WIDTHS_CYCLES 1200
+static struct tfx *run_width(const char *settings, double friction, double cohesion,
+                             double rolling, int one_lane)
+{
+    struct tfx *f = tfx_newf("widths", widths_fmt, settings, friction, cohesion, rolling);
+    f->sim->par.one_lane = one_lane;
+    t_steps(f, WIDTHS_CYCLES);
+    return f;
+}
+
+/* Every variant of the disc–disc loop (pair_loop.c: the normal law ×
+ * tangential × damping × rolling, twelve, and the general power law of one
+ * of them) runs the packing with two contacts at a time allowed and with
+ * one at a time (par.one_lane), and every array the cycle writes must agree
+ * byte for byte: where a variant has a two-lane path its kernels (the _x2
+ * twins of laws_lanes.h) and its kinematics must give the one-contact bits.
+ * The variants that have one are the ones the table below says: today the
+ * linear power law with the tangential spring alone (two_at_a_time) — it
+ * must run contacts two at a time (not vacuous), and the others never. */
+START_TEST(contacts_every_variant_same_at_both_widths)
+{
+    static const struct {
+        const char *name, *settings;
+        double friction, cohesion, rolling;
+        int two_lanes; /* the variant runs contacts two at a time */
+    } variants[] = {
+        {"inc", "normal_law = incremental\nbeta = 0", 0, 0, 0, 0},
+        {"pow", "normal_law = power\nnu = 1\nbeta = 0", 0, 0, 0, 0},
+        {"inc_s", "normal_law = incremental\nbeta = 0", 0.4, 3, 0, 0},
+        {"pow_s", "normal_law = power\nnu = 1\nbeta = 0", 0.4, 3, 0, 1},
+        {"pow_s nu = 1.5", "normal_law = power\nnu = 1.5\ndelta0 = 0.05\nbeta = 0", 0.4, 3, 0, 0},
+        {"inc_d", "normal_law = incremental\nbeta = 0.01", 0, 0, 0, 0},
+        {"pow_d", "normal_law = power\nnu = 1\nbeta = 0.01", 0, 0, 0, 0},
+        {"inc_sd", "normal_law = incremental\nbeta = 0.01", 0.4, 3, 0, 0},
+        {"pow_sd", "normal_law = power\nnu = 1\nbeta = 0.01", 0.4, 3, 0, 0},
+        {"inc_sr", "normal_law = incremental\nbeta = 0", 0.4, 3, 0.5, 0},
+        {"pow_sr", "normal_law = power\nnu = 1\nbeta = 0", 0.4, 3, 0.5, 0},
+        {"inc_sdr", "normal_law = incremental\nbeta = 0.01", 0.4, 3, 0.5, 0},
+        {"pow_sdr", "normal_law = power\nnu = 1\nbeta = 0.01", 0.4, 3, 0.5, 0},
+    };
+    for (size_t v = 0; v < sizeof variants / sizeof variants[0]; v++) {
+        struct tfx *wide = run_width(variants[v].settings, variants[v].friction,
+                                     variants[v].cohesion, variants[v].rolling, 0);
+        struct tfx *one = run_width(variants[v].settings, variants[v].friction,
+                                    variants[v].cohesion, variants[v].rolling, 1);
+        const struct bal_sim *a = wide->sim, *b = one->sim;
+        long contacts = 0, sliding = 0;
+        for (long c = 0; c < a->pp.n; c++) {
+            contacts += (a->pp.flags[c] & BAL_PAIR_TOUCHING) != 0;
+            sliding += (a->pp.flags[c] & BAL_PAIR_SLIDING) != 0;
+        }
+        ck_assert_msg(contacts > 200, "%s: %ld contacts: the discs must collide",
+                      variants[v].name, contacts);
+        if (variants[v].friction > 0)
+            ck_assert_msg(sliding > 0, "%s: no contact slides", variants[v].name);
+        ck_assert_int_eq(two_lane(b), 0);
+        if (variants[v].two_lanes)
+            ck_assert_msg(two_lane(a) > 100L * WIDTHS_CYCLES,
+                          "%s: %ld contacts two at a time: the two-lane path did not run",
+                          variants[v].name, two_lane(a));
+        else
+            ck_assert_msg(two_lane(a) == 0, "%s: ran %ld contacts two at a time",
+                          variants[v].name, two_lane(a));
+        same_state(a, b, variants[v].name);
+        tfx_release(wide);
+        tfx_release(one);
+    }
+}
+END_TEST
+
+/* The scene text of a file of the catalogue (the tests run in core/tests). */
+static struct tfx *case_scene(const char *path)
+{
+    FILE *fp = fopen(path, "r");
+    ck_assert_msg(fp != NULL, "cannot open %s", path);
+    static char text[T_TEXT_MAX];
+    const size_t n = fread(text, 1, sizeof text - 1, fp);
+    const int whole = feof(fp);
+    fclose(fp);
+    ck_assert_msg(whole, "%s is longer than %d bytes", path, T_TEXT_MAX - 1);
+    text[n] = 0;
+    return tfx_new(text, path);
+}
+
+/* The catalogue's case `coulomb` (cases/coulomb, reference/coulomb.ref)
+ * checks the Coulomb cap on the loop that runs two contacts at a time, so
+ * that a change to the tangential kernel fails the quick tier on that
+ * path: its two scenes must run that path — nearly all of their contacts
+ * two at a time — and give the bits of the one-contact loop. */
+START_TEST(contacts_coulomb_case_runs_two_at_a_time)
+{
+    static const struct {
+        const char *path;
+        long cycles, least_two_lane; /* the scene's cycles; contacts two at a time, at least */
+    } scenes[] = {
+        /* b's two contacts in every cycle */
+        {"../../cases/coulomb/spin.scene", 1000, 2 * 1000},
+        /* measured 339 376 of its 343 782 contact-cycles (the odd contact of a chunk runs
+         * alone) */
+        {"../../cases/coulomb/packing.scene", 6000, 300000},
+    };
+    for (size_t k = 0; k < sizeof scenes / sizeof scenes[0]; k++) {
+        struct tfx *wide = case_scene(scenes[k].path);
+        struct tfx *one = case_scene(scenes[k].path);
+        one->sim->par.one_lane = 1;
+        t_steps(wide, scenes[k].cycles);
+        t_steps(one, scenes[k].cycles);
+        ck_assert_msg(two_lane(wide->sim) >= scenes[k].least_two_lane,
+                      "%s: %ld contacts two at a time", scenes[k].path, two_lane(wide->sim));
+        ck_assert_int_eq(two_lane(one->sim), 0);
+        same_state(wide->sim, one->sim, scenes[k].path);
+        tfx_release(wide);
+        tfx_release(one);
+    }
 }
 END_TEST
 
@@ -1028,6 +1198,8 @@ Suite *suite_contacts(void)
     tcase_add_test(tc, contacts_sums_restart_each_cycle);
     tcase_add_test(tc, contacts_one_material_law);
     tcase_add_test(tc, contacts_pairs_of_contacts_match_the_scalar_law);
+    tcase_add_test(tc, contacts_every_variant_same_at_both_widths);
+    tcase_add_test(tc, contacts_coulomb_case_runs_two_at_a_time);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("friction");

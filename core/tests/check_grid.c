@@ -1,7 +1,7 @@
 /*
  * check_grid.c — suite "grid": the neighbour search (grid.c) and the
- * contact history that the candidate lists carry across rebuilds
- * (contacts.c, bal_pairs_merge_history).
+ * contact history that the candidate lists carry across rebuilds and
+ * re-sorts (grid.c, install).
  *
  * With the cell grid, disc–disc candidates are the pairs whose gap is below
  * the Verlet skin at the last rebuild, disc–wall candidates likewise; the
@@ -402,60 +402,175 @@ START_TEST(grid_head_on_contact_not_missed)
 }
 END_TEST
 
-/* bal_pairs_merge_history on hand-made lists: keys present in the old
- * list keep their history, new keys start from zero. */
-START_TEST(grid_merge_history)
+/* The history a rebuild carries over (grid.c, install: each new pair finds
+ * itself in the old list, and every column is gathered from there).  A
+ * packing with every history column (friction: F_s; rolling: M, θ_r; the
+ * wall list also keeps the dashpots D_n, D_s, M_d) gets a distinct marker
+ * in every column of every candidate, derived from the pair's scene ids;
+ * then discs swap places, so that some pairs leave the lists and others
+ * join, and the lists are rebuilt: a pair that was a candidate keeps its
+ * markers in every column and its flags, a new one starts from zero.  Then
+ * a re-sort (bal_grid_reorder) renumbers the discs: the markers follow the
+ * pairs through the permutation, and the oriented rolling history changes
+ * sign where the pair's two discs swapped order. */
+static const char *const carry_scene =
+    "[settings]\ngrid = on\ngravity = 0 -60\ndt = 0.0005\nbeta = 0.01\n"
+    "[material g]\nkn = 1e5\nks = 0.8e5\nfriction = 0.5\ndensity = 1\nrolling = 0.5\n"
+    "[material w]\nkn = 1e5\nks = 1e5\nfriction = 0.3\n"
+    "[fill pack]\nn = 200\ncolumns = 20\nrmin = 0.5\nrmax = 0.75\nseed = 11\nbox = 1\n"
+    "headroom = 1\nmaterial = g\nwall_material = w\n[stage s]\ncycles = 1\n";
+
+/* The marker of column `col` for the pair of scene ids (a, b) (a wall: b is
+ * its index plus 100 000), oriented: (b, a) gives its negative. */
+static double marker(int a, int b, int col)
 {
-    struct bal_pairs old = {0}, fresh = {0};
-    /* Lists with every optional column, as a frictional, damped scene has. */
-    old.shear = old.damping = fresh.shear = fresh.damping = 1;
-    int ok = bal_pairs_reserve(&old, 4) == BAL_OK && bal_pairs_reserve(&fresh, 4) == BAL_OK;
-    const uint64_t ko[3] = {(0ull << 32) | 1, (0ull << 32) | 3, (2ull << 32) | 5};
-    const uint64_t kf[4] = {(0ull << 32) | 1, (1ull << 32) | 2, (2ull << 32) | 5, (3ull << 32) | 4};
-    double fn[4] = {0}, fs[4] = {0}, ds[4] = {0};
-    int flags[4] = {0};
-    if (ok) {
-        old.n = 3;
-        for (int c = 0; c < 3; c++) {
-            old.i[c] = (int32_t)(ko[c] >> 32);
-            old.j[c] = (int32_t)(ko[c] & 0xffffffffu);
-            old.fn[c] = 1.25 + c;
-            old.fs[c] = -0.375 - c;
-            old.dn[c] = 0.0625 * c;
-            old.ds[c] = 0.5 + c;
-            old.flags[c] = (uint8_t)(c == 2 ? 3 : 1);
-        }
-        fresh.n = 4;
-        for (int c = 0; c < 4; c++) {
-            fresh.i[c] = (int32_t)(kf[c] >> 32);
-            fresh.j[c] = (int32_t)(kf[c] & 0xffffffffu);
-            fresh.fn[c] = fresh.fs[c] = fresh.dn[c] = fresh.ds[c] = 99; /* garbage */
-            fresh.flags[c] = 7;
-        }
-        bal_pairs_merge_history(&fresh, &old);
-        for (int c = 0; c < 4; c++) {
-            fn[c] = fresh.fn[c];
-            fs[c] = fresh.fs[c];
-            ds[c] = fresh.ds[c];
-            flags[c] = fresh.flags[c];
+    const double m = 1 + (a < b ? a : b) * 1000.0 + (a < b ? b : a) + col * 1e8;
+    return a < b ? m : -m;
+}
+
+/* The scene ids of candidate c of list p (walls: 100 000 + the wall). */
+static void pair_ids(const struct bal_sim *s, const struct bal_pairs *p, int walls, long c,
+                     int *a, int *b)
+{
+    *a = s->id[p->i[c]];
+    *b = walls ? 100000 + p->j[c] : s->id[p->j[c]];
+}
+
+/* Mark every column of every candidate of both lists. */
+static void mark(struct bal_sim *s)
+{
+    for (int walls = 0; walls < 2; walls++) {
+        struct bal_pairs *p = walls ? &s->pw : &s->pp;
+        for (long c = 0; c < p->n; c++) {
+            int a, b;
+            pair_ids(s, p, walls, c, &a, &b);
+            p->fn[c] = marker(a, b, 1);
+            p->fs[c] = marker(a, b, 2);
+            p->mr[c] = marker(a, b, 3);
+            p->tr[c] = marker(a, b, 4);
+            if (p->damping) {
+                p->dn[c] = marker(a, b, 5);
+                p->ds[c] = marker(a, b, 6);
+                p->dm[c] = marker(a, b, 7);
+            }
+            p->flags[c] = (uint8_t)(1 + (a + b) % 15);
         }
     }
-    bal_pairs_free(&old);
-    bal_pairs_free(&fresh);
-    ck_assert(ok);
-    ck_assert_double_eq(fn[0], 1.25);
-    ck_assert_double_eq(fs[0], -0.375);
-    ck_assert_double_eq(ds[0], 0.5);
-    ck_assert_int_eq(flags[0], 1);
-    ck_assert_double_eq(fn[1], 0.0);
-    ck_assert_double_eq(fs[1], 0.0);
-    ck_assert_int_eq(flags[1], 0);
-    ck_assert_double_eq(fn[2], 3.25);
-    ck_assert_double_eq(fs[2], -2.375);
-    ck_assert_double_eq(ds[2], 2.5);
-    ck_assert_int_eq(flags[2], 3);
-    ck_assert_double_eq(fn[3], 0.0);
-    ck_assert_int_eq(flags[3], 0);
+}
+
+/* Was the unordered pair of ids (a, b) among the n pairs of ids in was[]?
+ * 1 in the same order, -1 turned round, 0 not. */
+static int was_candidate(const int (*was)[2], long n, int a, int b)
+{
+    for (long k = 0; k < n; k++) {
+        if (was[k][0] == a && was[k][1] == b)
+            return 1;
+        if (was[k][0] == b && was[k][1] == a)
+            return -1;
+    }
+    return 0;
+}
+
+/* Every candidate of both lists: the markers of its ids (the rolling ones,
+ * oriented, as the discs are ordered now) if it was a candidate before
+ * (counted in *kept, and in *turned if its discs are now the other way
+ * round), all zero otherwise (*fresh). */
+static void check_carried(const struct bal_sim *s, const int (*was[2])[2], const long n_was[2],
+                          long *kept, long *turned, long *fresh)
+{
+    for (int walls = 0; walls < 2; walls++) {
+        const struct bal_pairs *p = walls ? &s->pw : &s->pp;
+        for (long c = 0; c < p->n; c++) {
+            int a, b;
+            pair_ids(s, p, walls, c, &a, &b);
+            const int order = was_candidate(was[walls], n_was[walls], a, b), old = order != 0;
+            *kept += old;
+            *turned += order < 0;
+            *fresh += !old;
+            const double fn = old ? fabs(marker(a, b, 1)) : 0, fs = old ? fabs(marker(a, b, 2)) : 0;
+            ck_assert_double_eq(p->fn[c], fn);
+            ck_assert_double_eq(p->fs[c], fs);
+            /* θ_r = ∫(ω_x − ω_y): its sign goes with the pair's order */
+            ck_assert_double_eq(p->mr[c], old ? marker(a, b, 3) : 0);
+            ck_assert_double_eq(p->tr[c], old ? marker(a, b, 4) : 0);
+            if (p->damping) {
+                ck_assert_double_eq(p->dn[c], old ? fabs(marker(a, b, 5)) : 0);
+                ck_assert_double_eq(p->ds[c], old ? fabs(marker(a, b, 6)) : 0);
+                ck_assert_double_eq(p->dm[c], old ? fabs(marker(a, b, 7)) : 0);
+            }
+            ck_assert_int_eq(p->flags[c], old ? 1 + (a + b) % 15 : 0);
+        }
+    }
+}
+
+/* The ids of every candidate of both lists, and the markers made unsigned
+ * but for the rolling columns (which a re-sort may negate): what
+ * check_carried expects of a pair carried over. */
+static void remember(struct bal_sim *s, int (*was[2])[2], long n_was[2])
+{
+    for (int walls = 0; walls < 2; walls++) {
+        struct bal_pairs *p = walls ? &s->pw : &s->pp;
+        n_was[walls] = p->n;
+        was[walls] = malloc((size_t)(p->n > 0 ? p->n : 1) * sizeof *was[walls]);
+        ck_assert_ptr_nonnull(was[walls]);
+        for (long c = 0; c < p->n; c++) {
+            int a, b;
+            pair_ids(s, p, walls, c, &a, &b);
+            was[walls][c][0] = a;
+            was[walls][c][1] = b;
+            p->fn[c] = fabs(p->fn[c]);
+            p->fs[c] = fabs(p->fs[c]);
+            if (p->damping) {
+                p->dn[c] = fabs(p->dn[c]);
+                p->ds[c] = fabs(p->ds[c]);
+                p->dm[c] = fabs(p->dm[c]);
+            }
+        }
+    }
+}
+
+START_TEST(grid_rebuild_carries_every_column)
+{
+    struct tfx *f = tfx_new(carry_scene, "carry");
+    struct bal_sim *s = f->sim;
+    ck_assert_int_eq(s->use_grid, 1);
+    t_steps(f, 800); /* it lands: pairs near and in contact */
+    ck_assert_ptr_nonnull(s->pp.mr);
+    ck_assert_ptr_nonnull(s->pw.dm); /* every column exists */
+    ck_assert_int_eq(s->pp.damping, 0); /* (disc pairs' dashpots are recomputed, not kept) */
+    for (int step = 0; step < 2; step++) {
+        mark(s);
+        int (*was[2])[2];
+        long n_was[2];
+        remember(s, was, n_was);
+        if (step == 0) {
+            /* discs far apart swap places: pairs leave the lists and others join */
+            for (int k = 0; k < 40; k++) {
+                const int i = k, j = s->n - 1 - k;
+                const double x = s->x[i], y = s->y[i];
+                s->x[i] = s->x[j];
+                s->y[i] = s->y[j];
+                s->x[j] = x;
+                s->y[j] = y;
+            }
+            ck_assert_int_eq(bal_grid_rebuild(s, &f->err), BAL_OK);
+        } else {
+            ck_assert_int_eq(bal_grid_reorder(s, &f->err), BAL_OK);
+        }
+        long kept = 0, turned = 0, fresh = 0;
+        check_carried(s, (const int (**)[2])was, n_was, &kept, &turned, &fresh);
+        free(was[0]);
+        free(was[1]);
+        /* measured: 128 of 238 kept, 99 new, 110 gone; then all 227 kept, 56 turned */
+        ck_assert_int_gt(kept, 100);
+        if (step == 0) {
+            ck_assert_int_gt(fresh, 20);                      /* pairs joined: from zero */
+            ck_assert_int_gt(n_was[0] + n_was[1] - kept, 20); /* and pairs left */
+        } else {
+            ck_assert_int_eq(fresh, 0);  /* a re-sort keeps every pair */
+            ck_assert_int_gt(turned, 0); /* and turned some round: θ_r and M change sign */
+        }
+    }
 }
 END_TEST
 
@@ -902,7 +1017,7 @@ Suite *suite_grid(void)
 
     tc = tcase_create("history");
     tcase_add_checked_fixture(tc, NULL, tfx_teardown);
-    tcase_add_test(tc, grid_merge_history);
+    tcase_add_test(tc, grid_rebuild_carries_every_column);
     tcase_add_test(tc, grid_history_survives_rebuild);
     tcase_add_test(tc, grid_on_off_agree_on_packing);
     tcase_add_test(tc, grid_rattlers_keep_their_lists);

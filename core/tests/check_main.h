@@ -21,16 +21,18 @@
 
 #include "ballast.h"
 #include "build.h"
-#include "contacts.h"
 #include "energy.h"
 #include "grid.h"
 #include "integrate.h"
 #include "measure.h"
+#include "pair_loop.h"
 #include "pairs.h"
 #include "scene.h"
 #include "specimen.h"
 #include "state.h"
+#include "threads.h"
 #include "timestep.h"
+#include "wall_loop.h"
 #include "walls.h"
 
 Suite *suite_scene(void);

@@ -12,6 +12,8 @@ harness/expressions.py: each module registers its own when it is imported.
     ensembles    members, seeds, realisations, over: the realisations of an [ensemble]
     pile_stats   ens_S, dip, dip_se, coordination, ens_forces, tail_rate, ...: polydisperse
                  piles over an [ensemble] (MLH 2000, Sec. 4.4)
+    coulomb      coulomb_error, sliding_contacts: the Coulomb cap at the sliding contacts of
+                 a final state (C&S eq. 19)
 
 A new family is one module here that calls expressions.register, and its name below.  The
 order of the imports is the order in which an unknown-function message lists the names.
@@ -25,3 +27,4 @@ from . import rolling  # noqa: F401
 from . import biaxial  # noqa: F401
 from . import ensembles  # noqa: F401
 from . import pile_stats  # noqa: F401
+from . import coulomb  # noqa: F401

@@ -32,7 +32,9 @@ VOID_RATIO = {"void_ratio", "void_ratios", "band_heights", "initial_void_ratio"}
 # issue 22: the statistics of polydisperse piles over an ensemble (families/pile_stats.py)
 PILE_STATS = {"ens_X", "ens_S", "ens_S_se", "dip", "dip_se", "profile_dip", "coordination", "ens_forces",
               "tail_rate", "tail_ks", "ens_fluct", "ens_rho", "log10"}
-NAMES = NAMES_BEFORE | NAMES_ADDED | BIAXIAL | ENSEMBLES | VOID_RATIO | PILE_STATS
+# issue 30: the Coulomb cap at the sliding contacts of a final state (families/coulomb.py)
+COULOMB = {"coulomb_error", "sliding_contacts"}
+NAMES = NAMES_BEFORE | NAMES_ADDED | BIAXIAL | ENSEMBLES | VOID_RATIO | PILE_STATS | COULOMB
 
 
 def _run(**columns):
@@ -43,7 +45,7 @@ def _run(**columns):
 
 def test_every_family_registered_and_every_name_kept():
     assert list(expressions.registered()) == ["signals", "variants", "piles", "networks", "collisions",
-                                              "rolling", "biaxial", "ensembles", "pile_stats"]
+                                              "rolling", "biaxial", "ensembles", "pile_stats", "coulomb"]
     names = {n for n, f in namespace(_run()).items() if callable(f)}
     assert names == NAMES
 

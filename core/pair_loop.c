@@ -5,6 +5,11 @@
  * Matuttis, Luding & Herrmann eqs 2–3).  The disc–wall loop is
  * wall_loop.c's; how the list is shared between threads, threads.c's.
  *
+ * Kept whole (about 650 lines, a third of them comments): each variant of
+ * the table at the end compiles the passes above it with its own constant
+ * MOD_* bits (inline functions, always inlined), so the passes and the
+ * table must be one translation unit, and the passes read as one piece.
+ *
  * For a contact between discs x and y (x = the lower index):
  *
  *   e  = (y − x)/D, t = (e2, −e1)                          C&S eqs (9)–(10)

@@ -27,6 +27,13 @@
  * order of their current positions (bal_grid_reorder), because flow
  * scatters neighbours across memory.  The rebuild that follows finds each
  * pair's history through the permutation.
+ *
+ * Kept whole (about 740 lines): the search, the merge that carries history
+ * into the new list, the re-sort and the choice of skin all read and write
+ * the same scratch (struct bal_rebuild_scratch) and the same invariant, the
+ * list sorted by key with its history beside it; split, each part would have
+ * to restate that invariant, and the merge is the one place history crosses
+ * a rebuild (issue 30).
  */
 #include <limits.h>
 #include <math.h>

@@ -309,7 +309,8 @@ def parser():
                                               "tabulate its checks, their error and each point's cost")
     sweep.add_argument("case", metavar="CASE")
     sweep.add_argument("--set", required=True, action="append", metavar="KEY=V1,V2,...",
-                       help="repeatable: several keys combine as a grid; a dt sweep keeps the simulated time")
+                       help="repeatable: several keys combine as a grid (KEY1,KEY2=V1,V2,... moves two keys "
+                            "together); a dt sweep keeps the simulated time")
     sweep.add_argument("--variant", metavar="NAME", help="the variant to sweep (needed when the case has several)")
     _runs(sweep)
     _runs(_selection(_command(sub, "cost", cmd_cost,

@@ -31,7 +31,13 @@ Outputs go to reports/studies/<scene-stem>-<n>/ (n the next free number) or --ou
 over an earlier study: runs/<label>/ (one run folder each), study.tsv, study.md and, when
 gnuplot works, error.svg (error against h, log-log; error.gp beside it).  --stability adds
 the largest stable step of the scene at its own settings (stability.py's bisection, its
-trials under stability/), printed beside the estimate and the advised steps.  --resume continues
+trials under stability/), printed beside the estimate and the advised steps.
+
+--set KEY=V1,V2,... (repeatable: a grid; KEY1,KEY2=V1,... couples keys on one axis; sweep_grid.py
+parses and checks it, every point read by `ballast info` before any run) runs the grid of points
+instead of the refinement: each point's quantities, cost, and error against its reference point
+(the costliest point with the same values on every axis but the last), in sweep.tsv, study.md,
+a short-column table and error_cost.svg (sweep_study below).  --resume continues
 an interrupted study in its folder (the newest <scene-stem>-<n>, or --out DIR), keeping every
 complete run of the same identity (runner.py).
 """

@@ -7,6 +7,7 @@ follows the linear closed form pi sqrt(m12/k) of the coupled stiffness, computed
 of two axes runs every point, a bad grid is refused with exit 2 before any run, and the study
 writes only its own folder."""
 import json
+import re
 import math
 import os
 import subprocess
@@ -17,7 +18,7 @@ import pytest
 
 from harness import sweep_grid
 from harness.errors import CatalogueError
-from harness.tests.test_study import COLLISION, GAP, M12
+from harness.tests.test_study import COLLISION, GAP, M12, page_block
 
 REPO = Path(__file__).resolve().parents[2]
 BIN = REPO / "bin" / "ballast"
@@ -156,3 +157,23 @@ def test_harness_sweep_takes_a_coupled_axis(tmp_path):
         label = f"material.disc.kn={kn},material.wall.kn={kn}"
         sets = json.loads((tmp_path / "sweeps" / "two_discs" / label / "run.json").read_text())["sets"]
         assert sets[-2:] == [f"material.disc.kn={kn}", f"material.wall.kn={kn}"]
+
+
+def test_the_worked_sweep_runs_as_the_page_says(tmp_path):
+    """docs/your-scene.md's sweep of the rolling disc, run as written (HOME a temporary folder):
+    the table it quotes, the wall-clock seconds masked."""
+    text = (REPO / "docs" / "your-scene.md").read_text()
+    (tmp_path / "roll").mkdir()
+    (tmp_path / "roll" / "roll.scene").write_text(page_block(text, "your-scene"))
+    command = page_block(text, "your-scene-sweep-command").strip()
+    done = subprocess.run(["sh", "-c", command], cwd=REPO, capture_output=True, text=True, timeout=300,
+                          env={**os.environ, "HOME": str(tmp_path), "BALLAST_REPORTS": str(tmp_path / "reports")})
+    assert done.returncode == 0, done.stderr
+
+    def masked(lines):      # the wall seconds: the last column but one
+        return [line.split()[:-2] + line.split()[-1:] for line in lines if re.match(r"^(point|P\d+) ", line)]
+    quoted = page_block(text, "your-scene-sweep-output").splitlines()
+    assert len(masked(quoted)) == 7
+    assert masked(done.stdout.splitlines()) == masked(quoted), \
+        "docs/your-scene.md quotes another sweep table than the study prints: rerun its command, update the page"
+    assert (tmp_path / "roll" / "sweep" / "sweep.tsv").is_file()

@@ -309,7 +309,8 @@ def parser():
                                               "tabulate its checks, their error and each point's cost")
     sweep.add_argument("case", metavar="CASE")
     sweep.add_argument("--set", required=True, action="append", metavar="KEY=V1,V2,...",
-                       help="repeatable: several keys combine as a grid; a dt sweep keeps the simulated time")
+                       help="repeatable: several keys combine as a grid (KEY1,KEY2=V1,V2,... moves two keys "
+                            "together); a dt sweep keeps the simulated time")
     sweep.add_argument("--variant", metavar="NAME", help="the variant to sweep (needed when the case has several)")
     _runs(sweep)
     _runs(_selection(_command(sub, "cost", cmd_cost,
@@ -332,16 +333,20 @@ def parser():
     stu.add_argument("--quantity", action="append", metavar="EXPR",
                      help="repeatable: an expression over the run's outputs (default: the final energies "
                           "and each series column's last value)")
-    stu.add_argument("--refine", default="settings.dt", metavar="KEY", help="the key refined (default settings.dt)")
+    stu.add_argument("--refine", default=None, metavar="KEY", help="the key refined (default settings.dt)")
     stu.add_argument("--base", type=float, default=None, metavar="V",
                      help="the coarsest value of the refined key (default: the scene's step, from ballast info; "
                           "needed for any other key)")
-    stu.add_argument("--factor", type=float, default=0.5, help="each level's h over the last's (default 0.5)")
-    stu.add_argument("--levels", type=int, default=4, help="number of levels (default 4, at least 3)")
+    stu.add_argument("--factor", type=float, default=None, help="each level's h over the last's (default 0.5)")
+    stu.add_argument("--levels", type=int, default=None, help="number of levels (default 4, at least 3)")
     stu.add_argument("--target", type=float, action="append", metavar="REL",
                      help="repeatable: advise the largest h for |q - q*|/|q*| <= REL, and check it by a run")
     stu.add_argument("--stability", action="store_true",
                      help="also bisect the largest stable step (stability.py), printed beside the advice")
+    stu.add_argument("--set", action="append", metavar="KEY=V1,V2,...",
+                     help="repeatable: run the grid of these points instead of the refinement (KEY1,KEY2=V1,V2,... "
+                          "moves two keys together); each point's quantities, cost and error against the "
+                          "costliest point (sweep.tsv, error_cost.svg)")
     stu.add_argument("--out", type=Path, default=None, metavar="DIR",
                      help="the study's folder (default reports/studies/<scene-stem>-<n>, n the next free)")
     _runs(stu)

@@ -31,7 +31,13 @@ Outputs go to reports/studies/<scene-stem>-<n>/ (n the next free number) or --ou
 over an earlier study: runs/<label>/ (one run folder each), study.tsv, study.md and, when
 gnuplot works, error.svg (error against h, log-log; error.gp beside it).  --stability adds
 the largest stable step of the scene at its own settings (stability.py's bisection, its
-trials under stability/), printed beside the estimate and the advised steps.  --resume continues
+trials under stability/), printed beside the estimate and the advised steps.
+
+--set KEY=V1,V2,... (repeatable: a grid; KEY1,KEY2=V1,... couples keys on one axis; sweep_grid.py
+parses and checks it, every point read by `ballast info` before any run) runs the grid of points
+instead of the refinement: each point's quantities, cost, and error against its reference point
+(the costliest point with the same values on every axis but the last), in sweep.tsv, study.md,
+a short-column table and error_cost.svg (sweep_study below).  --resume continues
 an interrupted study in its folder (the newest <scene-stem>-<n>, or --out DIR), keeping every
 complete run of the same identity (runner.py).
 """
@@ -42,7 +48,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import core_info, files, stability
+from . import core_info, files, stability, sweep_grid
 from .compare import evaluate
 from .errors import CatalogueError, EvalError, RunProblem
 from .runner import Job, run_all
@@ -71,6 +77,13 @@ TSV_COLUMNS = ("quantity", "level", "h", "value", "difference", "pairwise_order"
 ADVICE_COLUMNS = ("quantity", "target", "h_advised", "predicted_error", "predicted_particle_steps",
                   "predicted_seconds", "achieved_value", "achieved_error", "met")
 GNUPLOT_TIMEOUT = 60    # seconds
+# The refinement's options (None on the command line = not given: --set refuses them when given).
+REFINE_DEFAULTS = {"refine": "settings.dt", "factor": 0.5, "levels": 4}
+SWEEP_TSV_COLUMNS = ("point", "sets", "status", "steps", "particle_steps", "wall_seconds", "quantity", "value",
+                     "reference_point", "error")
+# A quantity's column in the printed sweep table is headed by its expression up to this length,
+# else by q1, q2, ... with the expressions listed below the table.
+SHORT_HEADER = 20
 
 
 # ---------------------------------------------------------------- the analysis (pure)
@@ -237,6 +250,11 @@ def study(args, reports_root, out=sys.stdout):
     scene = Path(args.scene).resolve()
     if not scene.is_file():
         raise CatalogueError(f"{args.scene}: no such scene file")
+    if getattr(args, "set", None):
+        return sweep_study(args, scene, reports_root, out)
+    for name, default in REFINE_DEFAULTS.items():
+        if getattr(args, name, None) is None:
+            setattr(args, name, default)
     if args.levels < MIN_LEVELS:
         raise CatalogueError(f"--levels {args.levels}: at least {MIN_LEVELS} (two differences give one order)")
     if not 0 < args.factor < 1:
@@ -419,3 +437,152 @@ def draw(folder, key, hs, quantities, analyses):
     except (OSError, subprocess.TimeoutExpired):
         return None
     return "error.svg" if done.returncode == 0 and (folder / "error.svg").is_file() else None
+
+
+# ---------------------------------------------------------------- sweeps (--set)
+
+def sweep_study(args, scene, reports_root, out):
+    """--set KEY=V1,V2 (a grid when repeated; KEY1,KEY2=V1,... couples keys on one axis, sweep_grid.py):
+    every point of the grid run once, each quantity's value and each point's cost, and each
+    value's deviation from the point of highest cost (the best-resolved point when the grid
+    refines the step or the stiffness; for other keys simply the reference the deviations are
+    measured from).  Writes sweep.tsv, study.md and, when gnuplot works, error_cost.svg."""
+    given = [f"--{n}" for n in ("refine", "factor", "levels", "base", "target")
+             if getattr(args, n, None) is not None]
+    if given:
+        raise CatalogueError(f"{', '.join(given)}: options of the refinement; --set runs the grid of its points "
+                             "instead (run the refinement as a separate study)")
+    keyed = sweep_grid.parse_sets(args.set)
+    swept = sweep_grid.swept_keys(keyed)
+    extra = time_keeping(args.bin, scene, DT_KEYS[0]) if any(k in DT_KEYS for k in swept) else []
+    folder = study_folder(reports_root, scene, args.out, args.resume)
+    points = sweep_grid.grid(keyed)
+    jobs = [Job("study", label, scene, list(extra) + sets, folder / "points" / f"P{i + 1}", probe=bool(extra))
+            for i, (label, sets) in enumerate(points)]
+    core_info.refuse_bad_points(args.bin, [(j.variant, j.scene, j.sets, swept) for j in jobs])   # before any run
+    files.make_dirs(folder)
+    print(f"study of {scene}: {len(jobs)} point(s) of {' x '.join(a for a, _ in keyed)} -> {folder}", file=out)
+    if extra:
+        print(f"sweeping the step: every run keeps the stages' simulated time ({' '.join(extra)})", file=out)
+    outcomes = run_all(jobs, args.bin, args.jobs, out, resume=args.resume)
+    if any(o.io_error for o in outcomes):
+        raise OSError(f"cannot record the runs: {next(o.io_error for o in outcomes if o.io_error)}")
+    quantities = list(args.quantity or []) or default_quantities(jobs[0].out)
+    costs = [run_cost(j.out) for j in jobs]
+    values = {expr: [value_of(expr, j.out)[0] for j in jobs] for expr in quantities}
+    point_values = [[values_of_axis(axis, sets) for axis, _ in keyed] for _, sets in points]
+    refs = reference_points(point_values, costs, values, quantities)
+    errors = {expr: [None if refs[i] is None or v is None else relative(v, values[expr][refs[i]])
+                     for i, v in enumerate(values[expr])] for expr in quantities}
+    text = sweep_table(keyed, point_values, quantities, values, errors, costs, refs)
+    limit = stability_limit(args, scene, folder, out) if getattr(args, "stability", False) else None
+    if limit:
+        text += "\n" + limit
+    print(text, file=out)
+    lines = ["\t".join(SWEEP_TSV_COLUMNS)]
+    for i, job_ in enumerate(jobs):
+        for expr in quantities:
+            c = costs[i]
+            lines.append("\t".join([f"P{i + 1}", " ".join(points[i][1]), str(c.get("status")),
+                                    num(c.get("steps"), "g"), num(c.get("particle_steps"), "g"),
+                                    num(c.get("wall_seconds"), ".4g"), expr, num(values[expr][i], ".17g"),
+                                    "-" if refs[i] is None else f"P{refs[i] + 1}", num(errors[expr][i], ".6g")]))
+    files.write_text(folder / "sweep.tsv", "\n".join(lines) + "\n")
+    figure = draw_cost(folder, quantities, errors, costs, refs)
+    md = [f"# Study of {scene.name}", "", f"Scene: `{scene}`.", "", "## Sweep", "",
+          "Points: " + " x ".join(f"`{a}` = {', '.join(v)}" for a, v in keyed) + " (a coupled axis `K1,K2` sets "
+          "both keys to each value). Error: |q - q_ref| / |q_ref| against the reference point: the point "
+          "of highest cost (particle-steps) among those with the same values on every axis but the last.", "", "```", text, "```", ""]
+    if figure:
+        md += [f"![error against cost]({figure})", ""]
+    md += ["Files: sweep.tsv (every point and quantity), points/P<n>/ (the run folders)."]
+    files.write_text(folder / "study.md", "\n".join(md) + "\n")
+    print(f"wrote {folder / 'sweep.tsv'}, {folder / 'study.md'}" + (f", {folder / figure}" if figure else ""),
+          file=out)
+    return 0 if all(o.ok for o in outcomes) else 1
+
+
+def values_of_axis(axis, sets):
+    """The value of an axis at a point (the coupled keys share it)."""
+    key = sweep_grid.axis_keys(axis)[0]
+    return next(s.split("=", 1)[1] for s in sets if s.split("=", 1)[0] == key)
+
+
+def relative(v, ref):
+    return abs(v - ref) / abs(ref) if ref != 0 else abs(v - ref)
+
+
+def reference_points(point_values, costs, values, quantities):
+    """Each point's reference: among the points with its values on every axis but the last (the
+    whole sweep for one axis), the one of highest particle-steps with every quantity measured
+    (the last such point on a tie); None where there is none.  The last axis is the one whose
+    values a point's error is measured along: put the resolution key (the step, 1/kn) last."""
+    ok = [i for i, c in enumerate(costs) if isinstance(c.get("particle_steps"), int)
+          and all(values[e][i] is not None for e in quantities)]
+    refs = []
+    for pv in point_values:
+        group = [i for i in ok if point_values[i][:-1] == pv[:-1]]
+        refs.append(max(group, key=lambda i: (costs[i]["particle_steps"], i)) if group else None)
+    return refs
+
+
+def short_axis(axis, axes):
+    """An axis's column header: each key's last part ('settings.dt' -> 'dt'; coupled keys with
+    one last part share it), the whole axis when two axes would get the same header."""
+    def short(a):
+        tails = list(dict.fromkeys(k.rsplit(".", 1)[-1] for k in sweep_grid.axis_keys(a)))
+        return ",".join(tails)
+    return short(axis) if [short(a) for a in axes].count(short(axis)) == 1 else axis
+
+
+def sweep_table(keyed, point_values, quantities, values, errors, costs, refs):
+    """One row per point: its values on each axis, each quantity's value (its error against its
+    reference point in brackets) and the point's cost; the axes and quantities named below."""
+    axes = [a for a, _ in keyed]
+    names = [e if len(e) <= SHORT_HEADER else f"q{i + 1}" for i, e in enumerate(quantities)]
+    rows = [["point"] + [short_axis(a, axes) for a in axes] + names + ["status", "particle-steps", "wall s", "ref"]]
+    for i, pv in enumerate(point_values):
+        cells = [f"{num(values[e][i], '.8g')} ({num(errors[e][i], '.1e')})" if refs[i] != i
+                 else f"{num(values[e][i], '.8g')} (ref)" for e in quantities]
+        ref = "-" if refs[i] is None else f"P{refs[i] + 1}"
+        rows.append([f"P{i + 1}"] + pv + cells + [str(costs[i].get("status")), num(costs[i].get("particle_steps"), "g"),
+                                                  num(costs[i].get("wall_seconds"), ".3g"), ref])
+    widths = [max(len(r[j]) for r in rows) for j in range(len(rows[0]))]
+    lines = ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
+    lines.append("")
+    lines += [f"{short_axis(a, axes)} = {a}" for a in axes if short_axis(a, axes) != a]
+    lines += [f"{n} = {e}" for n, e in zip(names, quantities) if n != e]
+    lines.append("(error) = |q - q_ref| / |q_ref|, q_ref at the point's ref: the point of highest cost "
+                 "(particle-steps) with the same values on every axis but the last")
+    return "\n".join(lines)
+
+
+def draw_cost(folder, quantities, errors, costs, refs):
+    """error_cost.svg: each quantity's error against the reference point by particle-steps,
+    log-log (points with a zero or missing error left out); None if gnuplot fails."""
+    curves = []
+    for expr in quantities:
+        pts = [(costs[i]["particle_steps"], e) for i, e in enumerate(errors[expr])
+               if refs[i] != i and e and e > 0 and isinstance(costs[i].get("particle_steps"), int)]
+        if pts:
+            curves.append((expr, sorted(pts)))
+    if not curves:
+        return None
+    data = []
+    for expr, pts in curves:
+        data += [f"# {expr}"] + [f"{c!r} {e!r}" for c, e in pts] + ["", ""]
+    files.write_text(folder / "error_cost.dat", "\n".join(data) + "\n")
+    style = Path(__file__).resolve().parent / "gnuplot" / "style.gp"
+    esc = lambda s: s.replace("\\", "\\\\").replace('"', '\\"')
+    plots = ", ".join(f'"error_cost.dat" index {i} using 1:2 with linespoints title "{esc(e)}"'
+                      for i, (e, _) in enumerate(curves))
+    gp = [f'load "{esc(str(style))}"', "set terminal svg size 800,500", 'set output "error_cost.svg"',
+          "set logscale xy", 'set xlabel "particle-steps"', 'set ylabel "|q - q_ref| / |q_ref|"',
+          "set key inside right top", f"plot {plots}"]
+    files.write_text(folder / "error_cost.gp", "\n".join(gp) + "\n")
+    try:
+        done = subprocess.run(["gnuplot", "error_cost.gp"], cwd=folder, capture_output=True,
+                              timeout=GNUPLOT_TIMEOUT, stdin=subprocess.DEVNULL)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    return "error_cost.svg" if done.returncode == 0 and (folder / "error_cost.svg").is_file() else None

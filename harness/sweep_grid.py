@@ -1,8 +1,11 @@
 """`harness sweep CASE --set KEY=V1,V2 [--set KEY2=W1,W2 ...]`: one variant run at every point
 of a grid of overrides, and a table of its checks with their error and the cost of each point.
+`harness study SCENE --set ...` runs the same grid on a bare scene (study.py).
 
 Several --set options combine as a GRID (every value of the first key with every value of the
-second, ...; the first key varies slowest).  A key given twice is refused, as are a value with
+second, ...; the first key varies slowest).  One option may COUPLE keys, --set K1,K2=V1,V2: one
+axis on which both keys take each value together (a pair of materials uses the smaller δ of the
+two, so a grain's and a wall's δ must move together); its point label is 'K1=V1,K2=V1'.  A key given twice is refused, as are a value with
 '/' and a key with '/' or '..' (they name the point's folder).  A point's label is 'KEY=V' for
 one key and 'KEY=V,KEY2=W' for several; its outputs go to reports/sweeps/<case>/<label>.
 
@@ -42,31 +45,50 @@ TSV_COLUMNS = ("point", "sets", "status", "steps", "particle_steps", "wall_secon
 
 
 def parse_sets(texts):
-    """['KEY=V1,V2', ...] -> [(KEY, [V1, V2]), ...]; refuses a malformed option or a key twice."""
-    out = []
+    """['KEY=V1,V2', 'K1,K2=W1,W2', ...] -> [(AXIS, [V1, V2]), ...], AXIS the key, or the coupled
+    keys 'K1,K2' (axis_keys splits them: every key of the axis takes each value together).
+    Refuses a malformed option, a key with '/' or '..' and a key given twice (in any axis)."""
+    out, seen = [], []
     for text in texts:
-        key, sep, values = text.partition("=")
-        key = key.strip()
+        axis, sep, values = text.partition("=")
+        keys = [k.strip() for k in axis.split(",")]
         values = [v.strip() for v in values.split(",") if v.strip()]
-        if not sep or not key or not values or any("/" in v for v in values):
-            raise CatalogueError(f"--set needs KEY=V1,V2,... (no '/' in values), got '{text}'")
-        if "/" in key or ".." in key:
-            # the key starts each point's folder name (reports/sweeps/<case>/KEY=V): a path in it
-            # would put the folder elsewhere, and no scene key holds '/' or '..'
-            raise CatalogueError(f"--set {key}: a key holds no '/' or '..' (it names the point's folder "
-                                 f"under reports/sweeps), got '{text}'")
-        if key in [k for k, _ in out]:
-            raise CatalogueError(f"--set {key} given twice: give its values once, KEY=V1,V2,... "
-                                 "(several --set keys combine as a grid)")
-        out.append((key, values))
+        if not sep or not all(keys) or not values or any("/" in v for v in values):
+            raise CatalogueError(f"--set needs KEY=V1,V2,... or KEY1,KEY2=V1,V2,... (no '/' in values), "
+                                 f"got '{text}'")
+        for key in keys:
+            if "/" in key or ".." in key:
+                # the key starts each point's folder name (reports/sweeps/<case>/KEY=V): a path in it
+                # would put the folder elsewhere, and no scene key holds '/' or '..'
+                raise CatalogueError(f"--set {key}: a key holds no '/' or '..' (it names the point's folder "
+                                     f"under reports/sweeps), got '{text}'")
+            if key in seen:
+                raise CatalogueError(f"--set {key} given twice: give its values once, KEY=V1,V2,... "
+                                     "(several --set keys combine as a grid; KEY1,KEY2=V1,V2,... moves "
+                                     "two keys together)")
+            seen.append(key)
+        out.append((",".join(keys), values))
     return out
 
 
+def axis_keys(axis):
+    """The keys of one axis of parse_sets: 'K' -> ['K'], 'K1,K2' -> ['K1', 'K2']."""
+    return axis.split(",")
+
+
+def swept_keys(keyed):
+    """Every key of every axis."""
+    return [k for axis, _ in keyed for k in axis_keys(axis)]
+
+
 def grid(keyed):
-    """[(label, [KEY=V, ...])] of every combination, the first key varying slowest."""
+    """[(label, [KEY=V, ...])] of every combination, the first axis varying slowest; a coupled
+    axis sets each of its keys to the same value ('K1=V,K2=V' in the label)."""
+    axes = [[[f"{k}={v}" for k in axis_keys(axis)] for v in values] for axis, values in keyed]
     points = []
-    for combo in itertools.product(*[[f"{k}={v}" for v in values] for k, values in keyed]):
-        points.append((",".join(combo), list(combo)))
+    for combo in itertools.product(*axes):
+        sets = [s for part in combo for s in part]
+        points.append((",".join(sets), sets))
     return points
 
 
@@ -85,7 +107,7 @@ def time_keeping(binary, variant):
 
 def jobs(case, variant, keyed, sweeps_root, binary):
     """One runner Job per grid point (with the time-keeping overrides of a dt sweep)."""
-    extra = time_keeping(binary, variant) if any(k in DT_KEYS for k, _ in keyed) else []
+    extra = time_keeping(binary, variant) if any(k in DT_KEYS for k in swept_keys(keyed)) else []
     return [Job(case.name, label, variant.scene, list(variant.sets) + extra + sets,
                 sweeps_root / case.name / label, case.runtime / max(len(case.variants), 1), variant.command,
                 probe=bool(extra))
@@ -96,7 +118,7 @@ def refuse_bad_points(jobs_, keyed, binary):
     """Before any run: every point as the core reads it, with all its overrides (the variant's,
     the time-keeping ones, the point's); exit 2 for an unknown key, a value out of range or a
     swept key that another key makes unused at some point (core_info.refuse_bad_points)."""
-    swept = [k for k, _ in keyed]
+    swept = swept_keys(keyed)
     core_info.refuse_bad_points(binary, [(job.variant, job.scene, job.sets, swept) for job in jobs_])
 
 

@@ -1,6 +1,7 @@
 # ballast — build, test, validate, benchmark.
 #
 #   make validate     build, run the default tier of the catalogue, gate, sweeps, report
+#   make gate         the pre-commit gate: the quick tier gated, no sweeps or stability (< 30 s)
 #   make sweep        the declared error-against-cost sweeps alone (needs the default runs)
 #   make test         C unit tests (Check), symbol-prefix check, harness tests (pytest)
 #   make test-sanitize  C unit tests under AddressSanitizer + UndefinedBehaviorSanitizer
@@ -34,7 +35,7 @@ LIB_OBJ  := $(LIB_SRC:core/%.c=$(BUILD)/%.o)
 TEST_SRC := $(wildcard core/tests/check_*.c)
 BENCH_SRC := core/bench/bench.c
 
-.PHONY: all deps test test-c test-prefix test-py test-sanitize test-browser validate bench bench-scaling \
+.PHONY: all deps test test-c test-prefix test-py test-sanitize test-browser validate gate bench bench-scaling \
         bench-peer bench-modules bench-modules-count bench-scaling-count bench-flat bench-threads bench-cost bench-piles-poly \
         clean keys sweep \
         test-valgrind test-slurm
@@ -140,6 +141,14 @@ endif
 endif
 validate: all
 	$(PYTHON) -m harness validate --tier $(TIER) -j $(JOBS) $(RESUME_FLAG) $(CASES)
+
+# The pre-commit gate for a change to the core (issue 32, item 4): the quick tier, gated, without
+# the sweeps, the stability limits and the extreme probes.  Every law path runs in it: the
+# incremental law (two_discs, nine_discs_*), the power law and its dashpot (collisions, piles),
+# the two-contacts-at-a-time loop with sliding (coulomb), rolling Models 1 and 2 (rolling_tester),
+# the wall controllers and the exact solver.  Its time is measured in docs/benchmarks.md.
+gate: all
+	$(PYTHON) -m harness validate --tier quick --no-sweeps --no-stability -j $(JOBS)
 
 # Error against cost: every [sweep] of the tier's cases -> reports/sweeps/<case>/cost.tsv
 # (validate runs them too, between the gate and the report; `harness report` draws them).

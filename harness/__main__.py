@@ -108,7 +108,7 @@ def cmd_check(args):
     checks = load_checks(all_cases)
     cases = selected(args, all_cases)
     return gate(references.for_cases(checks, cases), default_store(all_cases), reports_root(), sys.stdout,
-                keep_others=subset(args))
+                keep_others=subset(args), verbose=getattr(args, "verbose", False))
 
 
 def cmd_report(args):
@@ -294,11 +294,15 @@ def parser():
     _selection(_command(sub, "list", cmd_list, "table of the cases: tier, variants, expected run time, what each checks",
                         writes=False), default_tier="full", names=False)
     _runs(_selection(_command(sub, "run", cmd_run, "run every variant of the selected cases")))
-    _selection(_command(sub, "check", cmd_check,
-                        "evaluate the checks, print the gate table, write summary.json and junit.xml"))
+    check = _selection(_command(sub, "check", cmd_check,
+                                "evaluate the checks, print the gate table, write summary.json and junit.xml"))
+    check.add_argument("-v", "--verbose", action="store_true",
+                       help="list every check's row (default: the failures, KNOWN and SKIP rows and the counts)")
     _selection(_command(sub, "report", cmd_report, "render figures, write reports/summary.md and reports/index.html"))
     validate = _runs(_selection(_command(sub, "validate", cmd_validate, "run + check + cost + report")))
     validate.add_argument("--no-sweeps", action="store_true", help="skip the declared sweeps (cost)")
+    validate.add_argument("-v", "--verbose", action="store_true",
+                          help="list every check's row (default: the failures, KNOWN and SKIP rows and the counts)")
     validate.add_argument("--extremes", action="store_true",
                           help="run the extreme probes even when cases are named (a validate of all cases runs them)")
     validate.add_argument("--no-stability", action="store_true",

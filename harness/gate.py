@@ -63,12 +63,20 @@ def counts_text(verdicts):
             + (f", {d} known discrepanc{'y' if d == 1 else 'ies'} with a paper" if d else ""))
 
 
-def table(verdicts):
-    """The gate table as text: aligned columns, failure reasons, then 'N passed, M failed'."""
-    rows = [row(v) for v in verdicts]
+def table(verdicts, verbose=True):
+    """The gate table as text: aligned columns, failure reasons, then 'N passed, M failed'.
+    verbose=False (the terminal's default for check and validate): only the rows that did not
+    pass (FAIL, KNOWN, SKIP), so a green gate of 1 300 checks prints a few lines, not 1 300;
+    every row is in summary.json, junit.xml and summary.md either way."""
+    shown = verdicts if verbose else [v for v in verdicts if v.result != "PASS" or v.known]
+    rows = [row(v) for v in shown]
     widths = {c: max([len(c)] + [len(r[c]) for r in rows]) for c in COLUMNS}
-    lines = [_line({c: c.upper() for c in COLUMNS}, widths), _line({c: "-" * widths[c] for c in COLUMNS}, widths)]
-    lines += [_line(r, widths) for r in rows]
+    lines = []
+    if rows:
+        lines = [_line({c: c.upper() for c in COLUMNS}, widths), _line({c: "-" * widths[c] for c in COLUMNS}, widths)]
+        lines += [_line(r, widths) for r in rows]
+    if not verbose and len(shown) < len(verdicts):
+        lines.append(f"({len(verdicts) - len(shown)} passing check(s) not listed: -v lists every row)")
     failures = [v for v in verdicts if v.result == "FAIL"]
     skips = {}
     for v in verdicts:
@@ -146,13 +154,13 @@ def exit_status(verdicts):
     return 0 if passed and not failed else 1
 
 
-def gate(checks, store, reports_dir, out, keep_others=False):
+def gate(checks, store, reports_dir, out, keep_others=False, verbose=True):
     """Evaluate checks, print the table to out, write summary.json and junit.xml; the exit status
     (of these checks).  keep_others (a subset of the cases was asked for): summary.json and
     junit.xml keep the verdicts an earlier gate wrote for the other cases, so checking one case
     updates its part and leaves the rest."""
     verdicts = evaluate_all(checks, store)
-    print(table(verdicts), file=out)
+    print(table(verdicts, verbose), file=out)
     summary = Path(reports_dir) / "summary.json"
     written = verdicts
     if keep_others:

@@ -36,6 +36,21 @@ def test_table_is_aligned_and_ends_with_the_tally():
     assert "FAIL spring/a_much_longer_name: too big" in text
 
 
+def test_the_terminal_view_lists_only_what_did_not_pass():
+    # Issue 32: a green gate of 1 300 checks printed 1 300 PASS rows, burying a failure.  The
+    # default view (check and validate without -v) lists the FAIL (and KNOWN, SKIP) rows, then
+    # how many passing rows it left out and the tally; verbose lists every row.
+    verdicts = [v("short"), v("broken", passed=False, message="too big"), v("fine")]
+    short = table(verdicts, verbose=False).splitlines()
+    rows = [r for r in short[2:] if r.startswith("spring")]
+    assert len(rows) == 1 and "broken" in rows[0] and rows[0].rstrip().endswith("FAIL")
+    assert "(2 passing check(s) not listed: -v lists every row)" in short
+    assert short[-1] == "2 passed, 1 failed"
+    green = table([v("a"), v("b")], verbose=False).splitlines()
+    assert green == ["(2 passing check(s) not listed: -v lists every row)", "2 passed, 0 failed"]
+    assert len(table(verdicts, verbose=True).splitlines()) == len(short) + 2 - 1
+
+
 def test_no_checks_is_not_a_pass():
     assert exit_status([]) == 1
     assert table([]).splitlines()[-1] == "0 passed, 0 failed"

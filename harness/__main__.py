@@ -24,7 +24,7 @@ from contextlib import nullcontext
 from pathlib import Path
 
 from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_root
-from . import catalogue, export, extremes, files, references, stability
+from . import catalogue, export, extremes, files, known, references, stability
 from . import study as studies
 from . import families  # noqa: F401 -- registers every case family's expression functions
 from . import sweep as sweeps
@@ -107,8 +107,22 @@ def cmd_check(args):
     all_cases = load_cases()
     checks = load_checks(all_cases)
     cases = selected(args, all_cases)
+    refresh = None
+    if args.tier == "full" or subset(args):
+        refresh = functools.partial(refresh_known, checks, {c.name: c.tier for c in all_cases})
     return gate(references.for_cases(checks, cases), default_store(all_cases), reports_root(), sys.stdout,
-                keep_others=subset(args), verbose=getattr(args, "verbose", False))
+                keep_others=subset(args), verbose=getattr(args, "verbose", False), on_verdicts=refresh)
+
+
+def refresh_known(checks, tiers, verdicts):
+    """reference/known.tsv, the committed record of the KNOWN discrepancies: its rows of the KNOWN
+    checks just evaluated get their value, date, commit and tier (harness/known.py).  Only a
+    `check`/`validate --tier full` or one given case names calls this: a default-tier validate
+    leaves the committed file alone."""
+    path = known.record_path(reference_root())
+    done = known.refresh(path, checks, verdicts, tiers)
+    if done:
+        print(f"{path}: refreshed {len(done)} KNOWN row(s) ({', '.join(c for _, c in done)}); commit it")
 
 
 def cmd_report(args):

@@ -154,12 +154,15 @@ def exit_status(verdicts):
     return 0 if passed and not failed else 1
 
 
-def gate(checks, store, reports_dir, out, keep_others=False, verbose=True):
+def gate(checks, store, reports_dir, out, keep_others=False, verbose=True, on_verdicts=None):
     """Evaluate checks, print the table to out, write summary.json and junit.xml; the exit status
     (of these checks).  keep_others (a subset of the cases was asked for): summary.json and
     junit.xml keep the verdicts an earlier gate wrote for the other cases, so checking one case
-    updates its part and leaves the rest."""
+    updates its part and leaves the rest.  on_verdicts: called with the verdicts once evaluated
+    (the refresh of reference/known.tsv: __main__.py)."""
     verdicts = evaluate_all(checks, store)
+    if on_verdicts:
+        on_verdicts(verdicts)
     print(table(verdicts, verbose), file=out)
     summary = Path(reports_dir) / "summary.json"
     written = verdicts

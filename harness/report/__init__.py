@@ -8,7 +8,8 @@ header has the git revision and the date.  One module per output:
     contents.py   what the report shows, gathered once (runs, verdicts, figures, costs)
     plots.py      the figures of case.txt, drawn by gnuplot (network.py: the force network)
     cost_plot.py  the error-against-cost diagram
-    markdown.py   summary.md
+    markdown.py   summary.md (the verdict, the failures, the KNOWN list, then each case)
+    known_list.py every KNOWN discrepancy of the catalogue, from reference/known.tsv
     html_page.py  index.html
 
 write_report() below calls them in that order.  summary.md and index.html reach reports/
@@ -23,6 +24,7 @@ from .. import REPO_ROOT, files
 from ..children import options as child_options
 from .contents import gather
 from .html_page import page, stability_html
+from .known_list import html_section as known_html, markdown_lines as known_markdown, rows as known_rows
 from .markdown import markdown, stability_markdown
 
 
@@ -46,9 +48,11 @@ def write_report(cases, checks, store, runs_root, reports_dir, out=None, render=
     reports_dir = Path(reports_dir)
     reports = gather(cases, checks, store, runs_root, reports_dir, render)
     revision, date = git_revision(), now_text()
-    files.write_text(reports_dir / "summary.md", markdown(reports, revision, date) + stability_markdown(reports_dir))
+    record = known_rows()        # every KNOWN discrepancy, its case run or not (reference/known.tsv)
+    files.write_text(reports_dir / "summary.md", markdown(reports, revision, date, known_markdown(record, reports_dir))
+                     + stability_markdown(reports_dir))
     index = reports_dir / "index.html"
-    files.write_text(index, page(reports, revision, date).replace("</body></html>",
+    files.write_text(index, page(reports, revision, date, known_html(record, reports_dir)).replace("</body></html>",
                                                                   stability_html(reports_dir) + "</body></html>"))
     if out:
         print(f"wrote {reports_dir / 'summary.md'} and {index}", file=out)

@@ -115,7 +115,7 @@ def _index_html(reports):
     return table_html(["case", "title", "tier", "runs ok", "checks"], rows)
 
 
-def page(reports, revision, date):
+def page(reports, revision, date, known_html=""):
     verdicts = [v for r in reports for v in r.verdicts]
     passed, failed = tally(verdicts)
     return "\n".join([
@@ -125,7 +125,7 @@ def page(reports, revision, date):
         f"<p class=\"meta\">git revision <code>{esc(revision)}</code> &middot; {esc(date)} &middot; "
         f"<span class=\"{'FAIL' if failed or not verdicts else 'PASS' if passed else 'SKIP'}\">"
         f"{counts_text(verdicts)}</span></p>",
-        "</header>", _index_html(reports), *[_case_html(r) for r in reports], "</body></html>", ""])
+        "</header>", known_html, _index_html(reports), *[_case_html(r) for r in reports], "</body></html>", ""])
 
 
 COST_TEXT = ("Error against cost: every declared [sweep] of the case (harness/sweep.py). "

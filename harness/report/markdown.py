@@ -5,9 +5,16 @@ from .contents import ENERGY_COLUMNS, energy_cells, stability_tables
 from .cost_plot import UNSTABLE
 
 
-def markdown(reports, revision, date):
+def markdown(reports, revision, date, known_lines=()):
+    """The verdict first, then the failures, then known_lines (every KNOWN discrepancy of the
+    catalogue: known_list.py), then the cases."""
     verdicts = [v for r in reports for v in r.verdicts]
     lines = ["# ballast validation report", "", f"Revision `{revision}`, {date}. **{counts_text(verdicts)}.**", ""]
+    failures = [v for v in verdicts if v.result == "FAIL"]
+    if failures:
+        lines += [f"## Failures ({len(failures)})", ""]
+        lines += [f"- **FAIL** {v.case}/{v.check} ({v.variant}): {_md(v.message)}" for v in failures] + [""]
+    lines += list(known_lines)
     for r in reports:
         lines += _markdown_case(r)
     return "\n".join(lines) + "\n"

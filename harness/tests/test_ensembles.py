@@ -143,7 +143,7 @@ def test_a_check_over_an_ensemble_through_the_command_line(project, runs, capsys
                    "provenance = F = 10 k, k = 1..4\n")
     assert main(["run", "spring"]) == 0
     capsys.readouterr()
-    assert main(["check", "spring"]) == 0
+    assert main(["check", "-v", "spring"]) == 0
     assert "k_mean" in capsys.readouterr().out
 
 

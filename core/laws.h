@@ -121,18 +121,7 @@ struct bal_kin {
 #define BAL_COPYSIGN(mag, sgn) copysign(mag, sgn)
 #define BAL_SQRT(x) sqrt(x)
 #define BAL_POW(x, e) pow(x, e)
-#include "laws_lanes.h"
-#undef BAL_R
-#undef BAL_M
-#undef BAL_KIN
-#undef BAL_W
-#undef BAL_SPLAT
-#undef BAL_ANY
-#undef BAL_SELECT
-#undef BAL_ABS
-#undef BAL_COPYSIGN
-#undef BAL_SQRT
-#undef BAL_POW
+#include "laws_lanes.h" /* undefines the names above at its end */
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -178,18 +167,7 @@ static inline bal_v2 bal_v2_pow(bal_v2 x, double e) { return (bal_v2){pow(x[0], 
 #define BAL_COPYSIGN(mag, sgn) bal_v2_copysign(mag, sgn)
 #define BAL_SQRT(x) bal_v2_sqrt(x)
 #define BAL_POW(x, e) bal_v2_pow(x, e)
-#include "laws_lanes.h"
-#undef BAL_R
-#undef BAL_M
-#undef BAL_KIN
-#undef BAL_W
-#undef BAL_SPLAT
-#undef BAL_ANY
-#undef BAL_SELECT
-#undef BAL_ABS
-#undef BAL_COPYSIGN
-#undef BAL_SQRT
-#undef BAL_POW
+#include "laws_lanes.h" /* undefines the names above at its end */
 #endif /* __SSE2__ */
 
 /* ---------------------------------------------------------------- normal */

@@ -81,3 +81,17 @@ static inline BAL_R BAL_W(bal_law_shear)(const struct bal_law_params *P,
     }
     return fs;
 }
+
+/* The names this width was compiled with, undefined, so that laws.h can
+ * include this file again with those of the other width. */
+#undef BAL_R
+#undef BAL_M
+#undef BAL_KIN
+#undef BAL_W
+#undef BAL_SPLAT
+#undef BAL_ANY
+#undef BAL_SELECT
+#undef BAL_ABS
+#undef BAL_COPYSIGN
+#undef BAL_SQRT
+#undef BAL_POW

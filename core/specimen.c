@@ -46,6 +46,12 @@
  * walks them are one responsibility, scene order, and the table needs every
  * lay function beside it; the grading curve's maths, which needs none of
  * it, is grading.c.
+ *
+ * Kept whole (about 790 lines): every function here turns the scene's
+ * generator sections into discs in scene order or back (count, lay, name,
+ * origin, find), all through the one generator table; split by generator,
+ * each file would need the table's walk and scene order again.  The grading
+ * curve's maths, which needs neither, is its own file (grading.c).
  */
 #include <math.h>
 #include <stdio.h>

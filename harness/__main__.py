@@ -1,5 +1,5 @@
 """The command line: python3 -m harness {list,run,check,report,validate,rebaseline,sweep,cost,
-stability,study,export,job,gather}.
+stability,study,export,job,gather,plot,movie}.
 
 Each command is a small function that loads the catalogue and references, picks the
 cases, and hands over to runner, gate, report or rebaseline.  Exit statuses besides 0 and
@@ -24,13 +24,13 @@ from contextlib import nullcontext
 from pathlib import Path
 
 from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_root
-from . import catalogue, export, extremes, files, known, references, stability
+from . import catalogue, export, extremes, files, known, pictures, references, stability
 from . import study as studies
 from . import families  # noqa: F401 -- registers every case family's expression functions
 from . import sweep as sweeps
 from . import sweep_grid
 from .compare import RunStore, folder_locator
-from .errors import Busy, CatalogueError, IniError
+from .errors import Busy, CatalogueError, IniError, PictureError
 from .gate import gate
 from .lock import reports_lock
 from .rebaseline import rebaseline
@@ -230,6 +230,29 @@ def cmd_gather(args):
     return 1 if refused else 0
 
 
+def cmd_plot(args):
+    """One state of any run folder drawn to scale with its force chains (pictures.py)."""
+    return _picture(pictures.plot, args.run, at=args.at, out=args.out, colour=args.colour, since=args.since,
+                    script=args.script)
+
+
+def cmd_movie(args):
+    """An animation of a run folder's snapshots (pictures.py)."""
+    return _picture(pictures.movie, args.run, out=args.out, every=args.every, colour=args.colour,
+                    since=args.since, script=args.script)
+
+
+def _picture(fn, run, **options):
+    try:
+        said = fn(run, **options)
+    except RuntimeError as exc:        # gnuplot missing or failing: not the input's fault
+        print(f"ballast-harness: {exc}", file=sys.stderr)
+        return 1
+    for line in said:
+        print(line)
+    return 0
+
+
 STABILITY_RUNS = "stability-runs"     # the trial runs of `stability`, under the reports root
 
 
@@ -384,7 +407,34 @@ def parser():
     gat.add_argument("dir", type=Path, metavar="DIR")
     gat.add_argument("--bin", type=Path, default=None,
                      help="the core executable the runs must have been made by (default $BALLAST_BIN or bin/ballast)")
+    _pictures(sub)
     return p
+
+
+def _pictures(sub):
+    """plot and movie: they read one run folder and write one file (no reports lock)."""
+    plot = _command(sub, "plot", cmd_plot, "draw a run's discs to scale and its force chains (bar width "
+                    "proportional to F_n) with gnuplot: the final state, or the snapshot nearest --at TIME "
+                    "(docs/pictures.md)", writes=False)
+    plot.add_argument("run", type=Path, metavar="RUN", help="a run folder (what bin/ballast run --out wrote)")
+    plot.add_argument("--at", type=float, metavar="TIME",
+                      help="draw the snapshot nearest this simulated time (snapshots/index.tsv)")
+    plot.add_argument("--out", type=Path, metavar="FILE",
+                      help="the picture, .svg or .png (default RUN/plot.svg, with --at RUN/plot.FFFFFF.svg)")
+    movie = _command(sub, "movie", cmd_movie, "animate a run's snapshots: an animated GIF, or PNG frames in "
+                     "a self-contained HTML player (docs/pictures.md)", writes=False)
+    movie.add_argument("run", type=Path, metavar="RUN", help="a run folder with snapshots/")
+    movie.add_argument("--out", type=Path, metavar="FILE", help="the movie, .gif or .html (default RUN/movie.gif)")
+    movie.add_argument("--every", type=int, default=1, metavar="K",
+                       help="every K-th snapshot from the first, and the last always (default 1)")
+    for p in (plot, movie):
+        p.add_argument("--colour", choices=pictures.COLOURS, default="rotation",
+                       help="fill the discs by their rotation (default), speed, or grey")
+        p.add_argument("--since", metavar="STAGE",
+                       help="rotation since the start of this stage (the last snapshot at or before its first "
+                            "cycle; default: since the first snapshot)")
+        p.add_argument("--script", type=Path, metavar="FILE",
+                       help="also write the gnuplot script, its data inline, to FILE")
 
 
 def _command(sub, name, fn, text, writes=True):
@@ -419,7 +469,7 @@ def main(argv=None):
         with sigterm_as_interrupt():          # SIGTERM stops the runs like Ctrl-C: exit 130
             with reports_lock(reports_root(), args.command) if args.writes else nullcontext():
                 return args.fn(args)
-    except (IniError, CatalogueError) as exc:
+    except (IniError, CatalogueError, PictureError) as exc:
         print(f"ballast-harness: {exc}", file=sys.stderr)
         return USAGE_ERROR
     except KeyboardInterrupt:

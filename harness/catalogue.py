@@ -36,6 +36,17 @@ takes kind, title, variants and paper; variants default to all of the case's):
                and y = [LABEL;] EXPR (repeatable, paired in order: one line per pair and group),
                slope = number | asin (the legend gives the slope, or the angle whose sine it is),
                xlabel, ylabel, xrange, yrange
+    snapshots  frames of the variants' snapshots drawn to scale (harness/pictures.py), one row
+               per variant, one column per frame: show = network (force chains on grey discs)
+               | rotation (discs coloured by their rotation) | both; first = [LABEL;] EXPR (a
+               cycle: the first frame is the snapshot nearest it; default the first snapshot);
+               frames = N (default 4: from the first frame to the last snapshot, evenly spread);
+               since = STAGE (rotation since the last snapshot at or before the stage's first
+               cycle; default the first snapshot); label = NAME; EXPR (an array expression over
+               the last rows of series.tsv, as the biaxial family's per-row functions give:
+               its value at each frame's cycle, interpolated, heads the panel)
+    movie      an animated GIF of every snapshot of its variants, side by side: show, since and
+               label as for snapshots; every = K (every K-th snapshot and the last; default 1)
 
 A key that the figure's kind does not use is an error, as is an unknown kind.
 [sweep NAME] sections declare the case's error-against-cost sweeps (keys in sweep_spec.py).
@@ -58,7 +69,8 @@ from .sweep_spec import parse as parse_sweep
 CASE_KEYS = {"tier", "title", "checks", "runtime", "stability"}
 VARIANT_KEYS = {"scene", "set", "command", "label"}
 COMMANDS = ("run", "exact", "peer", "peer_rolling")
-FIGURE_KINDS = ("series", "network", "profile", "principal", "points", "curves", "errorbars", "fit")
+FIGURE_KINDS = ("series", "network", "profile", "principal", "points", "curves", "errorbars", "fit",
+                "snapshots", "movie")
 _COMMON = {"kind", "title", "variants", "paper"}
 _AXES = {"xlabel", "ylabel", "xrange", "yrange"}
 FIGURE_KIND_KEYS = {
@@ -70,7 +82,10 @@ FIGURE_KIND_KEYS = {
     "curves": _COMMON | _AXES | {"x", "y"},
     "errorbars": _COMMON | _AXES | {"x", "y", "paper_point"},
     "fit": (_COMMON - {"variants"}) | _AXES | {"group", "x", "y", "slope"},
+    "snapshots": _COMMON | {"show", "first", "frames", "since", "label"},
+    "movie": _COMMON | {"show", "since", "label", "every"},
 }
+SHOWS = ("network", "rotation", "both")
 SLOPES = ("number", "asin")
 FIGURE_KEYS = set().union(*FIGURE_KIND_KEYS.values())
 LOGSCALES = {"": "", "x": "x", "y": "y", "xy": "xy", "yx": "xy"}
@@ -117,6 +132,14 @@ class Figure:
     slope: str = "number"    # fit: how the legend gives a line's slope (SLOPES)
     names: dict = field(default_factory=dict)   # variant -> its legend label (the variants' `label`)
     references: list = field(default_factory=list)   # series: checks whose reference value is drawn
+    show: str = ""           # snapshots, movie: one of SHOWS
+    first: str = ""          # snapshots: the expression of the first frame's cycle ('' : the first snapshot)
+    first_label: str = ""    # snapshots: what that cycle is ('the peak of phi')
+    frames: int = 0          # snapshots: how many frames per variant
+    since: str = ""          # snapshots, movie: the stage the rotation is counted from ('' : the first snapshot)
+    label: str = ""          # snapshots, movie: the name of the panels' label quantity
+    label_expr: str = ""     # snapshots, movie: its array expression over the last rows of series.tsv
+    every: int = 1           # movie: every K-th snapshot
 
 
 @dataclass
@@ -423,9 +446,29 @@ def _fit(section, common):
                   **_axes(section, xs[0], ys[0]), **common)
 
 
+def _snapshots(section, common):
+    """snapshots and movie: the frames of the variants' snapshots (harness/pictures.py)."""
+    show = section.get("show", "network" if common["kind"] == "snapshots" else "both")
+    if show not in SHOWS:
+        raise section.error(f"'show' must be one of {', '.join(SHOWS)}, not '{show}'", section.entry("show").line)
+    out = Figure(variants=section.get("variants", "").split(), x="", y=[], xlabel="", ylabel="", show=show,
+                 since=section.get("since", ""), **common)
+    for key, least, default in (("frames", 1, 4), ("every", 1, 1)):
+        value = section.number(key, float(default))
+        if not value.is_integer() or value < least:
+            raise section.error(f"'{key}' must be a whole number, {least} or more, not '{section.get(key)}'",
+                                section.entry(key).line)
+        setattr(out, key, int(value))
+    if section.entry("first"):
+        (out.first_label,), (out.first,) = _labelled(section, "first")
+    if section.entry("label"):
+        (out.label,), (out.label_expr,) = _labelled(section, "label")
+    return out
+
+
 FIGURE_MAKERS = {"series": _series, "network": _one_variant, "profile": _profile,
                  "principal": _one_variant, "points": _points, "curves": _curves,
-                 "errorbars": _errorbars, "fit": _fit}
+                 "errorbars": _errorbars, "fit": _fit, "snapshots": _snapshots, "movie": _snapshots}
 
 
 def _range(section, key):

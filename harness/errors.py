@@ -5,6 +5,7 @@ an exit status, or a check (harness/compare.py) into a FAIL with its reason:
 
     IniError        a malformed case.txt, .ref or extremes.txt: 'file:line: what'   exit 2
     CatalogueError  a catalogue problem not tied to one line (an unknown case name) exit 2
+    PictureError    a run that cannot be drawn (not a run folder, no snapshots)     exit 2
     RunProblem      a run's outputs cannot be used: missing, failed or malformed    a FAIL
     RunSkipped      a run that says it could not run (an outside tool is missing)   a SKIP
     EvalError       a quantity could not be evaluated to one finite number          a FAIL
@@ -36,6 +37,11 @@ class IniError(ValueError):
 
 class CatalogueError(ValueError):
     """A catalogue problem that is not tied to one line (e.g. an unknown case name)."""
+
+
+class PictureError(ValueError):
+    """A run folder that `plot` or `movie` cannot draw: not a run, no snapshots where they are
+    asked for, a malformed table (named file:line), a bad option value."""
 
 
 class RunProblem(Exception):

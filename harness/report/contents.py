@@ -16,7 +16,7 @@ from ..references import reference_lines
 from ..stability import read_tsv
 from ..tables import read_harness_record, read_run_json
 from .cost_plot import render_cost
-from .plots import FigureOut, render_figure
+from .plots import RASTER, FigureOut, render_figure
 
 
 @dataclass
@@ -85,7 +85,8 @@ def with_references(figure, checks):
 def drawn_before(case, figure, figures_dir):
     """The FigureOut of a figure an earlier report drew (its files, where they exist)."""
     out = FigureOut(figure.name, figure.title, figure.paper)
-    png, svg = (Path(figures_dir) / f"{case.name}_{figure.name}.{ext}" for ext in ("png", "svg"))
+    png, svg = (Path(figures_dir) / f"{case.name}_{figure.name}.{ext}"
+                for ext in (RASTER.get(figure.kind, "png"), "svg"))
     out.png, out.svg = (png if png.is_file() else None), (svg if svg.is_file() else None)
     if out.png is None and out.svg is None:
         out.notes.append("not drawn yet: run `harness report` (or validate) with this case")

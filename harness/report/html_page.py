@@ -49,7 +49,8 @@ def image_html(figure):
     if figure.svg and (figure.svg.stat().st_size <= SVG_INLINE_MAX or not figure.png):
         src = "data:image/svg+xml;base64," + base64.b64encode(figure.svg.read_bytes()).decode()
     elif figure.png:
-        src = "data:image/png;base64," + base64.b64encode(figure.png.read_bytes()).decode()
+        src = (f"data:image/{figure.png.suffix.lstrip('.')};base64,"      # png, or gif: a movie
+               + base64.b64encode(figure.png.read_bytes()).decode())
         if figure.svg:
             link = (f" (<a href=\"figures/{esc(figure.svg.name)}\">vector version</a>, "
                     f"{figure.svg.stat().st_size / 1e6:.1f} MB)")

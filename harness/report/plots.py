@@ -37,6 +37,7 @@ from ..children import options as child_options
 from ..compare import evaluate, evaluate_array
 from ..errors import EvalError, RunProblem
 from ..expressions import Siblings
+from .. import pictures
 from ..families import piles
 from ..final_state import state
 from . import network
@@ -51,7 +52,7 @@ class FigureOut:
     title: str
     paper: str = ""
     svg: Path = None
-    png: Path = None
+    png: Path = None         # the raster image: a PNG, or a GIF for a movie (RASTER)
     notes: list = field(default_factory=list)
 
 
@@ -434,20 +435,23 @@ def _walls(folder):
 
 SCRIPTS = {"series": _series_script, "network": _network_script, "profile": _profile_script,
            "principal": _principal_script, "points": _points_script, "curves": _curves_script,
-           "errorbars": _errorbars_script, "fit": _fit_script}
+           "errorbars": _errorbars_script, "fit": _fit_script,
+           "snapshots": pictures.snapshots_script, "movie": pictures.movie_script}
+RASTER = {"movie": "gif"}   # a kind drawn as another raster image than PNG: the movie, an animated GIF
 
 
 def render_figure(case, figure, store, figures_dir):
     """Render one [figure] into figures_dir/<case>_<figure>.png/.svg; a FigureOut with notes."""
     out = FigureOut(figure.name, figure.title, figure.paper)
-    png, svg = (Path(figures_dir) / f"{case.name}_{figure.name}.{ext}" for ext in ("png", "svg"))
+    raster = RASTER.get(figure.kind, "png")
+    png, svg = (Path(figures_dir) / f"{case.name}_{figure.name}.{ext}" for ext in (raster, "svg"))
     for old in (png, svg):
         files.remove(old)
     if not shutil.which("gnuplot"):
         out.notes.append("gnuplot not found: figure not rendered")
         return out
     with tempfile.TemporaryDirectory(prefix="ballast-fig-") as workdir:
-        drawn = drawings(workdir)
+        drawn = drawings(workdir, raster)
         text, out.notes = SCRIPTS[figure.kind](case, figure, store, workdir, *drawn)
         if text is None:
             return out
@@ -458,9 +462,9 @@ def render_figure(case, figure, store, figures_dir):
     return out
 
 
-def drawings(workdir):
+def drawings(workdir, raster="png"):
     """Where gnuplot draws a figure: the scratch folder (its data files end in .dat)."""
-    return Path(workdir) / "figure.png", Path(workdir) / "figure.svg"
+    return Path(workdir) / f"figure.{raster}", Path(workdir) / "figure.svg"
 
 
 def publish(drawn, final):

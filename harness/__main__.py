@@ -465,6 +465,11 @@ def main(argv=None):
     args = parser().parse_args(argv)
     if hasattr(args, "bin") and args.bin is None:
         args.bin = bin_path()
+    # Every path given is taken from the caller's folder, once, here: the core runs in other
+    # folders (runner.py), where a relative --out or --bin would name something else.
+    for name, value in vars(args).items():
+        if isinstance(value, Path):
+            setattr(args, name, value.absolute())
     try:
         with sigterm_as_interrupt():          # SIGTERM stops the runs like Ctrl-C: exit 130
             with reports_lock(reports_root(), args.command) if args.writes else nullcontext():

@@ -35,6 +35,21 @@ def test_wrapper_script_runs_the_harness(project):
     assert "spring" in done.stdout and "slow" in done.stdout
 
 
+def test_wrapper_script_takes_paths_relative_to_where_it_is_called(tmp_path):
+    """A user's scene and --out given relative to the user's folder (the wrapper used to cd to
+    the repository first, so `ballast-harness study my.scene` said "no such scene file")."""
+    (tmp_path / "two.scene").write_text("[settings]\ndt = 1e-3\n\n[material m]\nkn = 1000\ndensity = 1\n\n"
+                                        "[disc a]\nx = 0 0\nr = 1\nmaterial = m\nv = 1 0\n\n"
+                                        "[disc b]\nx = 2.1 0\nr = 1\nmaterial = m\n\n[stage s]\ncycles = 400\n")
+    done = subprocess.run([str(WRAPPER), "study", "two.scene", "--out", "here", "--levels", "3",
+                           "--quantity", "final(disc_x(b))"], cwd=tmp_path, capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr
+    rows = (tmp_path / "here" / "study.tsv").read_text().splitlines()
+    status = rows[0].split("\t").index("status")
+    assert [r.split("\t")[status] for r in rows[1:]] == ["ok"] * 3, rows
+
+
 def test_validate_runs_checks_and_reports(project, capsys):
     assert main(["validate", "-j", "3"]) == 0
     out = capsys.readouterr().out

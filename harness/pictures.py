@@ -50,6 +50,7 @@ import numpy as np
 
 from . import REPO_ROOT, files, reports_root
 from .children import options as child_options
+from .compare import evaluate, evaluate_array
 from .errors import EvalError, PictureError, RunProblem, shown
 from .expressions import Siblings
 from .final_state import Table
@@ -113,9 +114,19 @@ class State:
     walls: list         # (ax, ay, bx, by) per wall
 
 
+class _Sheet(Table):
+    """A Table whose problems are PictureErrors (a run that cannot be drawn: exit 2)."""
+
+    def numbers(self, name):
+        try:
+            return super().numbers(name)
+        except EvalError as exc:
+            raise PictureError(str(exc)) from None
+
+
 def _table(path, needed):
     try:
-        return Table(path, needed)
+        return _Sheet(path, needed)
     except EvalError as exc:
         raise PictureError(str(exc)) from None
 
@@ -508,8 +519,6 @@ def publish(drawn, path):
 
 def _reference(run, info, found, colour, since):
     """(the State rotations are counted from or None, what it is) for --colour and --since."""
-    if since and not found:
-        raise PictureError(f"--since needs snapshots: {shown(run)} has none")
     if colour != "rotation":
         return None, ""
     if not found:
@@ -629,7 +638,6 @@ def _label_at(figure, run, siblings, notes, variant):
     """A function cycle -> the panel's label text (from the figure's `label`), or to ''."""
     if not figure.label_expr:
         return lambda cycle: ""
-    from .compare import evaluate_array
     try:
         values = evaluate_array(figure.label_expr, run, siblings)
     except EvalError as problem:
@@ -668,7 +676,6 @@ def _since_text(figure, references):
 def snapshots_script(case, figure, store, workdir, png, svg):
     """A grid of frames (rows: variants, columns: frames from `first` to the last snapshot) as a
     PNG only (a vector grid of thousands of discs would weigh megabytes).  (script, notes)."""
-    from .compare import evaluate
     notes, rows, references = [], [], []
     siblings = Siblings(lambda other: store.get(case.name, other), case.ensemble_members())
     for variant in figure.variants:

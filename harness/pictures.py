@@ -73,7 +73,8 @@ MIN_ROTATION_RANGE = 1.0    # degrees: no narrower scale, so the round-off turns
 MARGIN_SHARE = 0.03         # the blank border around the discs, a share of the larger side of their extent
 MOVIE_DELAY = 50            # hundredths of a second between the frames of a GIF: two frames a second
 PANEL_PX = 560              # the width of one panel of `plot` and `movie`, pixels
-GRID_PANEL_PX = 250         # the width of one panel of a report grid (several frames and variants)
+GRID_PANEL_PX = 300         # the width of one panel of a report grid (several frames and variants)
+MOVIE_PANEL_PX = 360        # the width of one variant's panel of a report movie
 FONT = "sans,10"
 GIF_FONT = "DejaVuSans,9"   # the GIF terminal (libgd) finds TrueType fonts by file name
 PALETTES = {"rotation": "set palette defined (-1 '#2166ac', -0.5 '#92c5de', 0 '#f7f7f7', 0.5 '#f4a582', 1 '#b2182b')",
@@ -250,6 +251,8 @@ class Panel:
     values: np.ndarray = None   # per disc: the rotation or speed coloured (None: grey)
     chains: bool = True
     title: str = ""
+    border: bool = True         # a thin grey ring round each disc (off in the report's small panels:
+                                # at 2 or 3 pixels a disc, the rings drown the chains and swell the PNG)
 
 
 def rotation(state, reference):
@@ -373,17 +376,18 @@ def panel_commands(k, panel, s, has_bars, colourbox=True, tics=True):
     """The commands that draw panel k (after its data blocks)."""
     x0, x1, y0, y1 = s.box
     out = [f"set title {gp_text(panel.title or panel.state.label)}",
-           f"set xrange [{x0!r}:{x1!r}]", f"set yrange [{y0!r}:{y1!r}]", "set size ratio -1", "unset key"]
+           f"set xrange [{x0!r}:{x1!r}]", f"set yrange [{y0!r}:{y1!r}]", "set size ratio -1", "unset key",
+           "set clip two"]      # a wall whose both ends lie outside the box is still drawn
     out += ["set tics out nomirror scale 0.5", "set format x '%g'", "set format y '%g'"] if tics else ["unset tics"]
+    border = f"border lc rgb '{DISC_BORDER}'" if panel.border else "noborder"
     if panel.values is not None and s.crange:
         out += [PALETTES[panel.colour], f"set cbrange [{s.crange[0]!r}:{s.crange[1]!r}]",
                 "set colorbox" if colourbox else "unset colorbox", "set cbtics scale 0.5"]
         discs = (f"$discs_{k} using 1:2:3:($4 < {s.crange[0]!r} ? {s.crange[0]!r} : $4 > {s.crange[1]!r} ? "
-                 f"{s.crange[1]!r} : $4) with circles lc palette lw 0.4 fs solid 1.0 border lc rgb '{DISC_BORDER}'")
+                 f"{s.crange[1]!r} : $4) with circles lc palette lw 0.4 fs solid 1.0 {border}")
     else:
         out.append("unset colorbox")
-        discs = (f"$discs_{k} using 1:2:3 with circles fc rgb '{GREY_DISC}' lw 0.4 fs solid 1.0 "
-                 f"border lc rgb '{DISC_BORDER}'")
+        discs = f"$discs_{k} using 1:2:3 with circles fc rgb '{GREY_DISC}' lw 0.4 fs solid 1.0 {border}"
     clauses = [discs]
     if panel.state.fixed.any():
         clauses.append(f"$discs_{k} using 1:2:($5 > 0 ? $3 : 1/0) with circles lc rgb '#000000' lw 1.5 fs empty")
@@ -391,7 +395,7 @@ def panel_commands(k, panel, s, has_bars, colourbox=True, tics=True):
         clauses.append(f"$chains_{k} using 1:2 with filledcurves closed fs solid 1.0 noborder "
                        f"lc rgb '{CHAIN_COLOUR}'")
     if panel.state.walls:
-        clauses.append(f"$walls_{k} using 1:2 with lines lw 2.5 lc rgb '{WALL_COLOUR}'")
+        clauses.append(f"$walls_{k} using 1:2 with lines lw {2.5 if tics else 1.5} lc rgb '{WALL_COLOUR}'")
     out.append("plot " + ", \\\n     ".join(clauses))
     return out
 
@@ -409,25 +413,46 @@ def terminal(path, size, gif_delay=MOVIE_DELAY):
     raise PictureError(f"{path}: cannot draw a {ext or 'file without extension'}")
 
 
-def canvas(s, columns, rows, panel_px, title_lines, colourbox, tics, head_lines=0):
-    """Pixel size of a canvas of rows x columns panels of the box s.box, each panel's title
-    title_lines high, under a page title of head_lines."""
+LINE_PX = 16          # a line of title text at the fonts above, pixels
+GAP_PX = 12           # between two panels of a grid, and round its edges
+COLOURBOX_PX = 70     # right of a grid's last column: the colour box and its labels
+
+
+@dataclass
+class Layout:
+    """A page's size in pixels and, for a grid, where its panels go (gnuplot's multiplot
+    `margins` and `spacing`, fractions of the page): every panel's plot area is the same size,
+    panel_px wide and as high as the box's aspect makes it."""
+    size: tuple
+    margins: tuple = None
+    spacing: tuple = None
+
+
+def layout(s, columns, rows, panel_px, title_lines, colourbox, head_lines):
     x0, x1, y0, y1 = s.box
-    aspect = (y1 - y0) / (x1 - x0)
-    extra_w = (70 if colourbox else 10) + (50 if tics else 10)
-    cell_w = panel_px + extra_w
-    cell_h = int(aspect * panel_px) + 16 * title_lines + (40 if tics else 14)
-    return columns * cell_w, rows * cell_h + (16 * head_lines + 14 if head_lines else 0)
+    panel_h = (y1 - y0) / (x1 - x0) * panel_px
+    if rows * columns == 1:       # one plot with its tics and gnuplot's own margins
+        return Layout((panel_px + (70 if colourbox else 10) + 60, int(panel_h + LINE_PX * title_lines + 60)))
+    title_px = LINE_PX * title_lines + 6
+    head_px = LINE_PX * (head_lines + 1) + 6     # gnuplot sets the page title a line below the top
+    right_px = COLOURBOX_PX if colourbox else GAP_PX
+    w = GAP_PX + columns * panel_px + (columns - 1) * GAP_PX + right_px
+    h = head_px + rows * (title_px + panel_h) + (rows - 1) * GAP_PX + GAP_PX
+    w, h = int(math.ceil(w)), int(math.ceil(h))
+    return Layout((w, h), (GAP_PX / w, 1 - right_px / w, GAP_PX / h, 1 - (head_px + title_px) / h),
+                  (GAP_PX / w, (GAP_PX + title_px) / h))
 
 
-def page_commands(grid, s, figure_title=""):
+def page_commands(grid, s, figure_title, where):
     """Commands drawing one page: grid is a list of rows of (k, panel, has_bars); one panel is
-    a plain plot, more a multiplot (colour box on the last column only)."""
+    a plain plot, more a multiplot placed by the Layout where (colour box on the last column)."""
     rows, columns = len(grid), max(len(r) for r in grid)
     if rows * columns == 1:
         k, panel, has_bars = grid[0][0]
         return panel_commands(k, panel, s, has_bars)
-    out = [f"set multiplot layout {rows},{columns} title {gp_text(figure_title)}"]
+    (l, r, b, t), (xs, ys) = where.margins, where.spacing
+    out = [f"set multiplot layout {rows},{columns} title {gp_text(figure_title)} "
+           f"margins {l!r},{r!r},{b!r},{t!r} spacing {xs!r},{ys!r}"]
     for row in grid:
         for c, (k, panel, has_bars) in enumerate(row):
             out += panel_commands(k, panel, s, has_bars, colourbox=(c == len(row) - 1), tics=False)
@@ -468,9 +493,8 @@ def page_script(pages, s, out_path, title, panel_px, gif_delay=MOVIE_DELAY, outp
     single = rows * columns == 1
     colourbox = any(p.values is not None for page in pages for row in page for p in row)
     title_lines = 1 + max(str(p.title).count("\n") for page in pages for row in page for p in row)
-    size = canvas(s, columns, rows, panel_px, title_lines, colourbox, single,
-                  0 if single else 1 + str(title).count("\n"))
-    lines = [terminal(outputs[0] if outputs else out_path, size, gif_delay)]
+    where = layout(s, columns, rows, panel_px, title_lines, colourbox, 0 if single else 1 + str(title).count("\n"))
+    lines = [terminal(outputs[0] if outputs else out_path, where.size, gif_delay)]
     if not outputs:
         lines.append(f"set output {gp_path(out_path)}")
     lines += blocks + ["set style fill solid 1.0"]
@@ -478,7 +502,7 @@ def page_script(pages, s, out_path, title, panel_px, gif_delay=MOVIE_DELAY, outp
         if outputs:
             lines.append(f"set output {gp_path(outputs[n])}")
         page_title = title if not single else ""
-        lines += page_commands(grid, s, page_title)
+        lines += page_commands(grid, s, page_title, where)
     lines += ["unset output", ""]
     return "\n".join(lines)
 
@@ -650,15 +674,15 @@ def _label_at(figure, run, siblings, notes, variant):
 
     def label(cycle):
         if not cycles[0] <= cycle <= cycles[-1]:
-            return f"{figure.label} -"
-        return f"{figure.label} {float(np.interp(cycle, cycles, values)):.3g}"
+            return f"{figure.label} = -"
+        return f"{figure.label} = {float(np.interp(cycle, cycles, values)):#.3g}"
     return label
 
 
 def _panel(figure, state, reference, title):
     colour = "none" if figure.show == "network" else "rotation"
     values = rotation(state, reference[0]) if colour == "rotation" else None
-    return Panel(state, colour, values, chains=figure.show in ("network", "both"), title=title)
+    return Panel(state, colour, values, chains=figure.show in ("network", "both"), title=title, border=False)
 
 
 def _since_text(figure, references):
@@ -742,7 +766,7 @@ def movie_script(case, figure, store, workdir, gif, svg):
         pages.append([row])
     s = scales([p for page in pages for p in page[0]])
     title = "\n".join([figure.title] + scale_lines(s, pages[0][0][0].colour, _since_text(figure, references)))
-    return page_script(pages, s, gif, title, GRID_PANEL_PX * 3 // 2), notes
+    return page_script(pages, s, gif, title, MOVIE_PANEL_PX), notes
 
 
 PLAYER = """<!DOCTYPE html>

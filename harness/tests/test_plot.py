@@ -449,7 +449,7 @@ def test_snapshot_grid_frames_run_from_first_to_the_last(drop_project, drop, tmp
     import numpy as np
     ek = float(np.interp(float(index[2]["cycle"]), [float(r["cycle"]) for r in series],
                          [float(r["Ek"]) for r in series]))
-    assert f"Ek {ek:.3g}, nearest one second in" in text and "bee, cycle" in text
+    assert f"Ek = {ek:#.3g}, nearest one second in" in text and "bee, cycle" in text
     # rotation since the start of stage rest, for both rows
     assert "since stage rest began" in text
     assert main(["report", "drop", "--tier", "full"]) == 0

@@ -464,3 +464,26 @@ def test_catalogue_refuses_bad_snapshot_figure_keys(drop_project, capsys, key, v
     assert main(["report", "drop", "--tier", "full"]) == 2
     err = capsys.readouterr().err
     assert message in err and "case.txt:" in err
+
+
+def test_tensile_and_open_contacts_are_not_drawn(drop, tmp_path, capsys):
+    """F_n = fn + dn: a contact whose dashpot pulls harder than its spring pushes is not drawn,
+    nor one the exact solver marks open."""
+    run = tmp_path / "run"
+    shutil.copytree(drop, run)
+    lines = (run / "contacts.tsv").read_text().splitlines()
+    head = lines[0].split("\t")
+    rows = [line.split("\t") for line in lines[1:]]
+    assert len(rows) >= 3
+    fn, dn = head.index("fn"), head.index("dn")
+    rows[0][dn] = repr(-2 * float(rows[0][fn]))                     # pulled apart by its dashpot
+    head.append("open")
+    for k, row in enumerate(rows):
+        row.append("1" if k == 1 else "0")                           # opened
+    (run / "contacts.tsv").write_text("\n".join("\t".join(r) for r in [head] + rows) + "\n")
+    script = tmp_path / "p.gp"
+    assert main(["plot", str(run), "--out", str(tmp_path / "p.png"), "--script", str(script)]) == 0
+    drawn = {(a, b) for a, b, *_ in bars(script)}
+    assert len(drawn) == len(rows) - 2
+    assert (rows[0][0], rows[0][1]) not in drawn and (rows[1][0], rows[1][1]) not in drawn
+    assert f"{len(rows) - 2} compressive contacts" in capsys.readouterr().out

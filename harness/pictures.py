@@ -325,8 +325,9 @@ def scale_lines(s, colour=None, since=""):
         out.append(f"bars: width proportional to F_n; the largest, {s.fmax:.4g}, drawn "
                    f"{CHAIN_WIDTH_SHARE * s.mean_r:.3g} wide ({CHAIN_WIDTH_SHARE:g} mean radius)")
     if s.crange and colour == "rotation":
-        out.append(f"colour: rotation in degrees, anticlockwise positive, -{s.crange[1]:g} to {s.crange[1]:g}"
-                   + (f", {since}" if since else ""))
+        out.append(f"colour: rotation in degrees, anticlockwise positive, -{s.crange[1]:g} to {s.crange[1]:g}")
+        if since:
+            out.append(since)
     elif s.crange and colour == "speed":
         out.append(f"colour: speed |v|, 0 to {s.crange[1]:g}")
     return out
@@ -548,7 +549,8 @@ def _reference(run, info, found, colour, since):
     if not found:
         return None, "theta as discs.tsv writes it (no snapshots)"
     frame = reference_frame(found, info, since) if since else found[0]
-    return frame_state(run, frame), f"since {frame.text()}" + (f", the start of stage {since}" if since else "")
+    return frame_state(run, frame), (f"since {frame.text()}" + (f" (the last snapshot before stage {since} began)"
+                                                                if since else ""))
 
 
 def plot(run, at=None, out=None, colour="rotation", since=None, script=None):

@@ -265,7 +265,7 @@ def test_plot_at_draws_the_snapshot_nearest_the_time(drop, tmp_path, capsys):
     times = [float(r["time"]) for r in index]
     assert len(index) >= 5
     for at, want in ((times[1] + 0.4 * (times[2] - times[1]), 1), (times[1] + 0.6 * (times[2] - times[1]), 2),
-                     ((times[1] + times[2]) / 2, 1), (-5.0, 0), (1e9, len(index) - 1)):
+                     (-5.0, 0), (1e9, len(index) - 1)):
         script = tmp_path / "at.gp"
         assert main(["plot", str(drop), "--at", repr(at), "--out", str(tmp_path / "at.svg"),
                      "--script", str(script)]) == 0

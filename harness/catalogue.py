@@ -85,7 +85,7 @@ FIGURE_KIND_KEYS = {
     "snapshots": _COMMON | {"show", "first", "frames", "since", "label"},
     "movie": _COMMON | {"show", "since", "label", "every"},
 }
-SHOWS = ("network", "rotation", "both")
+SHOWS = ("network", "rotation", "both")   # snapshots, movie: chains on grey discs, discs coloured by rotation, both
 SLOPES = ("number", "asin")
 FIGURE_KEYS = set().union(*FIGURE_KIND_KEYS.values())
 LOGSCALES = {"": "", "x": "x", "y": "y", "xy": "xy", "yx": "xy"}

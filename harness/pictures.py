@@ -43,7 +43,7 @@ import math
 import shutil
 import subprocess
 import tempfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -62,7 +62,6 @@ DISC_COLUMNS = ("name", "x", "y", "r", "theta", "vx", "vy")
 CONTACT_COLUMNS = ("a", "b", "kind", "x", "y", "fn")
 WALL_COLUMNS = ("name", "ax", "ay", "bx", "by")
 COLOURS = ("rotation", "speed", "none")
-SHOWS = ("network", "rotation", "both")   # a report figure: chains on grey discs, rotation alone, both
 
 CHAIN_WIDTH_SHARE = 0.8     # the largest F_n's bar is this share of the mean radius wide: narrower
                             # than a disc, so two bars side by side and the discs under them stay apart
@@ -296,6 +295,8 @@ class Scales:
 
 def scales(panels):
     states = [p.state for p in panels]
+    if not any(s.names for s in states):
+        raise PictureError(f"{states[0].label}: no discs to draw")
     x0 = min(float(np.min(s.x - s.r)) for s in states if s.names)
     x1 = max(float(np.max(s.x + s.r)) for s in states if s.names)
     y0 = min(float(np.min(s.y - s.r)) for s in states if s.names)

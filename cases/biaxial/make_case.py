@@ -21,6 +21,12 @@ RATE = 0.5                                # 1/s, biaxial.scene's
 STANDARD_CYCLES = 250000                  # natural axial strain 0.15 (0.5 /s x 1.2e-6 s per cycle)
 FULL_CYCLES = 500000                      # 0.30, biaxial.scene's
 PEAK_CUT = 18300                          # shear cycles of m1_d0.4_s200_e020 to its peak (a check keeps it)
+SNAPSHOT_DT = 0.04                        # s between the snapshots of the two tests the shear-band figures draw:
+                                          # frame k at 0.04 k s, so nine frames over the shearing (0.02 to 0.32 s),
+                                          # one at no rolling resistance's peak (0.042 s, 1.1 % axial strain)
+SNAPSHOTS = ("m0", "m1_d1.6")             # no rolling resistance and Model 1 delta = 1.6, side by side
+PAPER_BAND = ('"No attempt is to make in this paper to carry out DEM numerical simulations of shear band with '
+              'the model." (JYH 2005, Sec. 1)')
 WINDOW = {"standard": (0.10, 0.15), "full": (0.20, 0.30)}
 
 PAPER_FIG11 = ('"Fig. 11 shows that all these three models predict a strain-softening and shear-dilant '
@@ -109,14 +115,15 @@ def standard():
     parts = ["""[case biaxial]
 tier = standard
 title = Biaxial compression of JYH's specimen, reduced set (Jiang, Yu & Harris 2005, Sec. 5, Figs 11 and 13)
-checks = the prepared specimens' planar void ratios (0.25 and 0.20) and their profiles over height; on the dense specimen e020 (the one that softens and dilates as JYH's "medium-dense" one does, see the density study) at sigma_h = 200 kPa to an axial strain of 0.15, no rolling resistance, Model 2 and Model 1 at delta = 0.4 and Model 1 at delta = 1.6: the servo holds sigma_h, the peak phi rises with delta with Model 2 between no rolling and Model 1, the residual phi rises with delta, residual below peak, dilation; the force network at the peak
+checks = the prepared specimens' planar void ratios (0.25 and 0.20) and their profiles over height; on the dense specimen e020 (the one that softens and dilates as JYH's "medium-dense" one does, see the density study) at sigma_h = 200 kPa to an axial strain of 0.15, no rolling resistance, Model 2 and Model 1 at delta = 0.4 and Model 1 at delta = 1.6: the servo holds sigma_h, the peak phi rises with delta with Model 2 between no rolling and Model 1, the residual phi rises with delta, residual below peak, dilation; the force network at the peak; the force network and the rotation field from the peak to the residual (the shear band) and a movie of the shearing, for no rolling resistance and delta = 1.6
 runtime = 120
 stability = no
 """]
     parts.append(specimen_variant("specimen_e025_r1", "e025_r1"))
     parts.append(specimen_variant("specimen_e020_r1", "e020_r1"))
     for m in FIG11:
-        parts.append(variant(f"{m}_s200_e020", m, 200, specimen="e020_r1", cycles=STANDARD_CYCLES))
+        extra = [f"settings.snapshot_dt={SNAPSHOT_DT}"] if m in SNAPSHOTS else []
+        parts.append(variant(f"{m}_s200_e020", m, 200, specimen="e020_r1", cycles=STANDARD_CYCLES, extra=extra))
     parts.append(variant("m1_d0.4_s200_e020_peak", "m1_d0.4", 200, specimen="e020_r1", cycles=PEAK_CUT,
                          comment="m1_d0.4_s200_e020 cut at its peak (runs are deterministic: its final state is "
                                  "that run's at the peak; a check keeps the cycle)"))
@@ -126,7 +133,27 @@ stability = no
     parts.append("\n".join(["[figure network_peak]", "kind = network",
                             "title = Force network of Model 1, delta = 0.4, 200 kPa, specimen e020, at the peak",
                             "variants = m1_d0.4_s200_e020_peak"]) + "\n")
+    parts.append(shear_band())
     return "\n".join(parts)
+
+
+def shear_band():
+    """The force network and the rotation field from the peak to the residual, and the movie of
+    the shearing, for no rolling resistance and Model 1 delta = 1.6 (harness/pictures.py)."""
+    names = " ".join(f"{m}_s200_e020" for m in SNAPSHOTS)
+    common = [f"variants = {names}", "label = axial strain (%); 100 * axial_strain()"]
+    frames = ["first = the peak; peak_cycle()", "frames = 3"]
+    who = "no rolling resistance (top), Model 1 delta = 1.6 (bottom)"
+    return "\n".join([
+        "[figure shear_network]", "kind = snapshots",
+        f"title = Force network from the peak of phi to the residual (200 kPa, e020): {who}",
+        *common, "show = network", *frames, f"paper = {PAPER_BAND}", "",
+        "[figure shear_rotation]", "kind = snapshots",
+        f"title = Disc rotation since shearing began, from the peak of phi to the residual (200 kPa, e020): {who}",
+        *common, "show = rotation", "since = shear", *frames, f"paper = {PAPER_BAND}", "",
+        "[figure shear_movie]", "kind = movie",
+        "title = The shearing (200 kPa, e020): no rolling resistance (left), Model 1 delta = 1.6 (right)",
+        *common, "show = both", "since = shear"]) + "\n"
 
 
 def full():

@@ -27,6 +27,7 @@ import pytest
 
 from harness import error_cost, sweep
 from harness.tests.test_study import GAP, M12, write_scene
+from harness.tests.test_study_sweep import rows
 
 REPO = Path(__file__).resolve().parents[2]
 BIN = REPO / "bin" / "ballast"
@@ -70,11 +71,6 @@ def harness(args, tmp_path):
     env.pop("BALLAST_BIN", None)
     return subprocess.run([sys.executable, "-m", "harness"] + args, cwd=REPO, env=env, capture_output=True,
                           text=True, timeout=300)
-
-
-def rows(path):
-    lines = Path(path).read_text().splitlines()
-    return [dict(zip(lines[0].split("\t"), line.split("\t"))) for line in lines[1:]]
 
 
 @pytest.fixture

@@ -375,6 +375,9 @@ def parser():
                           "needed for any other key)")
     stu.add_argument("--factor", type=float, default=None, help="each level's h over the last's (default 0.5)")
     stu.add_argument("--levels", type=int, default=None, help="number of levels (default 4, at least 3)")
+    stu.add_argument("--no-midpoints", action="store_true",
+                     help="skip the runs at the geometric midpoints between levels (they tell a smooth "
+                          "quantity from one whose error jumps with h: envelope.py)")
     stu.add_argument("--target", type=float, action="append", metavar="REL",
                      help="repeatable: advise the largest h for |q - q*|/|q*| <= REL, and check it by a run")
     stu.add_argument("--stability", action="store_true",

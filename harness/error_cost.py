@@ -133,10 +133,12 @@ def spread(qs):
 def advise(hs, analysis, target):
     """(h, predicted relative error at h) for a converging quantity: the largest h with
     e(h) = e_finest (h / h_finest)^p <= target / ADVICE_MARGIN; None when there is no advice
-    (not converging, q* = 0).  An independent quantity meets any target at the coarsest h."""
+    (not converging, or a limit no larger than the last difference: a quantity converging to 0,
+    such as an energy error, whose relative error only grows as it converges).  An independent
+    quantity meets any target at the coarsest h."""
     if analysis["verdict"] == "independent":
         return hs[0], 0.0
-    if analysis["verdict"] != "converging" or analysis["limit"] == 0:
+    if analysis["verdict"] != "converging" or abs(analysis["limit"]) <= abs(analysis["diffs"][-1]):
         return None
     p, e_f = analysis["order"], analysis["errors"][-1]
     if e_f == 0:

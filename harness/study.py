@@ -49,7 +49,7 @@ import math
 import sys
 from pathlib import Path
 
-from . import core_info, files, points, stability, sweep_grid
+from . import core_info, envelope, files, points, stability, sweep_grid
 from .error_cost import (ADVICE_MARGIN, MIN_LEVELS, ORDER_AGREE, P_MIN, advise, aligned, analyse, cost_model,
                          deviation, num, plot)
 from .errors import CatalogueError, RunProblem
@@ -63,6 +63,12 @@ ADVICE_COLUMNS = ("quantity", "target", "h_advised", "predicted_error", "predict
                   "predicted_seconds", "achieved_value", "achieved_error", "met")
 # The refinement's options (None on the command line = not given: --set refuses them when given).
 REFINE_DEFAULTS = {"refine": "settings.dt", "factor": 0.5, "levels": 4}
+# The advice's check run is made only when it costs at most this many times the finest level:
+# a study's levels and midpoints cost ~3.5 x its finest level (1 + 1/2 + 1/4 ... and the
+# midpoints' 1.41 + 0.71 + ...), so a check of up to 16 x stays within ~5 x the whole study; an
+# advised step beyond it is far outside the range the levels measured (an extrapolation by a
+# factor of 16 in cost) and is reported, not run.
+CHECK_COST_CEILING = 16.0
 
 
 # ---------------------------------------------------------------- folders and runs
@@ -155,20 +161,94 @@ def study(args, reports_root, out=sys.stdout):
     extra = points.time_keeping(args.bin, scene, [], [key])
     folder = study_folder(reports_root, scene, args.out, args.resume)
     hs = [base * args.factor ** k for k in range(args.levels)]
+    mids = [] if getattr(args, "no_midpoints", False) else envelope.midpoints(hs, args.factor)
     jobs = level_jobs(scene, folder, [(f"L{k}", h) for k, h in enumerate(hs)], key, extra)
-    points.refuse(args.bin, jobs, [key])                                   # before any run
-    _, quantities = run_points(args, scene, folder, jobs, extra, f"{key} = {', '.join(f'{h:.6g}' for h in hs)}",
-                               "refining", out)
+    mid_jobs = level_jobs(scene, folder, [(f"M{k}", h) for k, h in enumerate(mids)], key, extra)
+    points.refuse(args.bin, jobs + mid_jobs, [key])                        # before any run
+    what = f"{key} = {', '.join(f'{h:.6g}' for h in hs)}" + (" and the midpoints between them" if mids else "")
+    _, quantities = run_points(args, scene, folder, jobs + mid_jobs, extra, what, "refining", out)
     costs, values, why = points.measure(jobs, quantities)
+    extra_points = {"M": (mids, points.measure(mid_jobs, quantities))}
     analyses = {}
     for expr in quantities:
         analyses[expr] = analyse(hs, values[expr], args.factor)
         if why[expr]:
             analyses[expr]["text"] += f": {why[expr]}"
+        if mids:
+            smoothness(analyses[expr], hs, values[expr], mids, extra_points["M"][1][1][expr])
+    rough = [e for e in quantities if analyses[e].get("rough")]
+    if rough:
+        extra_points["S"] = envelope_samples(args, scene, folder, key, extra, hs, rough, out)
+        for expr in rough:
+            bounded(analyses[expr], hs, values[expr], extra_points, expr)
     advice = advice_rows(args, scene, folder, key, extra, hs, quantities, analyses, costs, out)
     limit = stability_limit(args, scene, folder, out) if getattr(args, "stability", False) else None
     write_outputs(folder, scene, key, hs, quantities, values, analyses, costs, advice, args, out, limit)
+    write_extra_points(folder, quantities, extra_points)
     return 0
+
+
+# ---------------------------------------------------------------- not smooth in h (envelope.py)
+
+def smoothness(a, hs, qs, mids, qmids):
+    """Marks the analysis a 'rough' (a candidate for envelope.bound) when its quantity is not a
+    smooth power of h: a converging verdict whose midpoints depart from the power law by more
+    than envelope.SMOOTH_TOLERANCE, or differences that change sign (analyse says so)."""
+    if a["verdict"] == "converging":
+        deps = envelope.departures(hs, qs, a, mids, qmids)
+        a["departures"] = deps
+        if not envelope.smooth(deps):
+            a["rough"] = ("its midpoints depart from the power law through the levels by "
+                          + ", ".join("-" if d is None else f"{d:.2g}" for d in deps)
+                          + f" of the difference between their neighbours (smooth: <= {envelope.SMOOTH_TOLERANCE:g})")
+    elif a["verdict"] == "asymptotic?" and "change sign" in a["text"]:
+        a["rough"] = "its differences change sign"
+
+
+def envelope_samples(args, scene, folder, key, extra, hs, rough, out):
+    """The extra samples of envelope.samples, run once for every rough quantity; (hs, measured)."""
+    hs_s = envelope.samples(hs) if len(hs) >= 3 else []
+    jobs = level_jobs(scene, folder, [(f"S{k}", h) for k, h in enumerate(hs_s)], key, extra)
+    if jobs:
+        print(f"not smooth in h ({len(rough)} quantit{'y' if len(rough) == 1 else 'ies'}): "
+              f"{len(jobs)} more runs to sample the error's envelope", file=out)
+        points.launch(jobs, args.bin, args.jobs, out, args.resume)
+    return hs_s, points.measure(jobs, rough)
+
+
+def bounded(a, hs, qs, extra_points, expr):
+    """Replaces a rough quantity's verdict by its envelope (envelope.bound over the levels, the
+    midpoints and the samples): 'bounded' with q*, the order and each level's error against q*,
+    or 'not smooth' with the reason there is no bound."""
+    all_h, all_q = list(hs), list(qs)
+    for hs_x, (_, values, _) in extra_points.values():
+        if expr in values:
+            all_h += list(hs_x)
+            all_q += values[expr]
+    env = envelope.bound(all_h, all_q)
+    a["envelope"] = env
+    head = f"not smooth in h: {a['rough']}"
+    if env["ok"]:
+        a.update(verdict="bounded", order=env["order"], limit=env["limit"],
+                 errors=[deviation(q, env["limit"]) for q in qs], text=f"{head}; {env['text']}")
+    else:
+        a.update(verdict="not smooth", limit=None, errors=[None] * len(qs),
+                 text=f"{head}; no Richardson limit, and no envelope: {env['text']}")
+
+
+def write_extra_points(folder, quantities, extra_points):
+    """points.tsv: the midpoints (M) and envelope samples (S) beside the levels of study.tsv."""
+    lines = ["quantity	point	h	value	particle_steps	wall_seconds	status"]
+    for tag, (hs_x, (costs, values, _)) in extra_points.items():
+        for expr in quantities:
+            if expr not in values:
+                continue
+            for k, h in enumerate(hs_x):
+                lines.append("\t".join([expr, f"{tag}{k}", repr(h), num(values[expr][k], ".17g"),
+                                        num(costs[k].get("particle_steps"), "g"),
+                                        num(costs[k].get("wall_seconds"), ".4g"), str(costs[k].get("status"))]))
+    if len(lines) > 1:
+        files.write_text(folder / "points.tsv", "\n".join(lines) + "\n")
 
 
 def stability_limit(args, scene, folder, out):
@@ -193,13 +273,29 @@ def advice_rows(args, scene, folder, key, extra, hs, quantities, analyses, costs
     seconds = cost_model(hs, [c.get("wall_seconds") for c in costs])
     for expr in quantities:
         for target in args.target or []:
-            got = advise(hs, analyses[expr], target)
+            a, why = analyses[expr], ""
+            if a["verdict"] == "bounded":
+                h, predicted = envelope.advise(a["envelope"], target)
+                got, why = ((h, predicted), "") if h is not None else (None, predicted)
+            else:
+                got = advise(hs, a, target)
+                if got is None and a["verdict"] == "converging":
+                    why = (f"its limit {a['limit']:.3g} is no larger than the last difference "
+                           f"{a['diffs'][-1]:.3g}: it converges to 0, where a relative target means nothing")
             rows.append({"quantity": expr, "target": target, "h": None if got is None else got[0],
                          "predicted": None if got is None else got[1],
                          "steps": steps(got[0]) if got and steps else None,
                          "seconds": seconds(got[0]) if got and seconds else None,
-                         "why": "" if got else f"no advice: {analyses[expr]['verdict']}"})
-    wanted = sorted({fmt_h(r["h"]) for r in rows if r["h"] is not None}, key=float, reverse=True)
+                         "why": "" if got else f"no advice: {why or a['verdict']}"})
+    if steps:
+        ceiling = CHECK_COST_CEILING * steps(hs[-1])
+        for r in rows:
+            if r["h"] is not None and r["steps"] > ceiling:
+                r["why"] = (f"not run: the advised step would cost {r['steps']:.3g} particle-steps, over "
+                            f"{CHECK_COST_CEILING:g} x the finest level's (run it yourself with --set, or add levels)")
+                r["unchecked"] = True
+    wanted = sorted({fmt_h(r["h"]) for r in rows if r["h"] is not None and not r.get("unchecked")},
+                    key=float, reverse=True)
     checks = dict(zip(wanted, level_jobs(scene, folder, [(f"check_{i}", float(h)) for i, h in enumerate(wanted)],
                                          key, extra)))
     if checks:
@@ -207,7 +303,7 @@ def advice_rows(args, scene, folder, key, extra, hs, quantities, analyses, costs
         points.launch(list(checks.values()), args.bin, args.jobs, out, args.resume)
     for r in rows:
         r["achieved_value"] = r["achieved"] = r["met"] = None
-        if r["h"] is None:
+        if r["h"] is None or r.get("unchecked"):
             continue
         value, why = points.value_of(r["quantity"], checks[fmt_h(r["h"])].out)
         if value is None:
@@ -288,7 +384,7 @@ def terminal_table(key, hs, quantities, values, analyses, costs, advice):
 
 def draw(folder, key, hs, quantities, analyses):
     """error.svg: each converging quantity's error against q*, log-log; None if gnuplot fails."""
-    curves = [(e, analyses[e]) for e in quantities if analyses[e]["verdict"] == "converging"]
+    curves = [(e, analyses[e]) for e in quantities if analyses[e]["verdict"] in ("converging", "bounded")]
     curves = [(e, list(zip(hs, a["errors"]))) for e, a in curves if all(x and x > 0 for x in a["errors"])]
     return plot(folder, "error", curves, key, "|q - q*| / |q*|", "left top")
 

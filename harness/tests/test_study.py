@@ -352,3 +352,21 @@ def test_stability_is_bisected_beside_the_advice(tmp_path):
     bound = 2 / math.sqrt(7000 / M12)
     assert bound / 2 < float(m.group(1)) < bound
     assert (out / "stability").is_dir() and "stability: largest stable dt" in (out / "study.md").read_text()
+
+
+def test_an_advised_step_far_past_the_levels_is_reported_not_run(tmp_path):
+    """A target the levels are far from (1e-9 on the contact duration: ~300 x finer than the
+    finest level) is advised and priced, but its check run would cost more than
+    CHECK_COST_CEILING x the finest level: reported, not run (an energy-error study once launched
+    a check for hours)."""
+    nu, kn, gamma, dt, quantity, _ = SCENES["linear"]
+    scene = write_scene(tmp_path, nu, kn, gamma, dt)
+    out = tmp_path / "study"
+    done = harness(["study", str(scene), "--out", str(out), "-j", "2", "--quantity", quantity,
+                    "--target", "1e-9"])
+    assert done.returncode == 0, done.stderr
+    row = read_tsv(out / "advice.tsv")[0]
+    assert row["h_advised"] != "-" and row["achieved_value"] == "-"
+    assert float(row["predicted_particle_steps"]) > study.CHECK_COST_CEILING * 2 ** 9 * STAGE_TIME * 2 * 8
+    assert "not run: the advised step would cost" in done.stdout
+    assert not any(p.name.startswith("check_") for p in (out / "runs").iterdir())

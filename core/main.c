@@ -14,7 +14,10 @@
  * A scene that fails to load or validate writes nothing.  A run that
  * starts writes run.json saying how it ended; discs.tsv, contacts.tsv and
  * walls.tsv appear only when the run completed, series.tsv too or when it
- * was interrupted (the rows so far; run.json says "complete": false).
+ * was interrupted (the rows so far; run.json says "complete": false).  The
+ * snapshots folder (settings.snapshot_every or snapshot_dt) goes with
+ * series.tsv: complete when the run completed, the frames so far when it was
+ * interrupted, removed when it failed otherwise.
  * `run` ends with a one-line summary on stdout, and on a terminal shows
  * its progress on stderr once it has run for PROGRESS_AFTER seconds.
  */
@@ -287,9 +290,12 @@ static int cmd_inputs(const struct args *a)
 /* Remove an earlier run's outputs from dir (with_json: run.json too, and
  * first: a run killed while this runs must not leave an old run.json saying
  * ok beside a missing series), or, after a failed run, the outputs it had
- * finished, so that only run.json, saying why, remains. */
+ * finished, so that only run.json, saying why, remains (and series.tsv with
+ * the snapshots folder when keep_series). */
 static void remove_outputs(const char *dir, int with_json, int keep_series)
 {
+    if (!keep_series)
+        bal_output_remove_snapshots(dir);
     const char *names[] = {"run.json", "series.tsv", "discs.tsv", "contacts.tsv", "walls.tsv",
                            "stress.tsv", "stress_grid.tsv"};
     for (size_t k = with_json ? 0 : 1; k < sizeof names / sizeof names[0]; k++) {
@@ -380,6 +386,8 @@ static int cmd_run(const struct args *a)
     int kept = 0; /* an interrupted run's series, the rows so far */
     if (!series) {
         st = bal_error(&err, BAL_EIO, "%s: cannot write: %s", tmp, strerror(errno));
+    } else if ((st = bal_sim_set_snapshots(sim, a->out, &err)) != BAL_OK) {
+        fclose(series);
     } else {
         bal_output_series_header(sim, series);
         st = bal_sim_run(sim, series, &stop_requested, &err);

@@ -132,6 +132,7 @@ struct bal_settings {
     long snapshot_every;  /* cycles between snapshots (snapshots.c); 0 = off (0) */
     double snapshot_dt;   /* simulated time between snapshots; 0 = off (0); not with
                            * snapshot_every */
+    long vtk;             /* 1: each snapshot also as VTK XML PolyData (vtk.c) (0) */
     BAL_SECTION_TAIL;
 };
 

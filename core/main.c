@@ -2,7 +2,7 @@
  * main.c — the `ballast` command: the only place that parses the command
  * line, touches signals and maps a status to an exit code.
  *
- *   ballast run SCENE --out DIR [--set KEY=VALUE ...] [--threads N]
+ *   ballast run SCENE --out DIR [--set KEY=VALUE ...] [--threads N] [--vtk]
  *   ballast exact SCENE --out DIR [--set KEY=VALUE ...]
  *   ballast info SCENE [--set KEY=VALUE ...]
  *   ballast inputs SCENE [--set KEY=VALUE ...]
@@ -74,7 +74,7 @@ static int exit_code(enum bal_status st)
 
 static int usage(void)
 {
-    fputs("usage: ballast run SCENE --out DIR [--set KEY=VALUE ...] [--threads N]\n"
+    fputs("usage: ballast run SCENE --out DIR [--set KEY=VALUE ...] [--threads N] [--vtk]\n"
           "       ballast exact SCENE --out DIR [--set KEY=VALUE ...]\n"
           "       ballast info SCENE [--set KEY=VALUE ...]\n"
           "       ballast inputs SCENE [--set KEY=VALUE ...]\n"
@@ -109,6 +109,7 @@ struct args {
     int n_sets;
     char **sets;
     int threads; /* --threads N, checked; 0: not given */
+    int vtk;     /* --vtk: settings.vtk = 1 */
 };
 
 static int parse_args(int argc, char **argv, struct args *a)
@@ -136,6 +137,8 @@ static int parse_args(int argc, char **argv, struct args *a)
             }
             a->threads = (int)t;
         }
+        else if (strcmp(argv[k], "--vtk") == 0)
+            a->vtk = 1;
         else if (argv[k][0] != '-' && !a->scene)
             a->scene = argv[k];
         else {
@@ -154,6 +157,13 @@ static enum bal_status load(struct bal_scene *sc, const struct args *a, struct b
     for (int k = 0; k < a->n_sets; k++)
         if (bal_scene_set(sc, a->sets[k], err))
             return err->code;
+    /* --vtk: the snapshots as VTK files too, which needs snapshots. */
+    if (a->vtk && sc->settings.snapshot_every == 0 && sc->settings.snapshot_dt == 0)
+        return bal_error(err, BAL_EINVAL,
+                         "%s: --vtk needs snapshots: give settings.snapshot_every (cycles) or "
+                         "snapshot_dt (simulated time), in the scene or by --set", sc->path);
+    if (a->vtk)
+        sc->settings.vtk = 1;
     return bal_scene_validate(sc, err);
 }
 

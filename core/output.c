@@ -14,7 +14,7 @@
  *   run.json      version, build, scene, overrides, how the run ended,
  *                 steps, time step and its estimate, timings, energies
  *   snapshots/    the discs, contacts and walls at regular intervals, when
- *                 the scene asks (snapshots.c: it writes the rows of
+ *                 the scene asks (snapshots.c, vtk.c: they write the rows of
  *                 discs.tsv, contacts.tsv and walls.tsv through output.h)
  *
  * Numbers are printed with %.17g, so a file read back gives the same

@@ -1,6 +1,6 @@
 /*
  * output.h — internal: the tables of a state and the atomic file writing
- * that the final outputs (output.c) and the snapshots (snapshots.c)
+ * that the final outputs (output.c) and the snapshots (snapshots.c, vtk.c)
  * share, so that a snapshot's rows are those of the final files.
  */
 #ifndef BAL_OUTPUT_H

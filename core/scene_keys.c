@@ -86,6 +86,9 @@ const struct bal_key bal_scene_keys[] = {
     {BAL_SEC_SETTINGS, "snapshot_dt", BAL_KEY_DOUBLE, S(snapshot_dt), "0", 0, 0, BIG, NULL,
      "or the simulated time between snapshots (frame k at cycle ceil(k snapshot_dt / dt)); "
      "0 = none; not with snapshot_every"},
+    {BAL_SEC_SETTINGS, "vtk", BAL_KEY_LONG, S(vtk), "0", 0, 0, 1, NULL,
+     "1: each snapshot also as VTK XML PolyData with a ParaView .pvd collection (also `ballast "
+     "run --vtk`); needs snapshot_every or snapshot_dt"},
     {BAL_SEC_SETTINGS, "gamma_n", BAL_KEY_DOUBLE, S(gamma_n), "0", 0, 0, BIG, NULL,
      "viscous normal damping gamma_n d' (d/d0)^psi of MLH eq. 3, mass/time"},
     {BAL_SEC_SETTINGS, "psi", BAL_KEY_DOUBLE, S(psi), "0", 0, 0, 3, NULL,

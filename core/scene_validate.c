@@ -200,7 +200,8 @@ void bal_scene_settings_where(const struct bal_scene *s, const char *key, char *
         snprintf(buf, size, "%s: --set %s", s->path, key);
 }
 
-/* Snapshots are taken every so many cycles or every so much simulated time, not both. */
+/* Snapshots are taken every so many cycles or every so much simulated time, not both; the
+ * VTK files are written at the snapshots' frames, so vtk = 1 needs one of the two. */
 static enum bal_status check_snapshots(const struct bal_scene *s, struct bal_error *err)
 {
     const struct bal_settings *st = &s->settings;
@@ -212,6 +213,13 @@ static enum bal_status check_snapshots(const struct bal_scene *s, struct bal_err
                          "%s: snapshots every %s of simulated time and every %ld cycles (%s): "
                          "give one of snapshot_every and snapshot_dt, the other 0",
                          where, BAL_NUM(st->snapshot_dt), st->snapshot_every, other);
+    }
+    if (st->vtk && st->snapshot_every == 0 && st->snapshot_dt == 0) {
+        bal_scene_settings_where(s, "vtk", where, sizeof where);
+        return bal_error(err, BAL_EINVAL,
+                         "%s: vtk = 1 needs snapshots: give snapshot_every (cycles) or "
+                         "snapshot_dt (simulated time); the VTK files are written at their frames",
+                         where);
     }
     return BAL_OK;
 }

@@ -11,6 +11,10 @@
  *   contacts.FFFFFF.tsv  the touching contacts, as contacts.tsv
  *   walls.FFFFFF.tsv     the walls, as walls.tsv
  *
+ * and with settings.vtk = 1 the same frame as VTK XML PolyData (vtk.c:
+ * discs, contacts and walls .FFFFFF.vtp) and snapshots.pvd, the collection
+ * that ParaView opens, with each frame's simulated time.
+ *
  * Frames.  Frame 0 is the state the run starts from (cycle 0); then one at
  * every cycle of the schedule; and the final state of a run that completes
  * is always the last frame (once, when the schedule has it too).  Every N
@@ -19,7 +23,8 @@
  * (build.c), so that the frames are T apart whatever the step.
  *
  * Every file is written under NAME.tmp and renamed when complete; index.tsv
- * is rewritten (so renamed) after the frame's files are in place, so a reader never sees a frame listed whose files are missing.
+ * and snapshots.pvd are rewritten (so renamed) after the frame's files are
+ * in place, so a reader never sees a frame listed whose files are missing.
  * The run loop pays one comparison a cycle (s->step == s->snap.next, -1
  * when off); the table of frames is reserved at creation, so a frame
  * allocates nothing but what stdio does for its files.
@@ -37,6 +42,7 @@
 #include "scene.h"
 #include "snapshots.h"
 #include "status.h"
+#include "vtk.h"
 
 /* A frame in time is at ceil(k T / dt) cycles "to 1e-9 of a step": the
  * rounding of build.c for a stage given in time, so that the third frame of
@@ -148,21 +154,31 @@ enum bal_status bal_snapshots_frame(struct bal_sim *s, struct bal_error *err)
 {
     static const struct {
         const char *part;
-        rows_fn tsv;
-    } parts[] = {{"discs", disc_rows}, {"contacts", bal_output_contacts}, {"walls", bal_output_walls}};
+        rows_fn tsv, vtk;
+    } parts[] = {{"discs", disc_rows, bal_vtk_discs},
+                 {"contacts", bal_output_contacts, bal_vtk_contacts},
+                 {"walls", bal_output_walls, bal_vtk_walls}};
     struct bal_snapshots *p = &s->snap;
     if (p->n >= p->cap)
         return bal_error(err, BAL_EINVAL,
                          "%s: snapshots: frame %ld is past the %ld the stages' cycles have room "
                          "for (bal_sim_run called twice?)", s->scene->path, p->n, p->cap);
+    const int vtk = s->scene->settings.vtk != 0;
     char name[64];
     for (size_t q = 0; q < sizeof parts / sizeof parts[0]; q++) {
         bal_snapshots_name(name, sizeof name, parts[q].part, p->n, "tsv");
         if (write_file(s, name, parts[q].tsv, err))
             return err->code;
+        if (!vtk)
+            continue;
+        bal_snapshots_name(name, sizeof name, parts[q].part, p->n, "vtp");
+        if (write_file(s, name, parts[q].vtk, err))
+            return err->code;
     }
     /* Listed once its files are in place. */
     p->frames[p->n++] = (struct bal_snapshot_frame){s->step, s->time, s->stage >= 0 ? s->stage : 0};
+    if (vtk && write_file(s, "snapshots.pvd", bal_vtk_collection, err))
+        return err->code;
     if (write_file(s, "index.tsv", index_rows, err))
         return err->code;
     p->next = next_cycle(p, s->step, s->dt);
@@ -177,11 +193,12 @@ enum bal_status bal_snapshots_last(struct bal_sim *s, struct bal_error *err)
     return bal_snapshots_frame(s, err);
 }
 
-/* A file of the snapshots folder: index.tsv, a frame's file, or one of them
- * under its temporary name. */
+/* A file of the snapshots folder: index.tsv, snapshots.pvd, a frame's file,
+ * or one of them under its temporary name. */
 static int snapshot_file(const char *name)
 {
-    static const char *const starts[] = {"index.tsv", "discs.", "contacts.", "walls."};
+    static const char *const starts[] = {"index.tsv", "snapshots.pvd", "discs.", "contacts.",
+                                         "walls."};
     for (size_t k = 0; k < sizeof starts / sizeof starts[0]; k++)
         if (strncmp(name, starts[k], strlen(starts[k])) == 0)
             return 1;

@@ -15,8 +15,8 @@
  * naming the key).  No frame is due until bal_sim_set_snapshots names a
  * folder. */
 enum bal_status bal_snapshots_setup(struct bal_sim *s, struct bal_error *err);
-/* The frame of the current state: its files, then index.tsv rewritten to
- * list it; the next frame's cycle in s->snap.next.
+/* The frame of the current state: its files, then snapshots.pvd (with vtk)
+ * and index.tsv rewritten to list it; the next frame's cycle in s->snap.next.
  * Called by the run loop when s->step == s->snap.next. */
 enum bal_status bal_snapshots_frame(struct bal_sim *s, struct bal_error *err);
 /* The final state as the last frame, unless the last frame written is of this
@@ -27,7 +27,7 @@ enum bal_status bal_snapshots_last(struct bal_sim *s, struct bal_error *err);
 void bal_snapshots_name(char *buf, size_t size, const char *part, long frame, const char *ext);
 
 /* Frames are numbered in six digits (discs.FFFFFF.tsv): at most a million, which
- * is 3 million files in one folder. */
+ * is 3 million files in one folder (6 with vtk). */
 #define BAL_SNAPSHOT_FRAMES_MAX 1000000L
 
 #endif /* BAL_SNAPSHOTS_H */

@@ -241,8 +241,8 @@ static inline int bal_block_end(int n, int b)
     return to < n ? to : n;
 }
 
-/* One snapshot written: its cycle, simulated time and stage (index.tsv lists
- * them all, rewritten after each frame). */
+/* One snapshot written: its cycle, simulated time and stage (index.tsv and
+ * snapshots.pvd list them all, rewritten after each frame). */
 struct bal_snapshot_frame {
     long cycle;
     double time;

@@ -1,6 +1,6 @@
 /*
- * check_snapshots.c — suite "snapshots": the keys snapshot_every and
- * snapshot_dt (what is refused, with file, line and key), the
+ * check_snapshots.c — suite "snapshots": the keys snapshot_every,
+ * snapshot_dt and vtk (what is refused, with file, line and key), the
  * frames' schedule (frame 0 at cycle 0, every N cycles or every T of
  * simulated time, the final state once), the files of a frame (every one
  * renamed into place, none left under .tmp; index.tsv lists a frame only
@@ -209,10 +209,12 @@ END_TEST
 /* ------------------------------------------------------------------ */
 
 /* Every file of every frame listed, renamed into place: the folder holds
- * index.tsv and 3 files per frame, nothing else, no .tmp. */
+ * index.tsv and 3 TSV files per frame, nothing else, no .tmp; with vtk = 1
+ * (loop index 1) also snapshots.pvd and 3 VTK files per frame. */
 START_TEST(snapshots_files_complete_none_tmp)
 {
-    struct tfx *f = lone_disc("snapshot_every = 5\n", 7, 5);
+    const int vtk = _i;
+    struct tfx *f = lone_disc(vtk ? "snapshot_every = 5\nvtk = 1\n" : "snapshot_every = 5\n", 7, 5);
     run_with_snapshots(f);
     char dir[600];
     snprintf(dir, sizeof dir, "%s/snapshots", out_dir);
@@ -227,15 +229,16 @@ START_TEST(snapshots_files_complete_none_tmp)
     }
     closedir(d);
     ck_assert_int_eq(tmp, 0);
-    ck_assert_int_eq(files, 1 + 3 * 4);
+    ck_assert_int_eq(files, vtk ? 2 + 6 * 4 : 1 + 3 * 4);
+    ck_assert(exists("snapshots/snapshots.pvd") == vtk);
     static const char *const parts[] = {"discs", "contacts", "walls"};
     char name[64];
     for (long k = 0; k < 4; k++)
         for (int q = 0; q < 3; q++)
-        {
-            snprintf(name, sizeof name, "snapshots/%s.%06ld.tsv", parts[q], k);
-            ck_assert_msg(exists(name), "%s missing", name);
-        }
+            for (int v = 0; v <= vtk; v++) {
+                snprintf(name, sizeof name, "snapshots/%s.%06ld.%s", parts[q], k, v ? "vtp" : "tsv");
+                ck_assert_msg(exists(name), "%s missing", name);
+            }
 }
 END_TEST
 
@@ -398,10 +401,14 @@ static const struct {
     {"both, one by --set", "[settings]\nsnapshot_every = 5\n" LONE_BODY, "settings.snapshot_dt=0.5",
      "bad: --set snapshot_dt: snapshots every 0.5 of simulated time and every 5 cycles (bad:2: "
      "snapshot_every)"},
+    {"vtk alone", "[settings]\nvtk = 1\n" LONE_BODY, NULL,
+     "bad:2: vtk: vtk = 1 needs snapshots: give snapshot_every (cycles) or snapshot_dt"},
+    {"vtk by --set", LONE_BODY, "settings.vtk=1", "bad: --set vtk: vtk = 1 needs snapshots"},
     {"negative every", "[settings]\nsnapshot_every = -1\n" LONE_BODY, NULL,
      "bad:2: snapshot_every: -1 is out of range"},
     {"negative period", "[settings]\nsnapshot_dt = -0.1\n" LONE_BODY, NULL,
      "bad:2: snapshot_dt: -0.1 is out of range"},
+    {"vtk 2", "[settings]\nvtk = 2\n" LONE_BODY, NULL, "bad:2: vtk: 2 is out of range"},
     {"too many frames", "[settings]\ndt = 0.1\nsnapshot_every = 1\n" LONE_BODY, "stage.s.cycles=2000000",
      "bad:3: snapshot_every: 2000002 frames in the stages' 2000000 cycles; expected at most 1000000"},
     {"too many frames in time", "[settings]\ndt = 0.1\nsnapshot_dt = 0.1\n" LONE_BODY,
@@ -436,8 +443,9 @@ START_TEST(snapshots_keys_defaults_and_accepted)
     bal_scene_default(&sc);
     ck_assert_int_eq(sc.settings.snapshot_every, 0);
     ck_assert_double_eq(sc.settings.snapshot_dt, 0.0);
+    ck_assert_int_eq(sc.settings.vtk, 0);
     bal_scene_free(&sc);
-    struct tfx *f = tfx_new("[settings]\nsnapshot_every = 0\nsnapshot_dt = 0.5\n" LONE_BODY,
+    struct tfx *f = tfx_new("[settings]\nsnapshot_every = 0\nsnapshot_dt = 0.5\nvtk = 1\n" LONE_BODY,
                             "ok");
     ck_assert_int_eq(f->sim->snap.every, 0);
     ck_assert_double_eq(f->sim->snap.period, 0.5);
@@ -473,7 +481,7 @@ Suite *suite_snapshots(void)
     tc = tcase_create("files");
     tcase_add_checked_fixture(tc, out_setup, out_teardown);
     tcase_add_checked_fixture(tc, NULL, tfx_teardown);
-    tcase_add_test(tc, snapshots_files_complete_none_tmp);
+    tcase_add_loop_test(tc, snapshots_files_complete_none_tmp, 0, 2);
     tcase_add_test(tc, snapshots_failed_frame_not_listed);
     tcase_add_test(tc, snapshots_last_frame_is_the_final_state);
     tcase_add_test(tc, snapshots_disc_forces_closed_form);

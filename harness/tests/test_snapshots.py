@@ -13,11 +13,12 @@ The schedule, the keys and the rows are tested in core/tests/check_snapshots.c.
 import csv
 import signal
 import subprocess
-import tempfile
 import time
 from pathlib import Path
 
 import pytest
+
+from harness.tests.test_core_cli import full_disk  # noqa: F401 -- the fixture: a nearly full tmpfs
 
 REPO = Path(__file__).resolve().parents[2]
 BALLAST = REPO / "bin" / "ballast"
@@ -118,31 +119,13 @@ def test_a_failed_run_leaves_no_snapshots(tmp_path):
     assert sorted(p.name for p in out.iterdir()) == ["run.json"]
 
 
-def _mount_tmpfs(path, size):
-    try:
-        done = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(path)],
-                              capture_output=True, text=True, timeout=30)
-    except OSError as exc:
-        return str(exc)
-    return "" if done.returncode == 0 else done.stderr.strip() or "mount failed"
-
-
 @needs_ballast
-def test_a_full_disk_leaves_no_snapshot_and_no_temporary_file():
-    root = Path(tempfile.mkdtemp(prefix="ballast-full-"))
-    why = _mount_tmpfs(root, "200k")
-    if why:
-        root.rmdir()
-        pytest.skip(f"cannot mount a tmpfs here: {why}")
-    try:
-        out = root / "o"
-        done = ballast("run", PILE, "--out", out, *SHORT, "--set", "settings.snapshot_every=1")
-        assert done.returncode == 3, done.stderr
-        assert "No space left on device" in done.stderr or "write failed" in done.stderr
-        assert sorted(p.name for p in out.iterdir()) in (["run.json"], [])
-    finally:
-        subprocess.run(["umount", str(root)], capture_output=True, timeout=30)
-        root.rmdir()
+def test_a_full_disk_leaves_no_snapshot_and_no_temporary_file(full_disk):
+    out = full_disk / "o"
+    done = ballast("run", PILE, "--out", out, *SHORT, "--set", "settings.snapshot_every=1")
+    assert done.returncode == 3, done.stderr
+    assert "No space left on device" in done.stderr or "write failed" in done.stderr
+    assert sorted(p.name for p in out.iterdir()) in (["run.json"], [])
 
 
 @needs_ballast

@@ -70,7 +70,9 @@ const char *bal_strerror(enum bal_status code);
  * BAL_MAX_DISCS = 1e8). */
 #define BAL_BODY_MAX 64
 #define BAL_MAX_MOVES 16
-#define BAL_KEYS_MAX 24   /* most keys one section kind has */
+#define BAL_KEYS_MAX 32   /* most keys one section kind has ([settings]: one fewer, its last
+                           * key_line slot holds its header's line); at most the bits of
+                           * `given` */
 
 /* Every section struct ends with these: which keys were given (bit k for the
  * k-th key of its kind in the key table) and on which line. */
@@ -127,6 +129,10 @@ struct bal_settings {
     long force_dt;        /* 1: accept a time step at or above the stability estimate (0) */
     int integrator;       /* enum bal_integrator (centred) */
     int rolling_model;    /* enum bal_rolling_model, for pairs with rolling > 0 (model1) */
+    long snapshot_every;  /* cycles between snapshots (snapshots.c); 0 = off (0) */
+    double snapshot_dt;   /* simulated time between snapshots; 0 = off (0); not with
+                           * snapshot_every */
+    long vtk;             /* 1: each snapshot also as VTK XML PolyData (vtk.c) (0) */
     BAL_SECTION_TAIL;
 };
 
@@ -479,6 +485,12 @@ enum bal_status bal_sim_set_threads(struct bal_sim *sim, int threads, struct bal
 enum bal_status bal_sim_run(struct bal_sim *sim, FILE *series,
                             volatile const sig_atomic_t *stop, struct bal_error *err);
 
+/* Snapshots (settings.snapshot_every or snapshot_dt): bal_sim_run writes the state's frames
+ * into dir/snapshots (made here; snapshots.c), the first of the state it starts from, the
+ * last of the final state of a run that completes.  Without this call, or for a scene
+ * without snapshots (then nothing is made), it writes none. */
+enum bal_status bal_sim_set_snapshots(struct bal_sim *sim, const char *dir, struct bal_error *err);
+
 /* The cycles stage g runs at most: its `cycles`, or ceil(time/dt) for a
  * stage given in simulated time (to 1e-9 of a step: a time that is a whole
  * number of steps in exact arithmetic is that number of cycles). */
@@ -562,6 +574,10 @@ enum bal_status bal_output_run_json(const struct bal_sim *sim, const char *dir,
                                     const char *scene_path, int n_sets,
                                     char *const *sets, enum bal_status status,
                                     const char *message, struct bal_error *err);
+
+/* Remove dir/snapshots, the snapshots of an earlier or a failed run (the files snapshots.c
+ * writes, then the folder if that empties it). */
+void bal_output_remove_snapshots(const char *dir);
 
 /* Rename dir/name.tmp to dir/name: outputs appear only when complete. */
 enum bal_status bal_output_commit(const char *dir, const char *name,

@@ -2,7 +2,7 @@
  * main.c — the `ballast` command: the only place that parses the command
  * line, touches signals and maps a status to an exit code.
  *
- *   ballast run SCENE --out DIR [--set KEY=VALUE ...] [--threads N]
+ *   ballast run SCENE --out DIR [--set KEY=VALUE ...] [--threads N] [--vtk]
  *   ballast exact SCENE --out DIR [--set KEY=VALUE ...]
  *   ballast info SCENE [--set KEY=VALUE ...]
  *   ballast inputs SCENE [--set KEY=VALUE ...]
@@ -14,7 +14,10 @@
  * A scene that fails to load or validate writes nothing.  A run that
  * starts writes run.json saying how it ended; discs.tsv, contacts.tsv and
  * walls.tsv appear only when the run completed, series.tsv too or when it
- * was interrupted (the rows so far; run.json says "complete": false).
+ * was interrupted (the rows so far; run.json says "complete": false).  The
+ * snapshots folder (settings.snapshot_every or snapshot_dt) goes with
+ * series.tsv: complete when the run completed, the frames so far when it was
+ * interrupted, removed when it failed otherwise.
  * `run` ends with a one-line summary on stdout, and on a terminal shows
  * its progress on stderr once it has run for PROGRESS_AFTER seconds.
  */
@@ -71,7 +74,7 @@ static int exit_code(enum bal_status st)
 
 static int usage(void)
 {
-    fputs("usage: ballast run SCENE --out DIR [--set KEY=VALUE ...] [--threads N]\n"
+    fputs("usage: ballast run SCENE --out DIR [--set KEY=VALUE ...] [--threads N] [--vtk]\n"
           "       ballast exact SCENE --out DIR [--set KEY=VALUE ...]\n"
           "       ballast info SCENE [--set KEY=VALUE ...]\n"
           "       ballast inputs SCENE [--set KEY=VALUE ...]\n"
@@ -106,6 +109,7 @@ struct args {
     int n_sets;
     char **sets;
     int threads; /* --threads N, checked; 0: not given */
+    int vtk;     /* --vtk: settings.vtk = 1 */
 };
 
 static int parse_args(int argc, char **argv, struct args *a)
@@ -133,6 +137,8 @@ static int parse_args(int argc, char **argv, struct args *a)
             }
             a->threads = (int)t;
         }
+        else if (strcmp(argv[k], "--vtk") == 0)
+            a->vtk = 1;
         else if (argv[k][0] != '-' && !a->scene)
             a->scene = argv[k];
         else {
@@ -151,6 +157,13 @@ static enum bal_status load(struct bal_scene *sc, const struct args *a, struct b
     for (int k = 0; k < a->n_sets; k++)
         if (bal_scene_set(sc, a->sets[k], err))
             return err->code;
+    /* --vtk: the snapshots as VTK files too, which needs snapshots. */
+    if (a->vtk && sc->settings.snapshot_every == 0 && sc->settings.snapshot_dt == 0)
+        return bal_error(err, BAL_EINVAL,
+                         "%s: --vtk needs snapshots: give settings.snapshot_every (cycles) or "
+                         "snapshot_dt (simulated time), in the scene or by --set", sc->path);
+    if (a->vtk)
+        sc->settings.vtk = 1;
     return bal_scene_validate(sc, err);
 }
 
@@ -287,9 +300,12 @@ static int cmd_inputs(const struct args *a)
 /* Remove an earlier run's outputs from dir (with_json: run.json too, and
  * first: a run killed while this runs must not leave an old run.json saying
  * ok beside a missing series), or, after a failed run, the outputs it had
- * finished, so that only run.json, saying why, remains. */
+ * finished, so that only run.json, saying why, remains (and series.tsv with
+ * the snapshots folder when keep_series). */
 static void remove_outputs(const char *dir, int with_json, int keep_series)
 {
+    if (!keep_series)
+        bal_output_remove_snapshots(dir);
     const char *names[] = {"run.json", "series.tsv", "discs.tsv", "contacts.tsv", "walls.tsv",
                            "stress.tsv", "stress_grid.tsv"};
     for (size_t k = with_json ? 0 : 1; k < sizeof names / sizeof names[0]; k++) {
@@ -380,6 +396,8 @@ static int cmd_run(const struct args *a)
     int kept = 0; /* an interrupted run's series, the rows so far */
     if (!series) {
         st = bal_error(&err, BAL_EIO, "%s: cannot write: %s", tmp, strerror(errno));
+    } else if ((st = bal_sim_set_snapshots(sim, a->out, &err)) != BAL_OK) {
+        fclose(series);
     } else {
         bal_output_series_header(sim, series);
         st = bal_sim_run(sim, series, &stop_requested, &err);

@@ -13,6 +13,9 @@
  *                 sets stress_width
  *   run.json      version, build, scene, overrides, how the run ended,
  *                 steps, time step and its estimate, timings, energies
+ *   snapshots/    the discs, contacts and walls at regular intervals, when
+ *                 the scene asks (snapshots.c, vtk.c: they write the rows of
+ *                 discs.tsv, contacts.tsv and walls.tsv through output.h)
  *
  * Numbers are printed with %.17g, so a file read back gives the same
  * doubles: outputs compare bitwise across runs.  Every file is written
@@ -26,6 +29,7 @@
 #include <string.h>
 
 #include "measure.h"
+#include "output.h"
 #include "scene_keys.h"
 #include "specimen.h"
 #include "walls.h"
@@ -73,17 +77,21 @@ enum bal_status bal_output_series_row(const struct bal_sim *s, FILE *f, struct b
     return BAL_OK;
 }
 
-static FILE *open_tmp(const char *dir, const char *name, struct bal_error *err)
+FILE *bal_output_open(const char *dir, const char *name, struct bal_error *err)
 {
     char path[1024];
-    snprintf(path, sizeof path, "%s/%s.tmp", dir, name);
+    if (snprintf(path, sizeof path, "%s/%s.tmp", dir, name) >= (int)sizeof path) {
+        bal_error(err, BAL_EIO, "%s/%s: cannot write: the path is longer than %zu characters",
+                  dir, name, sizeof path - 1);
+        return NULL;
+    }
     FILE *f = fopen(path, "w");
     if (!f)
         bal_error(err, BAL_EIO, "%s: cannot write: %s", path, strerror(errno));
     return f;
 }
 
-static enum bal_status close_tmp(FILE *f, const char *dir, const char *name,
+enum bal_status bal_output_close(FILE *f, const char *dir, const char *name,
                                  struct bal_error *err)
 {
     int bad = ferror(f);
@@ -128,63 +136,95 @@ static void rolling_columns(const struct bal_sim *s, const struct bal_pairs *p, 
             p->tr[c], (p->flags[c] & BAL_PAIR_BROKEN) ? 2 : (p->flags[c] & BAL_PAIR_ROLLING) ? 1 : 0);
 }
 
-static void write_contacts(const struct bal_sim *s, FILE *f)
+void bal_output_contact_point(const struct bal_sim *s, int walls, long c, double *px, double *py,
+                              double *nx, double *ny)
+{
+    if (walls) {
+        const int i = s->pw.i[c];
+        double ex, ey;
+        const double d = bal_walls_normal(&s->walls[s->pw.j[c]], s->x[i], s->y[i], &ex, &ey);
+        /* Halfway between the disc's surface point and the wall point
+         * (C&S p. 49, contact A of Fig. 1). */
+        const double at = 0.5 * (s->r[i] + d);
+        *px = s->x[i] + at * ex;
+        *py = s->y[i] + at * ey;
+        *nx = ex;
+        *ny = ey;
+        return;
+    }
+    const int i = s->pp.i[c], j = s->pp.j[c];
+    const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
+    const double d = hypot(dx, dy), delta = s->r[i] + s->r[j] - d;
+    const double ex = dx / d, ey = dy / d, at = s->r[i] - delta / 2;
+    *px = s->x[i] + at * ex;
+    *py = s->y[i] + at * ey;
+    *nx = ex;
+    *ny = ey;
+}
+
+void bal_output_contacts(const struct bal_sim *s, FILE *f)
 {
     fputs("a\tb\tkind\tx\ty\tnx\tny\tfn\tfs\tdn\tds\tsliding", f);
     fputs(s->has_rolling ? "\tmr\tmd\ttheta_r\trolling\n" : "\n", f);
     char a[2 * BAL_NAME_MAX], b[2 * BAL_NAME_MAX];
+    double px, py, ex, ey;
     for (long c = 0; c < s->pp.n; c++) {
         if (!(s->pp.flags[c] & BAL_PAIR_TOUCHING))
             continue;
-        const int i = s->pp.i[c], j = s->pp.j[c];
-        const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
-        const double d = hypot(dx, dy), delta = s->r[i] + s->r[j] - d;
-        const double ex = dx / d, ey = dy / d, at = s->r[i] - delta / 2;
-        body_name(s, 0, i, a, sizeof a);
-        body_name(s, 0, j, b, sizeof b);
+        bal_output_contact_point(s, 0, c, &px, &py, &ex, &ey);
+        body_name(s, 0, s->pp.i[c], a, sizeof a);
+        body_name(s, 0, s->pp.j[c], b, sizeof b);
         double dn, ds;
         bal_measure_dashpots(s, &s->pp, c, &dn, &ds);
         fprintf(f, "%s\t%s\tdisc\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d", a,
-                b, s->x[i] + at * ex, s->y[i] + at * ey, ex, ey, s->pp.fn[c], pair_fs(&s->pp, c),
-                dn, ds, (s->pp.flags[c] & BAL_PAIR_SLIDING) != 0);
+                b, px, py, ex, ey, s->pp.fn[c], pair_fs(&s->pp, c), dn, ds,
+                (s->pp.flags[c] & BAL_PAIR_SLIDING) != 0);
         rolling_columns(s, &s->pp, c, f);
         fputc('\n', f);
     }
     for (long c = 0; c < s->pw.n; c++) {
         if (!(s->pw.flags[c] & BAL_PAIR_TOUCHING))
             continue;
-        const int i = s->pw.i[c];
-        const struct bal_wall *W = &s->walls[s->pw.j[c]];
-        double ex, ey;
-        const double d = bal_walls_normal(W, s->x[i], s->y[i], &ex, &ey);
-        /* Halfway between the disc's surface point and the wall point
-         * (C&S p. 49, contact A of Fig. 1). */
-        const double at = 0.5 * (s->r[i] + d);
-        body_name(s, 0, i, a, sizeof a);
+        bal_output_contact_point(s, 1, c, &px, &py, &ex, &ey);
+        body_name(s, 0, s->pw.i[c], a, sizeof a);
         fprintf(f, "%s\t%s\twall\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d", a,
-                W->name, s->x[i] + at * ex, s->y[i] + at * ey, ex, ey, s->pw.fn[c], s->pw.fs[c],
-                s->pw.dn[c], s->pw.ds[c], (s->pw.flags[c] & BAL_PAIR_SLIDING) != 0);
+                s->walls[s->pw.j[c]].name, px, py, ex, ey, s->pw.fn[c], s->pw.fs[c], s->pw.dn[c],
+                s->pw.ds[c], (s->pw.flags[c] & BAL_PAIR_SLIDING) != 0);
         rolling_columns(s, &s->pw, c, f);
         fputc('\n', f);
     }
 }
 
-static void write_discs(const struct bal_sim *s, FILE *f)
+void bal_output_discs(const struct bal_sim *s, FILE *f, int snapshot)
 {
-    fputs("id\tname\tx\ty\tr\ttheta\tvx\tvy\tomega\tm\tfixed\trow\n", f);
+    fputs(snapshot ? "id\tname\tgenerator\tindex\tx\ty\tr\ttheta\tvx\tvy\tomega\tfx\tfy\ttorque\tm\t"
+                     "fixed\n"
+                   : "id\tname\tx\ty\tr\ttheta\tvx\tvy\tomega\tm\tfixed\trow\n",
+          f);
     char name[2 * BAL_NAME_MAX];
     for (int k = 0; k < s->n; k++) {
         const int i = s->slot[k];
         double vx, vy, w;
         bal_measure_velocity(s, i, &vx, &vy, &w);
         bal_output_disc_name(s, k, name, sizeof name);
-        fprintf(f, "%d\t%s\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%d\t%d\n", k,
-                name, s->x[i], s->y[i], s->r[i], s->th[i] * (180 / BAL_PI), vx, vy, w,
-                bal_mass(s, i), s->fixed[i], s->row ? s->row[i] : -1);
+        fprintf(f, "%d\t%s", k, name);
+        if (snapshot) {
+            long index;
+            const char *generator = bal_specimen_disc_source(s->scene, k, &index);
+            fprintf(f, "\t%s\t%ld", generator, index);
+        }
+        fprintf(f, "\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g\t%.17g", s->x[i], s->y[i], s->r[i],
+                s->th[i] * (180 / BAL_PI), vx, vy, w);
+        if (snapshot)
+            fprintf(f, "\t%.17g\t%.17g\t%.17g", s->f[3 * i], s->f[3 * i + 1], s->f[3 * i + 2]);
+        fprintf(f, "\t%.17g\t%d", bal_mass(s, i), s->fixed[i]);
+        if (!snapshot)
+            fprintf(f, "\t%d", s->row ? s->row[i] : -1);
+        fputc('\n', f);
     }
 }
 
-static void write_walls(const struct bal_sim *s, FILE *f)
+void bal_output_walls(const struct bal_sim *s, FILE *f)
 {
     fputs("name\tax\tay\tbx\tby\tf1\tf2\tmoment\tecc\n", f);
     for (int k = 0; k < s->n_walls; k++) {
@@ -277,40 +317,40 @@ enum bal_status bal_output_state(const struct bal_sim *s, const char *dir, struc
     if (!moment)
         return bal_error(err, BAL_ENOMEM, "%s: out of memory for the stresses", dir);
     bal_measure_moments(s, moment);
-    FILE *g = open_tmp(dir, "stress.tsv", err);
+    FILE *g = bal_output_open(dir, "stress.tsv", err);
     enum bal_status st = g ? BAL_OK : err->code;
     if (st == BAL_OK) {
         write_stress(s, moment, g);
-        st = close_tmp(g, dir, "stress.tsv", err);
+        st = bal_output_close(g, dir, "stress.tsv", err);
     }
     if (st == BAL_OK && s->scene->settings.stress_width > 0) {
-        g = open_tmp(dir, "stress_grid.tsv", err);
+        g = bal_output_open(dir, "stress_grid.tsv", err);
         st = g ? BAL_OK : err->code;
         if (st == BAL_OK) {
             write_stress_grid(s, moment, g);
-            st = close_tmp(g, dir, "stress_grid.tsv", err);
+            st = bal_output_close(g, dir, "stress_grid.tsv", err);
         }
     }
     free(moment);
     if (st != BAL_OK)
         return st;
-    FILE *f = open_tmp(dir, "contacts.tsv", err);
+    FILE *f = bal_output_open(dir, "contacts.tsv", err);
     if (!f)
         return err->code;
-    write_contacts(s, f);
-    if (close_tmp(f, dir, "contacts.tsv", err))
+    bal_output_contacts(s, f);
+    if (bal_output_close(f, dir, "contacts.tsv", err))
         return err->code;
-    f = open_tmp(dir, "discs.tsv", err);
+    f = bal_output_open(dir, "discs.tsv", err);
     if (!f)
         return err->code;
-    write_discs(s, f);
-    if (close_tmp(f, dir, "discs.tsv", err))
+    bal_output_discs(s, f, 0);
+    if (bal_output_close(f, dir, "discs.tsv", err))
         return err->code;
-    f = open_tmp(dir, "walls.tsv", err);
+    f = bal_output_open(dir, "walls.tsv", err);
     if (!f)
         return err->code;
-    write_walls(s, f);
-    return close_tmp(f, dir, "walls.tsv", err);
+    bal_output_walls(s, f);
+    return bal_output_close(f, dir, "walls.tsv", err);
 }
 
 static void json_string(FILE *f, const char *v)
@@ -340,7 +380,7 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
                                     enum bal_status status, const char *message,
                                     struct bal_error *err)
 {
-    FILE *f = open_tmp(dir, "run.json", err);
+    FILE *f = bal_output_open(dir, "run.json", err);
     if (!f)
         return err->code;
     fputs("{\n  \"version\": ", f);
@@ -462,5 +502,5 @@ enum bal_status bal_output_run_json(const struct bal_sim *s, const char *dir,
         fputs("\n  ]", f);
     }
     fputs("\n}\n", f);
-    return close_tmp(f, dir, "run.json", err);
+    return bal_output_close(f, dir, "run.json", err);
 }

@@ -6,6 +6,7 @@
 #ifndef BAL_SCENE_H
 #define BAL_SCENE_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "scene_keys.h"
@@ -17,6 +18,10 @@ int bal_scene_find(const struct bal_scene *s, enum bal_section_kind sec,
  * sections of kind k the scene has (1 for the settings). */
 void *bal_scene_section(const struct bal_scene *s, enum bal_section_kind k, int i);
 int bal_scene_count(const struct bal_scene *s, enum bal_section_kind k);
+
+/* Where the [settings] key `key` was given, for a message in the parser's forms: "FILE:LINE:
+ * KEY" from the scene file, "FILE: --set KEY" from an override (or not given). */
+void bal_scene_settings_where(const struct bal_scene *s, const char *key, char *buf, size_t size);
 
 /* What every section struct shares: a named one starts with its name and
  * the line of its header; every one ends with BAL_SECTION_TAIL, which keys

@@ -28,6 +28,9 @@
  * ks against it too (ks may also be -1: equal to kn). */
 #define KMIN 1e-150
 
+/* A section's `given` has one bit per key of its kind. */
+_Static_assert(BAL_KEYS_MAX <= 32, "struct bal_settings' given (uint32_t) has a bit per key");
+
 #define S(field) offsetof(struct bal_settings, field)
 #define M(field) offsetof(struct bal_material_def, field)
 #define D(field) offsetof(struct bal_disc_def, field)
@@ -77,6 +80,15 @@ const struct bal_key bal_scene_keys[] = {
      "chooses the skin from the measured motion (fewest expected cost per cycle)"},
     {BAL_SEC_SETTINGS, "output_every", BAL_KEY_LONG, S(output_every), "1", 0, 1, LBIG, NULL,
      "cycles between rows of series.tsv"},
+    {BAL_SEC_SETTINGS, "snapshot_every", BAL_KEY_LONG, S(snapshot_every), "0", 0, 0, LBIG, NULL,
+     "cycles between snapshots: the discs, contacts and walls in snapshots/ (docs/paraview.md); "
+     "0 = none"},
+    {BAL_SEC_SETTINGS, "snapshot_dt", BAL_KEY_DOUBLE, S(snapshot_dt), "0", 0, 0, BIG, NULL,
+     "or the simulated time between snapshots (frame k at cycle ceil(k snapshot_dt / dt)); "
+     "0 = none; not with snapshot_every"},
+    {BAL_SEC_SETTINGS, "vtk", BAL_KEY_LONG, S(vtk), "0", 0, 0, 1, NULL,
+     "1: each snapshot also as VTK XML PolyData with a ParaView .pvd collection (also `ballast "
+     "run --vtk`); needs snapshot_every or snapshot_dt"},
     {BAL_SEC_SETTINGS, "gamma_n", BAL_KEY_DOUBLE, S(gamma_n), "0", 0, 0, BIG, NULL,
      "viscous normal damping gamma_n d' (d/d0)^psi of MLH eq. 3, mass/time"},
     {BAL_SEC_SETTINGS, "psi", BAL_KEY_DOUBLE, S(psi), "0", 0, 0, 3, NULL,

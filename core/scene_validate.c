@@ -191,6 +191,39 @@ static enum bal_status check_body_names(const struct bal_scene *s, struct bal_er
     return BAL_OK;
 }
 
+void bal_scene_settings_where(const struct bal_scene *s, const char *key, char *buf, size_t size)
+{
+    const int line = s->settings.key_line[bal_scene_key_index(BAL_SEC_SETTINGS, key)];
+    if (line > 0)
+        snprintf(buf, size, "%s:%d: %s", s->path, line, key);
+    else
+        snprintf(buf, size, "%s: --set %s", s->path, key);
+}
+
+/* Snapshots are taken every so many cycles or every so much simulated time, not both; the
+ * VTK files are written at the snapshots' frames, so vtk = 1 needs one of the two. */
+static enum bal_status check_snapshots(const struct bal_scene *s, struct bal_error *err)
+{
+    const struct bal_settings *st = &s->settings;
+    char where[BAL_PATH_MAX + 64], other[BAL_PATH_MAX + 64];
+    if (st->snapshot_every > 0 && st->snapshot_dt > 0) {
+        bal_scene_settings_where(s, "snapshot_dt", where, sizeof where);
+        bal_scene_settings_where(s, "snapshot_every", other, sizeof other);
+        return bal_error(err, BAL_EINVAL,
+                         "%s: snapshots every %s of simulated time and every %ld cycles (%s): "
+                         "give one of snapshot_every and snapshot_dt, the other 0",
+                         where, BAL_NUM(st->snapshot_dt), st->snapshot_every, other);
+    }
+    if (st->vtk && st->snapshot_every == 0 && st->snapshot_dt == 0) {
+        bal_scene_settings_where(s, "vtk", where, sizeof where);
+        return bal_error(err, BAL_EINVAL,
+                         "%s: vtk = 1 needs snapshots: give snapshot_every (cycles) or "
+                         "snapshot_dt (simulated time); the VTK files are written at their frames",
+                         where);
+    }
+    return BAL_OK;
+}
+
 enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *err)
 {
     for (int k = 0; k < BAL_SEC_COUNT; k++)
@@ -209,6 +242,9 @@ enum bal_status bal_scene_validate(const struct bal_scene *s, struct bal_error *
                          "%s:%d: delta0: required with psi != 0 (the dashpot "
                          "gamma_n (delta/delta0)^psi depends on it, MLH eq. 3)",
                          s->path, st->key_line[bal_scene_key_index(BAL_SEC_SETTINGS, "psi")]);
+
+    if (check_snapshots(s, err))
+        return err->code;
 
     for (int i = 0; i < s->n_discs; i++) {
         struct bal_disc_def *d = &s->discs[i];

@@ -29,7 +29,8 @@
  *
  * bal_sim_run() runs the stages of the loading protocol in order (each
  * stage gives its walls their controllers and sets the gravity ramp, and
- * may stop early on its stop rule), writes a series row every output_every cycles (output.c),
+ * may stop early on its stop rule), writes a series row every output_every cycles (output.c)
+ * and the snapshots when the scene asks for them (snapshots.c),
  * and stops, with a status, on a signal, a state that is no longer finite,
  * an energy runaway (energy.c) or a wall about to outrun the discs or a
  * servo's span closed (walls.c).
@@ -46,6 +47,7 @@
 #include "integrate.h"
 #include "measure.h"
 #include "pairs.h"
+#include "snapshots.h"
 #include "specimen.h"
 #include "threads.h"
 #include "wall_loop.h"
@@ -83,6 +85,7 @@ enum bal_status bal_sim_create(struct bal_sim **out, const struct bal_scene *sc,
         bal_build_lists(s, err) ||         /* the first candidate lists */
         bal_build_probes(s, err) ||        /* probe bodies */
         bal_build_stages(s, err) ||        /* the stages' log; none begun */
+        bal_snapshots_setup(s, err) ||     /* their frames' schedule (snapshots.c) */
         bal_walls_check_steps(s, err)) {   /* no wall outruns the discs (walls.c) */
         bal_sim_free(s);
         return err->code;
@@ -115,6 +118,7 @@ void bal_sim_free(struct bal_sim *s)
     free(s->moment);
     free(s->moment_prev);
     free(s->log);
+    free(s->snap.frames);
     bal_grid_free(&s->grid);
     bal_pairs_free(&s->pp);
     bal_pairs_free(&s->pw);
@@ -369,7 +373,8 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
     struct timespec t0;
     clock_gettime(CLOCK_MONOTONIC, &t0);
     double next_report = s->progress_seconds;
-    enum bal_status status = BAL_OK;
+    /* Frame 0 of the snapshots: the state the run starts from. */
+    enum bal_status status = s->step == s->snap.next ? bal_snapshots_frame(s, err) : BAL_OK;
     for (int g = 0; g < sc->n_stages && status == BAL_OK; g++) {
         const struct bal_stage_def *stage = &sc->stages[g];
         struct bal_stage_log *log = &s->log[g];
@@ -404,6 +409,9 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
             if ((row || (done && series && (g == sc->n_stages - 1 || stage->output_at_end))) &&
                 (status = bal_output_series_row(s, series, err)) != BAL_OK)
                 break;
+            /* A snapshot when one is due (-1 when off: one comparison). */
+            if (s->step == s->snap.next && (status = bal_snapshots_frame(s, err)) != BAL_OK)
+                break;
             if (done) {
                 log->stopped = 1;
                 break;
@@ -417,6 +425,9 @@ enum bal_status bal_sim_run(struct bal_sim *s, FILE *series, volatile const sig_
         status = check_finite(s, err);
     if (status == BAL_OK)
         status = bal_energy_guard(s, err);
+    /* The final state is the last snapshot. */
+    if (status == BAL_OK)
+        status = bal_snapshots_last(s, err);
     s->wall_seconds += seconds_since(&t0);
     return status;
 }

@@ -701,6 +701,17 @@ void bal_specimen_disc_name(const struct bal_scene *sc, int id, char *buf, size_
                  at.k);
 }
 
+const char *bal_specimen_disc_source(const struct bal_scene *sc, int id, long *index)
+{
+    const struct disc_place at = locate(sc, id);
+    *index = at.section < 0 ? -1 : at.k;
+    if (at.section < 0)
+        return "?";
+    if (at.gen < 0)
+        return sc->discs[at.section].name;
+    return bal_scene_item_name(bal_scene_section(sc, generators[at.gen].kind, at.section));
+}
+
 long bal_specimen_find_disc(const struct bal_scene *sc, const char *name, char *why, size_t size)
 {
     const char *dot = strrchr(name, '.');

@@ -59,6 +59,10 @@ int bal_specimen_grains_check(const struct bal_grains_def *g, const char **key, 
 /* The name of the disc with scene-order index id: its [disc] name, or
  * FILL.k / PILE.k for the k-th disc a generator made. */
 void bal_specimen_disc_name(const struct bal_scene *sc, int id, char *buf, size_t size);
+/* The section the disc with scene-order index id came from, and its index among that
+ * section's discs in *index: a [disc]'s name and 0, or the generator's name and k (the disc
+ * it names NAME.k). */
+const char *bal_specimen_disc_source(const struct bal_scene *sc, int id, long *index);
 /* The scene-order index of the disc a probe names: a [disc]'s name, or
  * NAME.k, the k-th disc of the [fill], [pile], [grains] or [import] named
  * NAME (as bal_specimen_disc_name names it).  -1 with the reason in `why`

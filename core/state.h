@@ -241,6 +241,31 @@ static inline int bal_block_end(int n, int b)
     return to < n ? to : n;
 }
 
+/* One snapshot written: its cycle, simulated time and stage (index.tsv and
+ * snapshots.pvd list them all, rewritten after each frame). */
+struct bal_snapshot_frame {
+    long cycle;
+    double time;
+    int stage;
+};
+
+/* Longest path of a run's snapshots folder, with its terminating zero (the
+ * output writers build their paths in 1024 characters). */
+#define BAL_SNAPSHOT_DIR_MAX 1000
+
+/* The snapshots of a run (snapshots.c): when the next frame is due and the
+ * frames written so far. */
+struct bal_snapshots {
+    long next;             /* the cycle of the next frame, the one test the run loop
+                            * makes per cycle; -1: none (snapshots off, or no folder) */
+    long every;            /* settings.snapshot_every; 0: frames in simulated time */
+    double period;         /* settings.snapshot_dt; 0: frames in cycles */
+    long n, cap;           /* frames written; room in `frames` (reserved at creation
+                            * for every frame the stages can have) */
+    struct bal_snapshot_frame *frames;
+    char dir[BAL_SNAPSHOT_DIR_MAX]; /* the folder, OUT/snapshots; "" until named */
+};
+
 struct bal_sim {
     const struct bal_scene *scene;
 
@@ -353,6 +378,9 @@ struct bal_sim {
     double overlap_budget;       /* share of the smaller radius; INFINITY = off */
     double overlap_sieve;        /* overlap_budget x the smallest radius of the scene */
     int over_budget;             /* a contact loop saw an overlap beyond the budget */
+
+    /* snapshots (snapshots.c) */
+    struct bal_snapshots snap;
 
     /* progress */
     long step;

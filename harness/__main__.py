@@ -24,7 +24,7 @@ from contextlib import nullcontext
 from pathlib import Path
 
 from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_root
-from . import catalogue, export, extremes, files, known, pictures, references, stability
+from . import catalogue, export, extremes, files, known, pictures, points, references, stability
 from . import study as studies
 from . import families  # noqa: F401 -- registers every case family's expression functions
 from . import sweep as sweeps
@@ -35,7 +35,7 @@ from .gate import gate
 from .lock import reports_lock
 from .rebaseline import rebaseline
 from .report import write_report
-from .runner import jobs_for, run_all, sigterm_as_interrupt
+from .runner import jobs_for, run_all, sigterm_as_interrupt, unrecorded
 
 USAGE_ERROR = 2
 IO_ERROR = 3         # as the core's exit code for an I/O error
@@ -90,10 +90,8 @@ def cmd_run(args):
 def runs_status(outcomes):
     """0 if every run is ok; IO_ERROR (said on stderr) if the harness could not prepare or
     record some run folder; else 1."""
-    unwritten = [o.io_error for o in outcomes if o.io_error]
-    if unwritten:
-        print(f"ballast-harness: {unwritten[0]}"
-              + (f" (and {len(unwritten) - 1} more run folder(s))" if len(unwritten) > 1 else ""), file=sys.stderr)
+    if unrecorded(outcomes):
+        print(f"ballast-harness: {unrecorded(outcomes)}", file=sys.stderr)
         return IO_ERROR
     return 0 if all(o.ok for o in outcomes) else 1
 
@@ -172,26 +170,43 @@ def cmd_rebaseline(args):
 
 
 def cmd_sweep(args):
+    """One variant at every point of a --set grid (sweep_grid.py, the machinery `study --set` runs
+    through): the table of its checks (sweep_<variant>.tsv, sweep_<variant>.svg) and, with
+    --quantity, each quantity's value and error against the point's reference point
+    (quantities_<variant>.tsv), under reports/sweeps/<case>/."""
     cases = load_cases()
     case = catalogue.select(cases, [args.case])[0]
     variant = sweep_variant(case, args.variant)
     keyed = sweep_grid.parse_sets(args.set)
-    jobs, extra = sweep_grid.jobs(case, variant, keyed, reports_root() / "sweeps", args.bin)
-    sweep_grid.refuse_bad_points(jobs, keyed, args.bin)
+    folder = reports_root() / "sweeps" / case.name
+    jobs, extra = sweep_grid.plan(args.bin, variant.scene, variant.sets, keyed, lambda _, label: folder / label,
+                                  owner=case.name, expected=case.runtime / max(len(case.variants), 1),
+                                  command=variant.command)
     if extra:
         print(f"sweep over the time step: every point keeps the stages' simulated time ({' '.join(extra)})")
-    outcomes = run_all(jobs, args.bin, args.jobs, sys.stdout, resume=args.resume)
-    if any(o.io_error for o in outcomes):       # runs that could not be recorded: say so, no table
-        return runs_status(outcomes)
+    outcomes = points.launch(jobs, args.bin, args.jobs, sys.stdout, args.resume)
     checks = [c for c in load_checks(cases) if c.case == case.name and c.run_variants == [variant.name]]
-    if not checks:
+    measured = sweep_grid.measure(keyed, jobs, args.quantity or [])
+    curves = []
+    if checks:
+        labels = [j.variant for j in jobs]
+        results = sweep_grid.evaluate(checks, jobs, measured.costs)
+        print(sweep_grid.checks_table(labels, checks, results))
+        path = folder / f"sweep_{variant.name}.tsv"
+        sweep_grid.write_checks_tsv(path, jobs, checks, results)
+        print(f"wrote {path}")
+        curves = sweep_grid.check_curves(labels, checks, results, measured.costs)
+    else:
         print(f"no checks of {case.name} use only variant '{variant.name}'")
-        return runs_status(outcomes)
-    results = sweep_grid.evaluate(checks, jobs)
-    print(sweep_grid.table([j.variant for j in jobs], checks, results))
-    path = reports_root() / "sweeps" / case.name / f"sweep_{variant.name}.tsv"
-    sweep_grid.write_tsv(path, jobs, checks, results)
-    print(f"wrote {path}")
+    if measured.quantities:
+        print(sweep_grid.points_table(measured))
+        path = folder / f"quantities_{variant.name}.tsv"
+        sweep_grid.write_points_tsv(path, measured)
+        print(f"wrote {path}")
+        curves += sweep_grid.point_curves(measured, " (vs ref point)")
+    figure = sweep_grid.draw(folder, f"sweep_{variant.name}", curves, "|q - ref| / |ref|")
+    if figure:
+        print(f"wrote {folder / figure}")
     return runs_status(outcomes)
 
 
@@ -200,7 +215,7 @@ def cmd_cost(args):
     all_cases = load_cases()
     checks = load_checks(all_cases)
     sweeps.run_declared(selected(args, all_cases), checks, args.bin, args.jobs, runs_root(),
-                        reports_root() / "sweeps", sys.stdout, functools.partial(run_all, resume=args.resume))
+                        reports_root() / "sweeps", sys.stdout, functools.partial(points.launch, resume=args.resume))
     return 0
 
 
@@ -353,6 +368,9 @@ def parser():
                        help="repeatable: several keys combine as a grid (KEY1,KEY2=V1,V2,... moves two keys "
                             "together); a dt sweep keeps the simulated time")
     sweep.add_argument("--variant", metavar="NAME", help="the variant to sweep (needed when the case has several)")
+    sweep.add_argument("--quantity", action="append", metavar="EXPR",
+                       help="repeatable: also each point's value of EXPR and its error against the point's "
+                            "reference point, as `study --set` gives them (quantities_<variant>.tsv)")
     _runs(sweep)
     _runs(_selection(_command(sub, "cost", cmd_cost,
                               "run every declared [sweep] of the selected cases (error against cost); "
@@ -380,6 +398,9 @@ def parser():
                           "needed for any other key)")
     stu.add_argument("--factor", type=float, default=None, help="each level's h over the last's (default 0.5)")
     stu.add_argument("--levels", type=int, default=None, help="number of levels (default 4, at least 3)")
+    stu.add_argument("--no-midpoints", action="store_true",
+                     help="skip the runs at the geometric midpoints between levels (they tell a smooth "
+                          "quantity from one whose error jumps with h: envelope.py)")
     stu.add_argument("--target", type=float, action="append", metavar="REL",
                      help="repeatable: advise the largest h for |q - q*|/|q*| <= REL, and check it by a run")
     stu.add_argument("--stability", action="store_true",

@@ -14,8 +14,8 @@ either, and only the core resolves them.  `ballast info` prints, among others:
                                                         that another key's value makes unused
 
 parse() turns that into a dict; stability.py asks through the runner's batch (interruptible),
-sweep_grid.py with query(); refuse_bad_points() asks about every point of a sweep before any
-of them runs (`harness sweep`, and the declared sweeps of `harness cost`).
+points.py with query(); refuse_bad_points() asks about every point of a sweep before any
+of them runs (`harness study`, `harness sweep`, and the declared sweeps of `harness cost`).
 """
 import re
 import subprocess

@@ -99,9 +99,10 @@ def departures(hs, qs, analysis, mids, qmids):
 
 
 def smooth(deps):
-    """True when every midpoint lies on the power law within SMOOTH_TOLERANCE (a missing
-    midpoint counts as a departure: the quantity was not measured there)."""
-    return all(d is not None and d <= SMOOTH_TOLERANCE for d in deps)
+    """True when every measured midpoint lies on the power law within SMOOTH_TOLERANCE.  A
+    midpoint without a value (its run failed, e.g. a guard stopped it) is no evidence either way
+    and is left out; with none measured the levels' verdict stands."""
+    return all(d <= SMOOTH_TOLERANCE for d in deps if d is not None)
 
 
 def bound(hs, qs):
@@ -139,7 +140,7 @@ def bound(hs, qs):
     K = float(np.max(np.abs(q - limit) * w))
     out.update(ok=True, order=p, limit=float(limit), mean=float(mean), K=K, uncertainty=ENVELOPE_MARGIN * K * h[0] ** p)
     rel = f" ({out['uncertainty'] / abs(limit):.2g} of it)" if limit != 0 else ""
-    out["text"] = (f"not smooth in h, bounded: |q - q*| <= K h^p with envelope order {p:.3g}, "
+    out["text"] = (f"bounded: |q - q*| <= K h^p with envelope order {p:.3g}, "
                    f"K = {K:.4g}, over {len(pts)} points; q* = {limit:.8g} +- {out['uncertainty']:.2g}{rel}")
     return out
 

@@ -100,6 +100,15 @@ class Outcome:
     io_error: WriteError = None   # the harness could not prepare or record the folder (files.py)
 
 
+def unrecorded(outcomes):
+    """'' when every run folder was prepared and recorded; else one line naming the first that
+    was not (the OS's reason) and how many more."""
+    unwritten = [o.io_error for o in outcomes if o.io_error]
+    if not unwritten:
+        return ""
+    return f"{unwritten[0]}" + (f" (and {len(unwritten) - 1} more run folder(s))" if len(unwritten) > 1 else "")
+
+
 def jobs_for(cases, runs_root):
     """One Job per variant of each case, outputs in runs_root/<case>/<variant>."""
     return [Job(c.name, v.name, v.scene, list(v.sets), Path(runs_root) / c.name / v.name,

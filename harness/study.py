@@ -40,137 +40,35 @@ instead of the refinement: each point's quantities, cost, and error against its 
 a short-column table and error_cost.svg (sweep_study below).  --resume continues
 an interrupted study in its folder (the newest <scene-stem>-<n>, or --out DIR), keeping every
 complete run of the same identity (runner.py).
+
+The points, their runs and their cost are points.py's; the analysis, the errors against a
+reference point, the tables' columns and the figures are error_cost.py's; the grid of --set is
+sweep_grid.py's -- the same code `harness sweep CASE` and the declared sweeps run through.
 """
 import math
-import subprocess
 import sys
 from pathlib import Path
 
-import numpy as np
-
-from . import core_info, files, stability, sweep_grid
-from .compare import evaluate
-from .errors import CatalogueError, EvalError, RunProblem
-from .runner import Job, run_all
-from .sweep import run_cost
+from . import core_info, envelope, files, points, stability, sweep_grid
+from .error_cost import (ADVICE_MARGIN, MIN_LEVELS, ORDER_AGREE, P_MIN, advise, aligned, analyse, cost_model,
+                         deviation, num, plot)
+from .errors import CatalogueError, RunProblem
+from .points import DT_KEYS
 from .tables import load_run
 
-DT_KEYS = ("settings.dt", "settings.dt_fraction")
-FORCE = "settings.force_dt=1"
-MIN_LEVELS = 3          # two differences give one pairwise order; three levels are the least
-# A pairwise order below P_MIN means a refinement by r cut the difference by less than r^P_MIN
-# (1.41 for r = 2): the differences are not shrinking the way a convergent sequence's do, as in
-# a chaotic scene whose particle-level quantities differ by O(1) at every step size.
-P_MIN = 0.5
-# Pairwise orders that differ by more than ORDER_AGREE are not yet asymptotic.  With p off by
-# 0.25 the Richardson error estimate d/(r^p - 1) is off by at most ~40 % for p >= 1, r = 2,
-# which ADVICE_MARGIN covers; a larger spread would make the extrapolation a guess.
-ORDER_AGREE = 0.25
-# Differences below ROUNDOFF x |q| are floating-point noise: the quantity does not depend on h.
-ROUNDOFF = 1e-12
-# The advice aims at REL / ADVICE_MARGIN: the error model's constant and q* are estimates from
-# the levels (their own error is of the order of the pairwise orders' spread, see ORDER_AGREE).
-ADVICE_MARGIN = 2.0
 STUDIES = "studies"
 TSV_COLUMNS = ("quantity", "level", "h", "value", "difference", "pairwise_order", "error_est",
                "particle_steps", "wall_seconds", "status")
 ADVICE_COLUMNS = ("quantity", "target", "h_advised", "predicted_error", "predicted_particle_steps",
                   "predicted_seconds", "achieved_value", "achieved_error", "met")
-GNUPLOT_TIMEOUT = 60    # seconds
 # The refinement's options (None on the command line = not given: --set refuses them when given).
 REFINE_DEFAULTS = {"refine": "settings.dt", "factor": 0.5, "levels": 4}
-SWEEP_TSV_COLUMNS = ("point", "sets", "status", "steps", "particle_steps", "wall_seconds", "quantity", "value",
-                     "reference_point", "error")
-# A quantity's column in the printed sweep table is headed by its expression up to this length,
-# else by q1, q2, ... with the expressions listed below the table.
-SHORT_HEADER = 20
-
-
-# ---------------------------------------------------------------- the analysis (pure)
-
-def analyse(hs, qs, factor):
-    """The convergence of one quantity over levels hs (coarsest first) with values qs.
-
-    {verdict, text, order, orders, order_lsq, limit, errors, diffs}: verdict is 'converging',
-    'asymptotic?' (not yet in the asymptotic range), 'not converging', 'independent' (the
-    differences are round-off) or 'failed' (a value is missing); order is the p used (the
-    finest pairwise order), limit the Richardson q* (None unless converging or independent),
-    errors each level's |q - q*| / |q*| (None where there is no q*)."""
-    r = 1.0 / factor
-    out = {"verdict": "failed", "text": "", "order": None, "orders": [], "order_lsq": None,
-           "limit": None, "errors": [None] * len(qs), "diffs": []}
-    if any(q is None or not math.isfinite(q) for q in qs):
-        out["text"] = "no value at some level (see the table)"
-        return out
-    d = [b - a for a, b in zip(qs, qs[1:])]
-    out["diffs"] = d
-    scale = max(abs(q) for q in qs)
-    if max(abs(x) for x in d) <= ROUNDOFF * max(scale, np.finfo(float).tiny):
-        out.update(verdict="independent", limit=qs[-1], errors=[0.0] * len(qs),
-                   text=f"independent of h: every difference is at round-off (<= {ROUNDOFF:g} |q|)")
-        return out
-    if any(x == 0 for x in d):
-        out.update(verdict="not converging", text="some differences are exactly zero and others not: "
-                                                  "not a smooth sequence in h")
-        return out
-    orders = [math.log(abs(a) / abs(b)) / math.log(r) for a, b in zip(d, d[1:])]
-    out["orders"] = orders
-    out["order_lsq"] = float(np.polyfit(np.log(hs[:-1]), np.log(np.abs(d)), 1)[0])
-    listed = ", ".join(f"{p:.3g}" for p in orders)
-    if min(orders) <= P_MIN:
-        out.update(verdict="not converging",
-                   text=f"not converging: pairwise orders {listed}; a refinement by {r:g} must cut the "
-                        f"difference by at least {r:g}^{P_MIN:g} (order > {P_MIN:g}): noise or chaos, "
-                        f"no extrapolation; the levels spread over {spread(qs)}")
-        return out
-    if any((a > 0) != (b > 0) for a, b in zip(d, d[1:])):
-        out.update(verdict="asymptotic?",
-                   text=f"not yet in the asymptotic range: the differences change sign (pairwise orders "
-                        f"{listed}): the error is not a smooth power of h here (a phase effect within "
-                        "the step, or noise); no extrapolation")
-        return out
-    if max(orders) - min(orders) > ORDER_AGREE:
-        out.update(verdict="asymptotic?",
-                   text=f"not yet in the asymptotic range: pairwise orders {listed} differ by more than "
-                        f"{ORDER_AGREE:g}; refine further (--levels, or a smaller base)")
-        return out
-    p = orders[-1]
-    limit = qs[-1] + d[-1] / (r ** p - 1)
-    errors = [abs(q - limit) / abs(limit) if limit != 0 else abs(q - limit) for q in qs]
-    out.update(verdict="converging", order=p, limit=limit, errors=errors,
-               text=f"converging at order {p:.3g} (pairwise {listed}; least squares {out['order_lsq']:.3g})")
-    return out
-
-
-def spread(qs):
-    """max - min of the levels' values, and relative to the largest |q|: what a user can count on
-    when the quantity does not converge."""
-    width, top = max(qs) - min(qs), max(abs(q) for q in qs)
-    return f"{width:.3g}" + (f" ({width / top:.2g} of |q|)" if top > 0 else "")
-
-
-def advise(hs, analysis, target):
-    """(h, predicted relative error at h) for a converging quantity: the largest h with
-    e(h) = e_finest (h / h_finest)^p <= target / ADVICE_MARGIN; None when there is no advice
-    (not converging, q* = 0).  An independent quantity meets any target at the coarsest h."""
-    if analysis["verdict"] == "independent":
-        return hs[0], 0.0
-    if analysis["verdict"] != "converging" or analysis["limit"] == 0:
-        return None
-    p, e_f = analysis["order"], analysis["errors"][-1]
-    if e_f == 0:
-        return hs[0], 0.0
-    h = hs[-1] * (target / ADVICE_MARGIN / e_f) ** (1.0 / p)
-    return h, e_f * (h / hs[-1]) ** p
-
-
-def cost_model(hs, costs):
-    """cost(h) by a least-squares power law over the levels with a cost (None when < 2)."""
-    pts = [(h, c) for h, c in zip(hs, costs) if isinstance(c, (int, float)) and c > 0]
-    if len(pts) < 2:
-        return None
-    slope, icpt = np.polyfit(np.log([h for h, _ in pts]), np.log([c for _, c in pts]), 1)
-    return lambda h: float(math.exp(icpt + slope * math.log(h)))
+# The advice's check run is made only when it costs at most this many times the finest level:
+# a study's levels and midpoints cost ~3.5 x its finest level (1 + 1/2 + 1/4 ... and the
+# midpoints' 1.41 + 0.71 + ...), so a check of up to 16 x stays within ~5 x the whole study; an
+# advised step beyond it is far outside the range the levels measured (an extrapolation by a
+# factor of 16 in cost) and is reported, not run.
+CHECK_COST_CEILING = 16.0
 
 
 # ---------------------------------------------------------------- folders and runs
@@ -212,18 +110,11 @@ def base_value(binary, scene, key, base):
     return value
 
 
-def time_keeping(binary, scene, key):
-    """The overrides that keep each stage's simulated time while the step is refined."""
-    if key not in DT_KEYS:
-        return []
-    info = core_info.query(binary, scene, [])
-    return [f"stage.{name}.time={fmt_h(cycles * info['dt'])}" for name, cycles, _, given in info["stages"]
-            if given == "cycles" and cycles > 0] + [FORCE]
-
-
-def job(scene, folder, label, key, h, extra):
-    return Job("study", label, scene, list(extra) + [f"{key}={fmt_h(h)}"], folder / "runs" / label,
-               probe=bool(extra))
+def level_jobs(scene, folder, levels, key, extra):
+    """One runner Job per level (label, h): the scene with key = h (after the time keeping extra),
+    in folder/runs/<label>."""
+    return points.jobs([(label, [f"{key}={fmt_h(h)}"], folder / "runs" / label) for label, h in levels],
+                       scene, extra=extra)
 
 
 def default_quantities(folder):
@@ -236,12 +127,16 @@ def default_quantities(folder):
     return out + [f"last({c})" for c in run.columns if c not in ("cycle", "time")]
 
 
-def value_of(expr, folder):
-    """(value, '') or (None, why)."""
-    try:
-        return evaluate(expr, load_run(folder)), ""
-    except (RunProblem, EvalError) as exc:
-        return None, str(exc)
+def run_points(args, scene, folder, jobs, extra, what, verb, out):
+    """Make the study's folder, say what runs (what: the points; verb: what the points do to the
+    step, when extra keeps the stages' time), run the points (parallel, resumable);
+    (outcomes, the quantities: --quantity, or the defaults of the first point's run)."""
+    files.make_dirs(folder)
+    print(f"study of {scene}: {what} -> {folder}", file=out)
+    if extra:
+        print(f"{verb} the step: every run keeps the stages' simulated time ({' '.join(extra)})", file=out)
+    outcomes = points.launch(jobs, args.bin, args.jobs, out, args.resume)
+    return outcomes, list(args.quantity or []) or default_quantities(jobs[0].out)
 
 
 # ---------------------------------------------------------------- the command
@@ -263,32 +158,97 @@ def study(args, reports_root, out=sys.stdout):
         raise CatalogueError("--target: a relative error above 0")
     key = args.refine
     base = base_value(args.bin, scene, key, args.base)
-    extra = time_keeping(args.bin, scene, key)
+    extra = points.time_keeping(args.bin, scene, [], [key])
     folder = study_folder(reports_root, scene, args.out, args.resume)
-    files.make_dirs(folder)
     hs = [base * args.factor ** k for k in range(args.levels)]
-    jobs = [job(scene, folder, f"L{k}", key, h, extra) for k, h in enumerate(hs)]
-    core_info.refuse_bad_points(args.bin, [(j.variant, j.scene, j.sets, [key]) for j in jobs])
-    print(f"study of {scene}: {key} = {', '.join(f'{h:.6g}' for h in hs)} -> {folder}", file=out)
-    if extra:
-        print(f"refining the step: every run keeps the stages' simulated time ({' '.join(extra)})", file=out)
-    outcomes = run_all(jobs, args.bin, args.jobs, out, resume=args.resume)
-    if any(o.io_error for o in outcomes):
-        raise OSError(f"cannot record the runs: {next(o.io_error for o in outcomes if o.io_error)}")
-    quantities = list(args.quantity or []) or default_quantities(jobs[0].out)
-    costs = [run_cost(j.out) for j in jobs]
-    values, analyses, notes = {}, {}, {}
+    mids = [] if getattr(args, "no_midpoints", False) else envelope.midpoints(hs, args.factor)
+    jobs = level_jobs(scene, folder, [(f"L{k}", h) for k, h in enumerate(hs)], key, extra)
+    mid_jobs = level_jobs(scene, folder, [(f"M{k}", h) for k, h in enumerate(mids)], key, extra)
+    points.refuse(args.bin, jobs + mid_jobs, [key])                        # before any run
+    what = f"{key} = {', '.join(f'{h:.6g}' for h in hs)}" + (" and the midpoints between them" if mids else "")
+    _, quantities = run_points(args, scene, folder, jobs + mid_jobs, extra, what, "refining", out)
+    costs, values, why = points.measure(jobs, quantities)
+    extra_points = {"M": (mids, points.measure(mid_jobs, quantities))}
+    analyses = {}
     for expr in quantities:
-        got = [value_of(expr, j.out) for j in jobs]
-        values[expr] = [v for v, _ in got]
-        notes[expr] = next((why for v, why in got if v is None), "")
         analyses[expr] = analyse(hs, values[expr], args.factor)
-        if notes[expr]:
-            analyses[expr]["text"] += f": {notes[expr]}"
+        if why[expr]:
+            analyses[expr]["text"] += f": {why[expr]}"
+        if mids:
+            smoothness(analyses[expr], hs, values[expr], mids, extra_points["M"][1][1][expr])
+    rough = [e for e in quantities if analyses[e].get("rough")]
+    if rough:
+        extra_points["S"] = envelope_samples(args, scene, folder, key, extra, hs, rough, out)
+        for expr in rough:
+            bounded(analyses[expr], hs, values[expr], extra_points, expr)
     advice = advice_rows(args, scene, folder, key, extra, hs, quantities, analyses, costs, out)
     limit = stability_limit(args, scene, folder, out) if getattr(args, "stability", False) else None
     write_outputs(folder, scene, key, hs, quantities, values, analyses, costs, advice, args, out, limit)
+    write_extra_points(folder, quantities, extra_points)
     return 0
+
+
+# ---------------------------------------------------------------- not smooth in h (envelope.py)
+
+def smoothness(a, hs, qs, mids, qmids):
+    """Marks the analysis a 'rough' (a candidate for envelope.bound) when its quantity is not a
+    smooth power of h: a converging verdict whose midpoints depart from the power law by more
+    than envelope.SMOOTH_TOLERANCE, or differences that change sign (analyse says so)."""
+    if a["verdict"] == "converging":
+        deps = envelope.departures(hs, qs, a, mids, qmids)
+        a["departures"] = deps
+        if not envelope.smooth(deps):
+            a["rough"] = ("its midpoints depart from the power law through the levels by "
+                          + ", ".join("-" if d is None else f"{d:.2g}" for d in deps)
+                          + f" of the difference between their neighbours (smooth: <= {envelope.SMOOTH_TOLERANCE:g})")
+    elif a["verdict"] == "asymptotic?" and "change sign" in a["text"]:
+        a["rough"] = "its differences change sign"
+
+
+def envelope_samples(args, scene, folder, key, extra, hs, rough, out):
+    """The extra samples of envelope.samples, run once for every rough quantity; (hs, measured)."""
+    hs_s = envelope.samples(hs) if len(hs) >= 3 else []
+    jobs = level_jobs(scene, folder, [(f"S{k}", h) for k, h in enumerate(hs_s)], key, extra)
+    if jobs:
+        print(f"not smooth in h ({len(rough)} quantit{'y' if len(rough) == 1 else 'ies'}): "
+              f"{len(jobs)} more runs to sample the error's envelope", file=out)
+        points.launch(jobs, args.bin, args.jobs, out, args.resume)
+    return hs_s, points.measure(jobs, rough)
+
+
+def bounded(a, hs, qs, extra_points, expr):
+    """Replaces a rough quantity's verdict by its envelope (envelope.bound over the levels, the
+    midpoints and the samples): 'bounded' with q*, the order and each level's error against q*,
+    or 'not smooth' with the reason there is no bound."""
+    all_h, all_q = list(hs), list(qs)
+    for hs_x, (_, values, _) in extra_points.values():
+        if expr in values:
+            all_h += list(hs_x)
+            all_q += values[expr]
+    env = envelope.bound(all_h, all_q)
+    a["envelope"] = env
+    head = f"not smooth in h: {a['rough']}"
+    if env["ok"]:
+        a.update(verdict="bounded", order=env["order"], limit=env["limit"],
+                 errors=[deviation(q, env["limit"]) for q in qs], text=f"{head}; {env['text']}")
+    else:
+        a.update(verdict="not smooth", limit=None, errors=[None] * len(qs),
+                 text=f"{head}; no Richardson limit, and no envelope: {env['text']}")
+
+
+def write_extra_points(folder, quantities, extra_points):
+    """points.tsv: the midpoints (M) and envelope samples (S) beside the levels of study.tsv."""
+    lines = ["quantity	point	h	value	particle_steps	wall_seconds	status"]
+    for tag, (hs_x, (costs, values, _)) in extra_points.items():
+        for expr in quantities:
+            if expr not in values:
+                continue
+            for k, h in enumerate(hs_x):
+                lines.append("\t".join([expr, f"{tag}{k}", repr(h), num(values[expr][k], ".17g"),
+                                        num(costs[k].get("particle_steps"), "g"),
+                                        num(costs[k].get("wall_seconds"), ".4g"), str(costs[k].get("status"))]))
+    if len(lines) > 1:
+        files.write_text(folder / "points.tsv", "\n".join(lines) + "\n")
 
 
 def stability_limit(args, scene, folder, out):
@@ -313,37 +273,49 @@ def advice_rows(args, scene, folder, key, extra, hs, quantities, analyses, costs
     seconds = cost_model(hs, [c.get("wall_seconds") for c in costs])
     for expr in quantities:
         for target in args.target or []:
-            got = advise(hs, analyses[expr], target)
+            a, why = analyses[expr], ""
+            if a["verdict"] == "bounded":
+                h, predicted = envelope.advise(a["envelope"], target)
+                got, why = ((h, predicted), "") if h is not None else (None, predicted)
+            else:
+                got = advise(hs, a, target)
+                if got is None and a["verdict"] == "converging":
+                    why = (f"its limit {a['limit']:.3g} is no larger than the last difference "
+                           f"{a['diffs'][-1]:.3g}: it converges to 0, where a relative target means nothing")
             rows.append({"quantity": expr, "target": target, "h": None if got is None else got[0],
                          "predicted": None if got is None else got[1],
                          "steps": steps(got[0]) if got and steps else None,
                          "seconds": seconds(got[0]) if got and seconds else None,
-                         "why": "" if got else f"no advice: {analyses[expr]['verdict']}"})
-    wanted = sorted({fmt_h(r["h"]) for r in rows if r["h"] is not None}, key=float, reverse=True)
-    checks = {h: job(scene, folder, f"check_{i}", key, float(h), extra) for i, h in enumerate(wanted)}
+                         "why": "" if got else f"no advice: {why or a['verdict']}"})
+    if steps:
+        ceiling = CHECK_COST_CEILING * steps(hs[-1])
+        for r in rows:
+            if r["h"] is not None and r["steps"] > ceiling:
+                r["why"] = (f"not run: the advised step would cost {r['steps']:.3g} particle-steps, over "
+                            f"{CHECK_COST_CEILING:g} x the finest level's (run it yourself with --set, or add levels)")
+                r["unchecked"] = True
+    wanted = sorted({fmt_h(r["h"]) for r in rows if r["h"] is not None and not r.get("unchecked")},
+                    key=float, reverse=True)
+    checks = dict(zip(wanted, level_jobs(scene, folder, [(f"check_{i}", float(h)) for i, h in enumerate(wanted)],
+                                         key, extra)))
     if checks:
         print(f"checking the advice: {len(checks)} run(s) at the advised {key}", file=out)
-        run_all(list(checks.values()), args.bin, args.jobs, out, resume=args.resume)
+        points.launch(list(checks.values()), args.bin, args.jobs, out, args.resume)
     for r in rows:
         r["achieved_value"] = r["achieved"] = r["met"] = None
-        if r["h"] is None:
+        if r["h"] is None or r.get("unchecked"):
             continue
-        value, why = value_of(r["quantity"], checks[fmt_h(r["h"])].out)
-        limit = analyses[r["quantity"]]["limit"]
+        value, why = points.value_of(r["quantity"], checks[fmt_h(r["h"])].out)
         if value is None:
             r["why"] = f"the check run gave no value: {why}"
             continue
         r["achieved_value"] = value
-        r["achieved"] = abs(value - limit) / abs(limit) if limit != 0 else abs(value - limit)
+        r["achieved"] = deviation(value, analyses[r["quantity"]]["limit"])
         r["met"] = r["achieved"] <= r["target"]
     return rows
 
 
 # ---------------------------------------------------------------- outputs
-
-def num(x, fmt=".6g"):
-    return "-" if x is None else format(x, fmt)
-
 
 def write_outputs(folder, scene, key, hs, quantities, values, analyses, costs, advice, args, out, limit=None):
     lines = ["\t".join(TSV_COLUMNS)]
@@ -373,7 +345,7 @@ def write_outputs(folder, scene, key, hs, quantities, values, analyses, costs, a
           + ", ".join(f"{h:.6g}" for h in hs) + f" (factor {args.factor:g}).", "",
           "Verdict thresholds: a pairwise order <= "
           f"{P_MIN:g} is not converging; pairwise orders spread by more than {ORDER_AGREE:g} are not yet "
-          f"asymptotic; advice aims at the target / {ADVICE_MARGIN:g} (harness/study.py).", "", "```", text, "```", ""]
+          f"asymptotic; advice aims at the target / {ADVICE_MARGIN:g} (harness/error_cost.py).", "", "```", text, "```", ""]
     if figure:
         md += [f"![error against {key}]({figure})", ""]
     md += ["Files: study.tsv (every level), " + ("advice.tsv (the advice and its check), " if advice else "")
@@ -391,8 +363,7 @@ def terminal_table(key, hs, quantities, values, analyses, costs, advice):
         rows.append(["", "  error vs q*"] + [num(e, ".2e") for e in a["errors"]] + [""])
     rows.append(["(particle-steps)", ""] + [num(c.get("particle_steps"), "g") for c in costs] + [""])
     rows.append(["(wall s)", ""] + [num(c.get("wall_seconds"), ".3g") for c in costs] + [""])
-    widths = [max(len(r[j]) for r in rows) for j in range(len(rows[0]))]
-    lines = ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
+    lines = aligned(rows)
     lines.append("")
     for expr in quantities:
         lines.append(f"{expr}: {analyses[expr]['text']}")
@@ -413,30 +384,9 @@ def terminal_table(key, hs, quantities, values, analyses, costs, advice):
 
 def draw(folder, key, hs, quantities, analyses):
     """error.svg: each converging quantity's error against q*, log-log; None if gnuplot fails."""
-    curves = [(e, analyses[e]) for e in quantities if analyses[e]["verdict"] == "converging"]
-    curves = [(e, a) for e, a in curves if all(x and x > 0 for x in a["errors"])]
-    if not curves:
-        return None
-    data = []
-    for i, (expr, a) in enumerate(curves):
-        data.append(f"# {expr}")
-        data += [f"{h!r} {err!r}" for h, err in zip(hs, a["errors"])]
-        data += ["", ""]
-    files.write_text(folder / "error.dat", "\n".join(data) + "\n")
-    style = Path(__file__).resolve().parent / "gnuplot" / "style.gp"
-    esc = lambda s: s.replace("\\", "\\\\").replace('"', '\\"')
-    plots = ", ".join(f'"error.dat" index {i} using 1:2 with linespoints title "{esc(e)}"'
-                      for i, (e, _) in enumerate(curves))
-    gp = [f'load "{esc(str(style))}"', "set terminal svg size 800,500", 'set output "error.svg"',
-          "set logscale xy", f'set xlabel "{esc(key)}"', 'set ylabel "|q - q*| / |q*|"',
-          "set key inside left top", f"plot {plots}"]
-    files.write_text(folder / "error.gp", "\n".join(gp) + "\n")
-    try:
-        done = subprocess.run(["gnuplot", "error.gp"], cwd=folder, capture_output=True, timeout=GNUPLOT_TIMEOUT,
-                              stdin=subprocess.DEVNULL)
-    except (OSError, subprocess.TimeoutExpired):
-        return None
-    return "error.svg" if done.returncode == 0 and (folder / "error.svg").is_file() else None
+    curves = [(e, analyses[e]) for e in quantities if analyses[e]["verdict"] in ("converging", "bounded")]
+    curves = [(e, list(zip(hs, a["errors"]))) for e, a in curves if all(x and x > 0 for x in a["errors"])]
+    return plot(folder, "error", curves, key, "|q - q*| / |q*|", "left top")
 
 
 # ---------------------------------------------------------------- sweeps (--set)
@@ -453,42 +403,18 @@ def sweep_study(args, scene, reports_root, out):
         raise CatalogueError(f"{', '.join(given)}: options of the refinement; --set runs the grid of its points "
                              "instead (run the refinement as a separate study)")
     keyed = sweep_grid.parse_sets(args.set)
-    swept = sweep_grid.swept_keys(keyed)
-    extra = time_keeping(args.bin, scene, DT_KEYS[0]) if any(k in DT_KEYS for k in swept) else []
     folder = study_folder(reports_root, scene, args.out, args.resume)
-    points = sweep_grid.grid(keyed)
-    jobs = [Job("study", label, scene, list(extra) + sets, folder / "points" / f"P{i + 1}", probe=bool(extra))
-            for i, (label, sets) in enumerate(points)]
-    core_info.refuse_bad_points(args.bin, [(j.variant, j.scene, j.sets, swept) for j in jobs])   # before any run
-    files.make_dirs(folder)
-    print(f"study of {scene}: {len(jobs)} point(s) of {' x '.join(a for a, _ in keyed)} -> {folder}", file=out)
-    if extra:
-        print(f"sweeping the step: every run keeps the stages' simulated time ({' '.join(extra)})", file=out)
-    outcomes = run_all(jobs, args.bin, args.jobs, out, resume=args.resume)
-    if any(o.io_error for o in outcomes):
-        raise OSError(f"cannot record the runs: {next(o.io_error for o in outcomes if o.io_error)}")
-    quantities = list(args.quantity or []) or default_quantities(jobs[0].out)
-    costs = [run_cost(j.out) for j in jobs]
-    values = {expr: [value_of(expr, j.out)[0] for j in jobs] for expr in quantities}
-    point_values = [[values_of_axis(axis, sets) for axis, _ in keyed] for _, sets in points]
-    refs = reference_points(point_values, costs, values, quantities)
-    errors = {expr: [None if refs[i] is None or v is None else relative(v, values[expr][refs[i]])
-                     for i, v in enumerate(values[expr])] for expr in quantities}
-    text = sweep_table(keyed, point_values, quantities, values, errors, costs, refs)
+    jobs, extra = sweep_grid.plan(args.bin, scene, [], keyed, lambda i, _: folder / "points" / f"P{i + 1}")
+    outcomes, quantities = run_points(args, scene, folder, jobs, extra,
+                                      f"{len(jobs)} point(s) of {' x '.join(a for a, _ in keyed)}", "sweeping", out)
+    measured = sweep_grid.measure(keyed, jobs, quantities)
+    text = sweep_grid.points_table(measured)
     limit = stability_limit(args, scene, folder, out) if getattr(args, "stability", False) else None
     if limit:
         text += "\n" + limit
     print(text, file=out)
-    lines = ["\t".join(SWEEP_TSV_COLUMNS)]
-    for i, job_ in enumerate(jobs):
-        for expr in quantities:
-            c = costs[i]
-            lines.append("\t".join([f"P{i + 1}", " ".join(points[i][1]), str(c.get("status")),
-                                    num(c.get("steps"), "g"), num(c.get("particle_steps"), "g"),
-                                    num(c.get("wall_seconds"), ".4g"), expr, num(values[expr][i], ".17g"),
-                                    "-" if refs[i] is None else f"P{refs[i] + 1}", num(errors[expr][i], ".6g")]))
-    files.write_text(folder / "sweep.tsv", "\n".join(lines) + "\n")
-    figure = draw_cost(folder, quantities, errors, costs, refs)
+    sweep_grid.write_points_tsv(folder / "sweep.tsv", measured)
+    figure = sweep_grid.draw(folder, "error_cost", sweep_grid.point_curves(measured), "|q - q_ref| / |q_ref|")
     md = [f"# Study of {scene.name}", "", f"Scene: `{scene}`.", "", "## Sweep", "",
           "Points: " + " x ".join(f"`{a}` = {', '.join(v)}" for a, v in keyed) + " (a coupled axis `K1,K2` sets "
           "both keys to each value). Error: |q - q_ref| / |q_ref| against the reference point: the point "
@@ -500,89 +426,3 @@ def sweep_study(args, scene, reports_root, out):
     print(f"wrote {folder / 'sweep.tsv'}, {folder / 'study.md'}" + (f", {folder / figure}" if figure else ""),
           file=out)
     return 0 if all(o.ok for o in outcomes) else 1
-
-
-def values_of_axis(axis, sets):
-    """The value of an axis at a point (the coupled keys share it)."""
-    key = sweep_grid.axis_keys(axis)[0]
-    return next(s.split("=", 1)[1] for s in sets if s.split("=", 1)[0] == key)
-
-
-def relative(v, ref):
-    return abs(v - ref) / abs(ref) if ref != 0 else abs(v - ref)
-
-
-def reference_points(point_values, costs, values, quantities):
-    """Each point's reference: among the points with its values on every axis but the last (the
-    whole sweep for one axis), the one of highest particle-steps with every quantity measured
-    (the last such point on a tie); None where there is none.  The last axis is the one whose
-    values a point's error is measured along: put the resolution key (the step, 1/kn) last."""
-    ok = [i for i, c in enumerate(costs) if isinstance(c.get("particle_steps"), int)
-          and all(values[e][i] is not None for e in quantities)]
-    refs = []
-    for pv in point_values:
-        group = [i for i in ok if point_values[i][:-1] == pv[:-1]]
-        refs.append(max(group, key=lambda i: (costs[i]["particle_steps"], i)) if group else None)
-    return refs
-
-
-def short_axis(axis, axes):
-    """An axis's column header: each key's last part ('settings.dt' -> 'dt'; coupled keys with
-    one last part share it), the whole axis when two axes would get the same header."""
-    def short(a):
-        tails = list(dict.fromkeys(k.rsplit(".", 1)[-1] for k in sweep_grid.axis_keys(a)))
-        return ",".join(tails)
-    return short(axis) if [short(a) for a in axes].count(short(axis)) == 1 else axis
-
-
-def sweep_table(keyed, point_values, quantities, values, errors, costs, refs):
-    """One row per point: its values on each axis, each quantity's value (its error against its
-    reference point in brackets) and the point's cost; the axes and quantities named below."""
-    axes = [a for a, _ in keyed]
-    names = [e if len(e) <= SHORT_HEADER else f"q{i + 1}" for i, e in enumerate(quantities)]
-    rows = [["point"] + [short_axis(a, axes) for a in axes] + names + ["status", "particle-steps", "wall s", "ref"]]
-    for i, pv in enumerate(point_values):
-        cells = [f"{num(values[e][i], '.8g')} ({num(errors[e][i], '.1e')})" if refs[i] != i
-                 else f"{num(values[e][i], '.8g')} (ref)" for e in quantities]
-        ref = "-" if refs[i] is None else f"P{refs[i] + 1}"
-        rows.append([f"P{i + 1}"] + pv + cells + [str(costs[i].get("status")), num(costs[i].get("particle_steps"), "g"),
-                                                  num(costs[i].get("wall_seconds"), ".3g"), ref])
-    widths = [max(len(r[j]) for r in rows) for j in range(len(rows[0]))]
-    lines = ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
-    lines.append("")
-    lines += [f"{short_axis(a, axes)} = {a}" for a in axes if short_axis(a, axes) != a]
-    lines += [f"{n} = {e}" for n, e in zip(names, quantities) if n != e]
-    lines.append("(error) = |q - q_ref| / |q_ref|, q_ref at the point's ref: the point of highest cost "
-                 "(particle-steps) with the same values on every axis but the last")
-    return "\n".join(lines)
-
-
-def draw_cost(folder, quantities, errors, costs, refs):
-    """error_cost.svg: each quantity's error against the reference point by particle-steps,
-    log-log (points with a zero or missing error left out); None if gnuplot fails."""
-    curves = []
-    for expr in quantities:
-        pts = [(costs[i]["particle_steps"], e) for i, e in enumerate(errors[expr])
-               if refs[i] != i and e and e > 0 and isinstance(costs[i].get("particle_steps"), int)]
-        if pts:
-            curves.append((expr, sorted(pts)))
-    if not curves:
-        return None
-    data = []
-    for expr, pts in curves:
-        data += [f"# {expr}"] + [f"{c!r} {e!r}" for c, e in pts] + ["", ""]
-    files.write_text(folder / "error_cost.dat", "\n".join(data) + "\n")
-    style = Path(__file__).resolve().parent / "gnuplot" / "style.gp"
-    esc = lambda s: s.replace("\\", "\\\\").replace('"', '\\"')
-    plots = ", ".join(f'"error_cost.dat" index {i} using 1:2 with linespoints title "{esc(e)}"'
-                      for i, (e, _) in enumerate(curves))
-    gp = [f'load "{esc(str(style))}"', "set terminal svg size 800,500", 'set output "error_cost.svg"',
-          "set logscale xy", 'set xlabel "particle-steps"', 'set ylabel "|q - q_ref| / |q_ref|"',
-          "set key inside right top", f"plot {plots}"]
-    files.write_text(folder / "error_cost.gp", "\n".join(gp) + "\n")
-    try:
-        done = subprocess.run(["gnuplot", "error_cost.gp"], cwd=folder, capture_output=True,
-                              timeout=GNUPLOT_TIMEOUT, stdin=subprocess.DEVNULL)
-    except (OSError, subprocess.TimeoutExpired):
-        return None
-    return "error_cost.svg" if done.returncode == 0 and (folder / "error_cost.svg").is_file() else None

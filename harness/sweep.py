@@ -27,21 +27,29 @@ The error of a run (one number, documented in docs/error-against-cost.md) is the
     Interval and trend checks have no point reference and never count; nor do regressions.
   * each `error =` expression: |value|.
   * each `converge =` expression q (a scalar of the run): |q - q_f| / |q_f| (|q - q_f| when
-    q_f = 0), where q_f is the same quantity of the FINEST point of the same sweep, i.e. the
-    ok point of the most particle-steps.  This is self-convergence: an error against the
-    finest swept run, not against a reference; it is meaningful only for sweeps whose most
-    expensive run is the most accurate (dt, stop tolerances).  The finest point itself has
-    no such term (its note says so).
+    q_f = 0), where q_f is the same quantity of the FINEST point of the same sweep
+    (error_cost.finest_index, as `harness study --set` picks its reference point: status ok,
+    every converge quantity measured, the most particle-steps, the last on a tie).  This is
+    self-convergence: an error against the finest swept run, not against a reference; it is
+    meaningful only for sweeps whose most expensive run is the most accurate (dt, stop
+    tolerances).  The finest point itself has no such term (its note says so).
 
 Cost is particle-steps = steps x n_discs from run.json (wall-clock seconds are recorded too).
+
+This module is the catalogue's layer: which points a [sweep] declares, its error terms from the
+references, cost.tsv and the cheapest setting per tolerance.  The points' jobs, their launch
+(`run_declared` is given points.launch), their cost (points.run_cost), the relative deviation
+and the finest point (error_cost.py) are the machinery `harness study` and `harness sweep CASE`
+run through as well; the report (harness/report/cost_plot.py) draws cost.tsv.
 """
 import json
 from pathlib import Path
 
 from . import core_info, files
 from .compare import RunStore, quantity_in
+from .error_cost import deviation, finest_index
 from .errors import EvalError, IniError, RunProblem
-from .runner import Job
+from .points import FORCE, jobs as point_jobs, run_cost
 from .sweep_spec import number
 from .tables import load_run, read_run_json
 
@@ -132,11 +140,6 @@ class _Recording(RunStore):
         return found
 
 
-def deviation(q, ref):
-    """|q - ref| / |ref|, or |q - ref| when ref = 0."""
-    return abs(q - ref) / abs(ref) if ref != 0 else abs(q - ref)
-
-
 def term_errors(case, variant, folder, runs_root, terms, errors, loaded=None):
     """{term name: error or an EvalError/RunProblem message (str)}, and {term: DEM siblings it read}."""
     out, siblings, loaded = {}, {}, {} if loaded is None else loaded
@@ -192,12 +195,6 @@ def converge_terms(values, finest):
     return out
 
 
-def finest_index(costs):
-    """The index of the finest point: status ok and the most particle-steps (None if none is ok)."""
-    ok = [i for i, c in enumerate(costs) if c["status"] == "ok" and c["particle_steps"] is not None]
-    return max(ok, key=lambda i: costs[i]["particle_steps"]) if ok else None
-
-
 def _dem(case, variants):
     return sorted(v for v in variants if case.variant(v) is None or case.variant(v).command != "exact")
 
@@ -215,39 +212,18 @@ def run_error(by_term, dropped=()):
     return kept[worst], worst, ""
 
 
-def run_cost(folder):
-    """{status, steps, n_discs, particle_steps, wall_seconds} from run.json (None where absent),
-    and 'unsettled': the stages that have a stop rule but ran to their cycle limit."""
-    try:
-        info = read_run_json(folder)
-    except RunProblem as problem:
-        return {"status": f"no run.json ({problem})", "steps": None, "n_discs": None,
-                "particle_steps": None, "wall_seconds": None, "unsettled": []}
-    steps, n = info.get("steps"), info.get("n_discs")
-    unsettled = [st.get("name", "?") for st in info.get("stages", []) or []
-                 if isinstance(st, dict) and st.get("stop_rule") and not st.get("stopped")]
-    return {"status": info.get("status", "?"), "steps": steps, "n_discs": n,
-            "particle_steps": steps * n if isinstance(steps, int) and isinstance(n, int) else None,
-            "wall_seconds": info.get("wall_seconds"), "unsettled": unsettled}
-
-
 # ---------------------------------------------------------------- running and tabulating
 
-FORCE = ["settings.force_dt=1"]
-
-
 def jobs(case, sweeps_root):
-    """One runner Job per declared point of the case."""
+    """One runner Job per declared point of the case (points.jobs), after the variant's overrides.
+    force_dt: a point past the stability estimate is part of the trade to measure (ballast refuses
+    such a step otherwise); it runs, and the guards say if it is unstable (probe)."""
     out = []
     for sweep in case.sweeps:
         variant = case.variant(sweep.variant)
-        for f in sweep.run_factors():
-            label = sweep.label(f)
-            # force_dt: a point past the stability estimate is part of the trade to measure
-            # (ballast refuses such a step otherwise); it runs, and the guards say if it is unstable
-            out.append(Job(case.name, label, variant.scene, list(variant.sets) + sweep.sets(f) + FORCE,
-                           Path(sweeps_root) / case.name / label, case.runtime / max(len(case.variants), 1),
-                           variant.command, probe=True))
+        out += point_jobs([(sweep.label(f), sweep.sets(f) + [FORCE], Path(sweeps_root) / case.name / sweep.label(f))
+                            for f in sweep.run_factors()], variant.scene, variant.sets, owner=case.name,
+                           expected=case.runtime / max(len(case.variants), 1), command=variant.command, probe=True)
     return out
 
 
@@ -275,9 +251,9 @@ def points(case, checks, runs_root, sweeps_root):
         dropped = sorted({t for *_, sib in evaluated for t, read in sib.items() if read})
         finest, values = None, []
         if sweep.converge:
-            finest = finest_index(costs)
             values = [converge_values(case, sweep.variant, folder, runs_root, sweep.converge, loaded)
                       for _, folder, _ in pts]
+            finest = finest_index(costs, usable=lambda i: not any(isinstance(v, str) for v in values[i].values()))
         for i, ((f, folder, sets, by_term, _), cost) in enumerate(zip(evaluated, costs)):
             unsettled = cost.pop("unsettled")
             notes = []
@@ -285,7 +261,7 @@ def points(case, checks, runs_root, sweeps_root):
                 if i == finest:
                     notes.append("the finest run: the reference of the self-convergence error")
                 elif finest is None:
-                    by_term = {**by_term, CONVERGE + "*": "no ok point to converge to"}
+                    by_term = {**by_term, CONVERGE + "*": "no ok point with every quantity measured to converge to"}
                 else:
                     by_term = {**by_term, **converge_terms(values[i], values[finest])}
             if cost["status"] != "ok":
@@ -381,8 +357,9 @@ def cost_path(sweeps_root, case_name):
 
 
 def run_declared(cases, checks, binary, workers, runs_root, sweeps_root, out, run_all):
-    """Run every declared point of the cases (one parallel batch), write each case's cost.tsv;
-    print the cheapest setting per tolerance.  The list of (case, rows)."""
+    """Run every declared point of the cases (one parallel batch, by run_all: points.launch with
+    the command's --resume), write each case's cost.tsv; print the cheapest setting per
+    tolerance.  The list of (case, rows)."""
     swept = [c for c in cases if c.sweeps]
     for case in cases:
         if not case.sweeps:

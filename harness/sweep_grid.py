@@ -1,47 +1,53 @@
-"""`harness sweep CASE --set KEY=V1,V2 [--set KEY2=W1,W2 ...]`: one variant run at every point
-of a grid of overrides, and a table of its checks with their error and the cost of each point.
-`harness study SCENE --set ...` runs the same grid on a bare scene (study.py).
+"""A sweep over a grid of --set points: `harness study SCENE --set ...` (study.py) on a bare
+scene, and `harness sweep CASE --set ...` on one variant of a catalogue case, which adds the
+case's checks.  Both run the grid through the same code (points.py: the jobs, the time keeping,
+the launcher, the cost; error_cost.py: the errors, the table, the figure).
 
 Several --set options combine as a GRID (every value of the first key with every value of the
 second, ...; the first key varies slowest).  One option may COUPLE keys, --set K1,K2=V1,V2: one
 axis on which both keys take each value together (a pair of materials uses the smaller δ of the
-two, so a grain's and a wall's δ must move together); its point label is 'K1=V1,K2=V1'.  A key given twice is refused, as are a value with
-'/' and a key with '/' or '..' (they name the point's folder).  A point's label is 'KEY=V' for
-one key and 'KEY=V,KEY2=W' for several; its outputs go to reports/sweeps/<case>/<label>.
+two, so a grain's and a wall's δ must move together); its point label is 'K1=V1,K2=V1'.  A key
+given twice is refused, as are a value with '/' and a key with '/' or '..' (they name the
+point's folder).  A point's label is 'KEY=V' for one key and 'KEY=V,KEY2=W' for several; a
+case's point runs in reports/sweeps/<case>/<label>, a study's in <study>/points/P<n>.
 
 Before any run, `ballast info` reads every point with all its overrides: a key the core does
 not know or a value out of its range is refused (exit 2) with the core's message, and so is a
 grid that sweeps a key which another key's value makes unused at some point (settings.dt > 0
 makes settings.dt_fraction unused; `ballast info` lists such keys, from the core's table in
-core/scene_keys.c): its values would all give the same run.
+core/scene_keys.c): its values would all give the same run.  A grid over the time step keeps
+each stage's simulated time and sets settings.force_dt = 1 (points.time_keeping).
 
-A sweep over the time step (settings.dt or settings.dt_fraction) keeps the SIMULATED time of
-every stage fixed: `ballast info` of the unswept variant gives each stage's cycles and dt, and
-every point runs each stage given in cycles as `stage.NAME.time = cycles x dt` (a stage given
-in time already keeps it).  Without this a smaller step would cover a fraction of the time and
-nearly every check would fail for that reason alone.  Such a sweep also sets
-settings.force_dt = 1, as the declared error-against-cost sweeps do: a step past the stability
-estimate is a point to measure, and the run-time guards say whether it went unstable.
+The quantities of a grid (a study's --quantity, or `harness sweep CASE --quantity`): each
+point's value and its error |q - q_ref| / |q_ref| against its reference point, the finest
+point with the same values on every axis but the last (error_cost.reference_points); a table
+of one row per point (points_table), a TSV of one row per point and quantity (write_points_tsv)
+and a figure of each quantity's error against particle-steps (draw).
 
-The table has one row per check that reads the variant alone, one column per point: the value,
-its verdict and its error against the reference (|q - ref|/|ref|, |q - ref| when ref = 0; '-'
-for an interval, a trend or a value that could not be computed), and below them each point's
-cost: its status, steps, particle-steps and wall-clock seconds (run.json).  The same numbers go
-to reports/sweeps/<case>/sweep_<variant>.tsv, one row per point and check.
+The checks of `harness sweep CASE` (those that read the variant alone): one row per check, one
+column per point -- the value, its verdict and its error against the reference (|q - ref|/|ref|,
+|q - ref| when ref = 0; '-' for an interval, a trend or a value that could not be computed) --
+and below them each point's cost: its status, steps, particle-steps and wall-clock seconds
+(run.json).  The same numbers go to reports/sweeps/<case>/sweep_<variant>.tsv, one row per
+point and check, and the checks' errors against particle-steps to sweep_<variant>.svg.
 """
 import itertools
+from dataclasses import dataclass
 
-from . import core_info, files
+from . import files, points
 from .compare import RunStore, evaluate_all
+from .error_cost import aligned, cost_curves, deviation, num, plot, reference_points
 from .errors import CatalogueError
 from .gate import fmt_number, fmt_reference
-from .runner import Job
-from .sweep import deviation, run_cost
 
-DT_KEYS = ("settings.dt", "settings.dt_fraction")
-FORCE = "settings.force_dt=1"
 TSV_COLUMNS = ("point", "sets", "status", "steps", "particle_steps", "wall_seconds", "check", "value",
                "reference", "error", "result")
+POINTS_TSV_COLUMNS = ("point", "sets", "status", "steps", "particle_steps", "wall_seconds", "quantity", "value",
+                      "reference_point", "error")
+# A quantity's column in the printed table is headed by its expression up to this length, else
+# by q1, q2, ... with the expressions listed below the table.
+SHORT_HEADER = 20
+COST_AXIS = "particle-steps"
 
 
 def parse_sets(texts):
@@ -85,42 +91,117 @@ def grid(keyed):
     """[(label, [KEY=V, ...])] of every combination, the first axis varying slowest; a coupled
     axis sets each of its keys to the same value ('K1=V,K2=V' in the label)."""
     axes = [[[f"{k}={v}" for k in axis_keys(axis)] for v in values] for axis, values in keyed]
-    points = []
+    out = []
     for combo in itertools.product(*axes):
         sets = [s for part in combo for s in part]
-        points.append((",".join(sets), sets))
-    return points
+        out.append((",".join(sets), sets))
+    return out
 
 
-def stages_of(binary, scene, sets):
-    """(dt, [(stage, cycles, seconds, given_in)]) from `ballast info` of the scene (core_info.py)."""
-    got = core_info.query(binary, scene, sets)
-    return got["dt"], got["stages"]
+def axis_value(axis, sets):
+    """The value of an axis at a point (the coupled keys share it)."""
+    key = axis_keys(axis)[0]
+    return next(s.split("=", 1)[1] for s in sets if s.split("=", 1)[0] == key)
 
 
-def time_keeping(binary, variant):
-    """The overrides that keep each stage's simulated time while dt is swept."""
-    dt, stages = stages_of(binary, variant.scene, variant.sets)
-    return [f"stage.{name}.time={repr(cycles * dt)}" for name, cycles, _, given in stages
-            if given == "cycles" and cycles > 0] + [FORCE]
+def short_axis(axis, axes):
+    """An axis's column header: each key's last part ('settings.dt' -> 'dt'; coupled keys with
+    one last part share it), the whole axis when two axes would get the same header."""
+    def short(a):
+        tails = list(dict.fromkeys(k.rsplit(".", 1)[-1] for k in axis_keys(a)))
+        return ",".join(tails)
+    return short(axis) if [short(a) for a in axes].count(short(axis)) == 1 else axis
 
 
-def jobs(case, variant, keyed, sweeps_root, binary):
-    """One runner Job per grid point (with the time-keeping overrides of a dt sweep)."""
-    extra = time_keeping(binary, variant) if any(k in DT_KEYS for k in swept_keys(keyed)) else []
-    return [Job(case.name, label, variant.scene, list(variant.sets) + extra + sets,
-                sweeps_root / case.name / label, case.runtime / max(len(case.variants), 1), variant.command,
-                probe=bool(extra))
-            for label, sets in grid(keyed)], extra
+# ---------------------------------------------------------------- the grid's points, run
 
-
-def refuse_bad_points(jobs_, keyed, binary):
-    """Before any run: every point as the core reads it, with all its overrides (the variant's,
-    the time-keeping ones, the point's); exit 2 for an unknown key, a value out of range or a
-    swept key that another key makes unused at some point (core_info.refuse_bad_points)."""
+def plan(binary, scene, base, keyed, folder_of, **job):
+    """(jobs, extra): one runner Job per grid point, run with base (a variant's overrides), the
+    time keeping of a grid over the step (extra) and the point's sets, in folder_of(i, label);
+    job: the Job's owner, expected seconds and command (points.jobs).  Every point is read by
+    the core before any runs (points.refuse)."""
     swept = swept_keys(keyed)
-    core_info.refuse_bad_points(binary, [(job.variant, job.scene, job.sets, swept) for job in jobs_])
+    extra = points.time_keeping(binary, scene, base, swept)
+    jobs = points.jobs([(label, sets, folder_of(i, label)) for i, (label, sets) in enumerate(grid(keyed))],
+                       scene, base, extra, **job)
+    points.refuse(binary, jobs, swept)
+    return jobs, extra
 
+
+@dataclass
+class Measured:
+    """A grid's points after their runs: per point (in grid order) its own sets, cost, values
+    on the axes and reference point; per quantity its values and errors."""
+    keyed: list
+    sets: list          # [[KEY=V, ...]] of each point (without the base and time-keeping overrides)
+    quantities: list
+    costs: list
+    values: dict        # {expr: [value or None]}
+    point_values: list  # [[the value of each axis]]
+    refs: list          # [index of the reference point, or None]
+    errors: dict        # {expr: [|q - q_ref| / |q_ref| or None]}
+
+
+def measure(keyed, jobs, quantities):
+    """Each point's cost and quantities, its reference point and each quantity's error."""
+    costs, values, _ = points.measure(jobs, quantities)
+    sets = [s for _, s in grid(keyed)]
+    point_values = [[axis_value(axis, s) for axis, _ in keyed] for s in sets]
+    refs = reference_points(point_values, costs, lambda i: all(values[e][i] is not None for e in quantities))
+    errors = {e: [None if refs[i] is None or v is None else deviation(v, values[e][refs[i]])
+                  for i, v in enumerate(values[e])] for e in quantities}
+    return Measured(keyed, sets, quantities, costs, values, point_values, refs, errors)
+
+
+def points_table(m):
+    """One row per point: its values on each axis, each quantity's value (its error against its
+    reference point in brackets) and the point's cost; the axes and quantities named below."""
+    axes = [a for a, _ in m.keyed]
+    names = [e if len(e) <= SHORT_HEADER else f"q{i + 1}" for i, e in enumerate(m.quantities)]
+    rows = [["point"] + [short_axis(a, axes) for a in axes] + names + ["status", "particle-steps", "wall s", "ref"]]
+    for i, pv in enumerate(m.point_values):
+        cells = [f"{num(m.values[e][i], '.8g')} ({num(m.errors[e][i], '.1e')})" if m.refs[i] != i
+                 else f"{num(m.values[e][i], '.8g')} (ref)" for e in m.quantities]
+        ref = "-" if m.refs[i] is None else f"P{m.refs[i] + 1}"
+        cost = m.costs[i]
+        rows.append([f"P{i + 1}"] + pv + cells + [str(cost.get("status")), num(cost.get("particle_steps"), "g"),
+                                                  num(cost.get("wall_seconds"), ".3g"), ref])
+    lines = aligned(rows)
+    lines.append("")
+    lines += [f"{short_axis(a, axes)} = {a}" for a in axes if short_axis(a, axes) != a]
+    lines += [f"{n} = {e}" for n, e in zip(names, m.quantities) if n != e]
+    lines.append("(error) = |q - q_ref| / |q_ref|, q_ref at the point's ref: the point of highest cost "
+                 "(particle-steps) with the same values on every axis but the last")
+    return "\n".join(lines)
+
+
+def write_points_tsv(path, m):
+    """One row per point and quantity (POINTS_TSV_COLUMNS)."""
+    lines = ["\t".join(POINTS_TSV_COLUMNS)]
+    for i, cost in enumerate(m.costs):
+        for expr in m.quantities:
+            lines.append("\t".join([f"P{i + 1}", " ".join(m.sets[i]), str(cost.get("status")),
+                                    num(cost.get("steps"), "g"), num(cost.get("particle_steps"), "g"),
+                                    num(cost.get("wall_seconds"), ".4g"), expr, num(m.values[expr][i], ".17g"),
+                                    "-" if m.refs[i] is None else f"P{m.refs[i] + 1}",
+                                    num(m.errors[expr][i], ".6g")]))
+    files.make_dirs(path.parent)
+    files.write_text(path, "\n".join(lines) + "\n")
+
+
+def point_curves(m, suffix=""):
+    """Each quantity's error against its reference point by particle-steps (the references left
+    out), titled by the expression and suffix."""
+    curves = cost_curves(m.quantities, m.errors, m.costs, skip=lambda i: m.refs[i] == i)
+    return [(name + suffix, pts) for name, pts in curves]
+
+
+def draw(folder, name, curves, ylabel):
+    """NAME.svg in folder: error against particle-steps, log-log (error_cost.plot)."""
+    return plot(folder, name, curves, COST_AXIS, ylabel, "right top")
+
+
+# ---------------------------------------------------------------- the checks of a case's sweep
 
 def error_of(v):
     """|q - ref| / |ref| of a verdict with a number for value and reference, else None."""
@@ -130,16 +211,16 @@ def error_of(v):
     return None
 
 
-def evaluate(checks, jobs_):
-    """{label: (verdicts, cost)} of every point."""
+def evaluate(checks, jobs, costs):
+    """{label: (verdicts, cost)} of every point, each run standing in for the variant."""
     out = {}
-    for job in jobs_:
+    for job, cost in zip(jobs, costs):
         store = RunStore(lambda c, v, folder=job.out: folder)
-        out[job.variant] = (evaluate_all(checks, store), run_cost(job.out))
+        out[job.variant] = (evaluate_all(checks, store), cost)
     return out
 
 
-def table(labels, checks, results):
+def checks_table(labels, checks, results):
     """The printed table: checks by points ('value VERDICT err E'), then the cost rows."""
     header = ["check", "reference", "tolerance"] + list(labels)
     rows = []
@@ -154,13 +235,19 @@ def table(labels, checks, results):
     for name, field in (("status", "status"), ("steps", "steps"), ("particle-steps", "particle_steps"),
                         ("wall s", "wall_seconds")):
         rows.append([f"({name})", "", ""] + [fmt_number(results[label][1].get(field)) for label in labels])
-    widths = [max(len(r[j]) for r in [header] + rows) for j in range(len(header))]
-    return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in [header] + rows)
+    return "\n".join(aligned([header] + rows))
 
 
-def write_tsv(path, jobs_, checks, results):
+def check_curves(labels, checks, results, costs):
+    """Each check's error against its reference by particle-steps (checks with no point error
+    left out)."""
+    errors = {c.name: [error_of(results[label][0][i]) for label in labels] for i, c in enumerate(checks)}
+    return cost_curves([c.name for c in checks], errors, costs)
+
+
+def write_checks_tsv(path, jobs, checks, results):
     lines = ["\t".join(TSV_COLUMNS)]
-    for job in jobs_:
+    for job in jobs:
         verdicts, cost = results[job.variant]
         for check, v in zip(checks, verdicts):
             err = error_of(v)

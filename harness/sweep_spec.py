@@ -17,7 +17,8 @@ A case declares its sweeps in case.txt, one [sweep NAME] section per swept param
     converge = max(Fn_C)                     # optional, repeatable: self-convergence (sweep.py)
 
 parse() reads one section into a Sweep (catalogue.py calls it for every [sweep]); what a
-sweep's points are run with and how their error is measured is sweep.py.
+sweep's points are run with and how their error is measured is sweep.py (on points.py and
+error_cost.py, the machinery `harness study` and `harness sweep CASE` share).
 """
 import math
 from dataclasses import dataclass, field

@@ -174,6 +174,7 @@ int main(void)
     srunner_add_suite(sr, suite_threads());
     srunner_add_suite(sr, suite_rolling());
     srunner_add_suite(sr, suite_specimen());
+    srunner_add_suite(sr, suite_snapshots());
     srunner_run_all(sr, CK_ENV); /* CK_VERBOSITY, default normal */
     const int failed = srunner_ntests_failed(sr);
     srunner_free(sr);

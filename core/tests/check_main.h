@@ -48,6 +48,7 @@ Suite *suite_energy(void);
 Suite *suite_threads(void);
 Suite *suite_rolling(void);
 Suite *suite_specimen(void);
+Suite *suite_snapshots(void);
 
 /* Room for the scene texts the tests format. */
 #define T_TEXT_MAX 8192

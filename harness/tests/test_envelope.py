@@ -65,6 +65,11 @@ def test_the_envelope_bounds_the_error_and_its_advice_meets_the_truth():
         assert h >= target * LIMIT / worst / 4
 
 
+def test_a_midpoint_without_a_value_is_no_evidence():
+    assert E.smooth([0.01, None, 0.02])
+    assert not E.smooth([0.01, None, 0.9])
+
+
 def test_too_few_points_give_no_envelope_and_say_what_to_add():
     hs = levels(2 ** -11, 4)
     pts = hs + E.midpoints(hs, 0.5)

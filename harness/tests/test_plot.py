@@ -83,29 +83,8 @@ def drop(tmp_path_factory):
     scene.write_text(SCENE)
     run = root / "run"
     run.mkdir()
-    if "snapshot_dt" in ballast("keys").stdout:
-        done = ballast("run", scene, "--out", run, "--set", f"settings.snapshot_dt={SNAPSHOT_DT}")
-        assert done.returncode == 0, done.stderr
-        return run
-    # TEMPORARY, until the core writes snapshots (branch snap32): the same frames, each the final
-    # state of a run stopped at that time, in the snapshot format
-    done = ballast("run", scene, "--out", run)
+    done = ballast("run", scene, "--out", run, "--set", f"settings.snapshot_dt={SNAPSHOT_DT}")
     assert done.returncode == 0, done.stderr
-    snaps = run / "snapshots"
-    snaps.mkdir()
-    rows = ["frame\tcycle\ttime\tstage"]
-    for k in range(7):
-        t = k * SNAPSHOT_DT
-        part = root / f"t{k}"
-        part.mkdir()
-        done = ballast("run", scene, "--out", part, "--set", f"stage.fall.time={min(t, 2)}",
-                       "--set", f"stage.rest.time={max(0, t - 2)}")
-        assert done.returncode == 0, done.stderr
-        for name in ("discs", "contacts", "walls"):
-            shutil.copy(part / f"{name}.tsv", snaps / f"{name}.{k:06d}.tsv")
-        steps = pictures.run_info(part)["steps"]
-        rows.append(f"{k}\t{steps}\t{t}\t{'fall' if t <= 2 else 'rest'}")
-    (snaps / "index.tsv").write_text("\n".join(rows) + "\n")
     return run
 
 

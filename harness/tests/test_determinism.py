@@ -4,7 +4,8 @@ Every variant of every case of the default tier (standard, as `make validate`) i
 with the real bin/ballast, into two roots: once with -j 1 in catalogue order, once with -j 2
 in a shuffled order (fixed seed), both passes at the same time, so runs of one pass share the
 machine with runs of the other.  Every output file must be equal byte for byte: series.tsv,
-discs.tsv, contacts.tsv, walls.tsv, stress*.tsv, ballast.stdout (the summary's wall time masked)/stderr, and run.json with
+discs.tsv, contacts.tsv, walls.tsv, stress*.tsv, the snapshots (snapshots/, where a variant writes them),
+ballast.stdout (the summary's wall time masked)/stderr, and run.json with
 its wall-clock fields (wall_seconds, timers, particle_steps_per_s) masked (the exact solver
 writes its solve time there too, not in series.tsv).  Of an [ensemble] only the first
 REALISATIONS realisations are run: the others are the same scene with another seed (the
@@ -39,10 +40,10 @@ def jobs_kept(cases, root):
 
 
 def outputs(job):
-    """{file: bytes} of a job's folder; run.json without its wall-clock fields; not harness.json
-    (the runner's record: paths and wall time)."""
+    """{file: bytes} of a job's folder, its sub-folders too (snapshots/); run.json without its
+    wall-clock fields; not harness.json (the runner's record: paths and wall time)."""
     out = {}
-    for path in sorted(Path(job.out).iterdir()):
+    for path in sorted(p for p in Path(job.out).rglob("*") if p.is_file()):
         if path.name == "harness.json":
             continue
         data = path.read_bytes()
@@ -50,7 +51,7 @@ def outputs(job):
             data = without_wall_clock(data)
         elif path.name == "ballast.stdout":
             data = without_summary_clock(data)
-        out[path.name] = data
+        out[str(path.relative_to(job.out))] = data
     return out
 
 

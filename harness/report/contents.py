@@ -11,7 +11,7 @@ from pathlib import Path
 from .. import files, sweep
 from ..compare import evaluate_all
 from ..errors import RunProblem
-from ..gate import read_summary
+from ..gate import known, read_summary, skipped, tally
 from ..references import reference_lines
 from ..stability import read_tsv
 from ..tables import read_harness_record, read_run_json
@@ -27,6 +27,22 @@ class CaseReport:
     verdicts: list
     verdict_source: str
     cost: object = None          # CostOut: the error-against-cost section (below)
+
+
+def case_counts(r):
+    """A case's counts for the table of cases: runs, runs ok, passed, failed, KNOWN, skipped."""
+    passed, failed = tally(r.verdicts)
+    return {"runs": len(r.runs), "runs_ok": sum(x["status"] == "ok" for x in r.runs), "passed": passed,
+            "failed": failed, "known": known(r.verdicts), "skipped": skipped(r.verdicts)}
+
+
+def skip_groups(verdicts):
+    """{(case, message): [check names]} of the skipped checks, as the gate table groups them."""
+    groups = {}
+    for v in verdicts:
+        if v.skipped:
+            groups.setdefault((v.case, v.message), []).append(v.check)
+    return groups
 
 
 # ---------------------------------------------------------------- runs
@@ -182,8 +198,8 @@ STABILITY_LIMIT_HEADERS = [("case", "case"), ("variant", "variant"), ("estimate"
 STABILITY_EXTREME_HEADERS = [("group", "group"), ("probe", "probe"), ("what", "what"), ("expect", "expect"),
                              ("exit", "exit"), ("steps", "steps"), ("e_out_over_in", "E_out/E_in"),
                              ("overlap_max", "overlap/r"), ("outcome", "outcome"), ("as_expected", "as expected")]
-STABILITY_NOTE = ("Written by `python3 -m harness stability` (not by validate: it bisects every DEM variant, "
-                  "about 10 runs each). *limit / bound* is the largest stable dt over ballast's estimate (the "
+STABILITY_NOTE = ("Written by `harness stability` (every DEM variant, about 10 runs each) and by validate (the "
+                  "first DEM variant of each case). *limit / bound* is the largest stable dt over ballast's estimate (the "
                   "contact-network bound of core/timestep.c); a safe and tight estimate has it in [1, 1.25]. "
                   "*old* is C&S's single-spring 2 sqrt(m/k). The criteria are in harness/stability.py.")
 EXTREMES_NOTE = ("Extreme probes (cases/extremes/extremes.txt): each row a scene pushed to a limit of the physics; "
@@ -200,3 +216,30 @@ def stability_tables(reports_dir):
         if path.exists():
             out.append((title, note, headers, read_tsv(path)))
     return out
+
+
+def stability_digest(reports_dir):
+    """A few sentences on reports/stability.tsv and extremes.tsv for the top of the report: how many
+    limits were measured and how many lie in their target, how many probes behaved as declared,
+    and which did not (none when neither file exists; the tables are on the stability page)."""
+    out = []
+    for title, _, _, rows in stability_tables(reports_dir):
+        if title == "Stability limits":
+            inside = [r for r in rows if r.get("in_target") == "yes"]
+            fractions = sorted(float(r["limit_fraction"]) for r in rows if _number(r.get("limit_fraction")))
+            spread = f", limit / bound from {fractions[0]:g} to {fractions[-1]:g}" if fractions else ""
+            outside = [f"{r.get('case', '')}/{r.get('variant', '')}" for r in rows if r not in inside]
+            out.append(f"Stability limits: {len(rows)} variant(s) bisected{spread}; {len(inside)} in [1, 1.25]"
+                       + (f"; outside: {', '.join(outside)}" if outside else "") + ".")
+        else:
+            odd = [f"{r.get('group', '')}/{r.get('probe', '')}" for r in rows if r.get("as_expected") != "yes"]
+            out.append(f"Extreme probes: {len(rows)}, {len(rows) - len(odd)} as declared, {len(odd)} finding(s)"
+                       + (f": {', '.join(odd)}" if odd else "") + " (measurements, not a gate).")
+    return out
+
+
+def _number(text):
+    try:
+        return float(text) == float(text)
+    except (TypeError, ValueError):
+        return False

@@ -24,7 +24,7 @@ from contextlib import nullcontext
 from pathlib import Path
 
 from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_root
-from . import catalogue, export, extremes, files, known, references, stability
+from . import catalogue, compact, export, extremes, files, known, references, stability
 from . import study as studies
 from . import families  # noqa: F401 -- registers every case family's expression functions
 from . import sweep as sweeps
@@ -151,7 +151,8 @@ def cmd_report(args):
 
 
 def cmd_validate(args):
-    """Run, check, cost, stability, report.  Without -v the terminal gets a line or two per phase
+    """Run, check, cost, stability, report, then compact what the report no longer needs
+    (compact.py; not with --keep-outputs).  Without -v the terminal gets a line or two per phase
     and every failure, KNOWN row and finding; the detail of the sweeps, the bisections and the
     probes goes to a Transient status line (console.py) and is in the report (issue 32, item 4)."""
     load_checks(load_cases())          # a broken reference file stops us before any run
@@ -175,6 +176,11 @@ def cmd_validate(args):
             # a measurement for the report: its failure is said, not fatal to the gate
             print(f"stability: not measured: {exc}")
     cmd_report(args)
+    if not args.keep_outputs:
+        # the report is written: what no check, figure, report or resume reads again goes (compact.py)
+        tally = compact.compact(selected(args, load_cases()), runs_root(), reports_root() / "sweeps")
+        print(f"kept {compact.disk(reports_root()) / 1e6:.0f} MB under {reports_root()}: {tally.text()} "
+              "(--keep-outputs keeps every file)")
     print(f"validate: {counts_text(verdicts)}; the report: {reports_root() / 'summary.md'}, "
           f"{reports_root() / 'index.html'}")
     return run_status or check_status
@@ -387,6 +393,10 @@ def parser():
                           help="run the extreme probes even when cases are named (a validate of all cases runs them)")
     validate.add_argument("--no-stability", action="store_true",
                           help="skip the stability limits (first variant of each case) and extreme probes")
+    validate.add_argument("--keep-outputs", action="store_true",
+                          help="keep every file the runs wrote (default: once the report is written, a series.tsv "
+                               "of 64 KiB or more is gzipped and the tables of ensemble realisations and sweep "
+                               "points are removed: harness/compact.py)")
     rebase = _command(sub, "rebaseline", cmd_rebaseline, "rewrite the regression values of CASE from its current outputs")
     rebase.add_argument("case", metavar="CASE")
     sweep = _command(sub, "sweep", cmd_sweep, "run one variant at every point of a grid of --set values and "

@@ -53,7 +53,8 @@ from pathlib import Path
 from . import files
 from .children import options as child_options
 from .errors import RunProblem, Stopped, WriteError
-from .tables import read_harness_record, read_run_json, run_failure, skip_reason, unfinished_outputs
+from .tables import (read_harness_record, read_run_json, removed_tables, run_failure, skip_reason,
+                     unfinished_outputs)
 
 STDERR_TAIL = 5
 STOP_GRACE = 10.0    # seconds a terminated run has to write run.json and exit before SIGKILL
@@ -363,10 +364,21 @@ def output_digests(folder):
             if p.is_file() and p.name != "harness.json"}
 
 
+def stored_outputs(record):
+    """{file name: SHA-256} a run folder should hold: the outputs harness.json lists, with each
+    table validate gzipped (its "compacted" entry: compact.py) as NAME.gz and its digest."""
+    outputs = dict(record.get("outputs") or {})
+    for name, digest in ((record.get("compacted") or {}).get("gzip") or {}).items():
+        outputs.pop(name, None)
+        outputs[name + ".gz"] = digest
+    return outputs
+
+
 def stale(job, ident):
     """Why job.out cannot stand for a run of ident ('' when it can): it must hold harness.json
     saying the run succeeded with exactly this identity (every input it read unchanged:
-    identity_change), every file it lists unchanged, no
+    identity_change), every file it lists unchanged (a table validate gzipped as its .gz:
+    stored_outputs; a run whose tables validate removed is made again), no
     other output file, and complete outputs (run.json status ok, the expected files, no .tmp)."""
     record = read_harness_record(job.out)
     if record is None:
@@ -376,8 +388,11 @@ def stale(job, ident):
     changed = identity_change(record.get("identity"), ident)
     if changed:
         return changed
+    removed = removed_tables(job.out, record)
+    if removed:
+        return removed
     recorded = record.get("outputs")
-    if not isinstance(recorded, dict) or output_digests(job.out) != recorded:
+    if not isinstance(recorded, dict) or output_digests(job.out) != stored_outputs(record):
         return "its files changed since the run"
     try:
         info = read_run_json(job.out)

@@ -5,7 +5,8 @@ figures inlined and every table in it): the verdict, the failures, the skipped c
 KNOWN list, the table of the cases, then per case what it checks, its counts, the rows that did
 not pass, its figures and its error against cost; the stability digest.  The figures are linked
 from reports/figures/ (the report is index.html with its folder), an SVG above SVG_LINK_MAX
-shown by its PNG with a link to the vector file; each case's full tables (runs, energy audit,
+shown by its PNG with a link to the vector file (gzipped: contents.pack_vector); each case's
+full tables (runs, energy audit,
 every check, every swept point) are on its page, cases/<case>.html, and the stability tables
 on stability.html.
 """
@@ -13,7 +14,8 @@ import html
 
 from .. import sweep
 from ..gate import counts_text, fmt_number, fmt_reference, tally
-from .contents import ENERGY_COLUMNS, case_counts, energy_cells, skip_groups, stability_digest, stability_tables
+from .contents import (ENERGY_COLUMNS, SVG_LINK_MAX, case_counts, energy_cells, skip_groups, stability_digest,
+                       stability_tables)
 from .markdown import CASES_DIR, STABILITY_PAGE
 
 CSS = """
@@ -44,21 +46,19 @@ def table_html(headers, rows):
     return f"<table><tr>{head}</tr>\n" + "\n".join(f"<tr>{''.join(r)}</tr>" for r in rows) + "</table>"
 
 
-SVG_LINK_MAX = 512 * 1024   # a larger SVG (a force network of thousands of lines) is shown by its PNG, and linked
-
-
 def image_html(figure, prefix=""):
     """The figure, linked from the figures folder (prefix: the way there from the page, '../' from
     a case page): its SVG, or its PNG when there is no SVG or the SVG is above SVG_LINK_MAX bytes
-    (then with a link to the SVG), else only its notes."""
+    (kept gzipped then: contents.pack_vector; linked below the PNG), else only its notes."""
     link = ""
-    if figure.svg and (figure.svg.stat().st_size <= SVG_LINK_MAX or not figure.png):
+    if figure.svg and figure.svg.suffix == ".svg" and (figure.svg.stat().st_size <= SVG_LINK_MAX or not figure.png):
         src = f"{prefix}figures/{figure.svg.name}"
     elif figure.png:
         src = f"{prefix}figures/{figure.png.name}"
         if figure.svg:
+            kind = "gzipped SVG, " if figure.svg.suffix == ".gz" else ""
             link = (f" (<a href=\"{esc(prefix)}figures/{esc(figure.svg.name)}\">vector version</a>, "
-                    f"{figure.svg.stat().st_size / 1e6:.1f} MB)")
+                    f"{kind}{figure.svg.stat().st_size / 1e6:.1f} MB)")
     else:
         src = ""
     img = f"<img alt=\"{esc(figure.title)}\" src=\"{esc(src)}\">" if src else "<p class=\"bad\">(no figure)</p>"

@@ -178,7 +178,8 @@ def cmd_validate(args):
     cmd_report(args)
     if not args.keep_outputs:
         # the report is written: what no check, figure, report or resume reads again goes (compact.py)
-        tally = compact.compact(selected(args, load_cases()), runs_root(), reports_root() / "sweeps")
+        tally = compact.compact(selected(args, load_cases()), runs_root(),
+                                None if args.no_sweeps else reports_root() / "sweeps")
         print(f"kept {compact.disk(reports_root()) / 1e6:.0f} MB under {reports_root()}: {tally.text()} "
               "(--keep-outputs keeps every file)")
     print(f"validate: {counts_text(verdicts)}; the report: {reports_root() / 'summary.md'}, "

@@ -167,3 +167,11 @@ def test_disk_counts_every_file_once(tmp_path):
     (tmp_path / "y").write_bytes(b"123")
     os.symlink(tmp_path / "y", tmp_path / "link")
     assert compact.disk(tmp_path) == 8
+
+
+def test_a_validate_without_sweeps_leaves_the_points_an_earlier_cost_wrote(project):
+    reports = project_with_everything(project)
+    assert main(["run", "spring"]) == 0 and main(["cost", "spring"]) == 0
+    assert main(["validate", "--no-stability", "--no-sweeps"]) == 1      # k_discs fails (see REFS)
+    assert "series.tsv" in files_in(reports / "sweeps" / "spring" / "stiffness_x2")
+    assert "contacts.tsv" not in files_in(reports / "runs" / "spring" / "k_s1")

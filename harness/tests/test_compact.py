@@ -112,6 +112,8 @@ def test_a_later_report_keeps_the_figures_of_a_case_whose_tables_were_removed(va
     assert main(["report"]) == 0
     assert figure.stat().st_mtime_ns == drawn
     assert "have their tables removed since" in (validated / "index.html").read_text()
+    # harness.json keeps its time: summary.json is still fresh, its verdicts are the report's
+    assert "verdicts: reports/summary.json" in (validated / "cases" / "spring.html").read_text()
 
 
 def test_keep_outputs_keeps_every_file(project):

@@ -16,6 +16,10 @@ from harness.tests.test_sweep_cost import SWEEPS
 
 CASES = 10       # extra cases, one variant each: a stability limit each
 PROBES = 30      # extreme probes
+# What a terminal shows: the runs (progress line, count), the verdict (2), the sweeps (progress
+# line, count, one line), the stability limits (1), the probes (the one finding, p0 declared a
+# stop and ran through, and a count), the report (1), what reports/ keeps (1), the last line.
+PHASE_LINES = 13
 
 
 class Terminal(io.StringIO):
@@ -74,10 +78,7 @@ def test_validate_prints_a_line_or_two_per_phase(project, monkeypatch):
     status, text = validate(monkeypatch)
     assert status == 0
     lines = visible(text)
-    # the runs (progress line and count), the verdict (2), the sweeps (progress line, count, one
-    # line), the stability limits, the probes (one finding: p0 declared a stop and ran through),
-    # the report, validate's last line
-    assert len(lines) <= 13, "\n".join(lines)
+    assert len(lines) <= PHASE_LINES, "\n".join(lines)
     assert lines[3] == "6 passed, 0 failed"                   # the verdict, before the sweeps and the rest
     assert any(ln.startswith(f"stability: {CASES + 1} limit(s) bisected, {CASES + 1} in [1, 1.25]")
                for ln in lines), lines
@@ -94,8 +95,8 @@ def test_validate_off_a_terminal_drops_the_detail(project, monkeypatch):
     status, text = validate(monkeypatch, tty=False)
     assert status == 0
     assert "springs/p7: " not in text and "error <= 0.01" not in text and "\r" not in text
-    runs = 3 + CASES + 3             # a short batch (at most 60 runs) prints a line per run off a terminal
-    assert len(text.splitlines()) <= 10 + runs, text
+    runs = 3 + CASES + 3             # a short batch (at most 60 runs) prints a line per run off a terminal,
+    assert len(text.splitlines()) <= PHASE_LINES - 2 + runs, text      # not the two progress lines
 
 
 def test_validate_verbose_prints_every_line(project, monkeypatch):

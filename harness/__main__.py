@@ -24,18 +24,19 @@ from contextlib import nullcontext
 from pathlib import Path
 
 from . import TIERS, bin_path, cases_root, reference_root, reports_root, runs_root
-from . import catalogue, export, extremes, files, known, pictures, points, references, stability
+from . import catalogue, compact, export, extremes, files, known, pictures, points, references, stability
 from . import study as studies
 from . import families  # noqa: F401 -- registers every case family's expression functions
 from . import sweep as sweeps
 from . import sweep_grid
 from .compare import RunStore, folder_locator
+from .console import Transient
 from .errors import Busy, CatalogueError, IniError, PictureError
-from .gate import gate
+from .gate import counts_text, gate
 from .lock import reports_lock
 from .rebaseline import rebaseline
 from .report import write_report
-from .runner import jobs_for, run_all, sigterm_as_interrupt, unrecorded
+from .runner import STOPPED, jobs_for, run_all, sigterm_as_interrupt, unrecorded
 
 USAGE_ERROR = 2
 IO_ERROR = 3         # as the core's exit code for an I/O error
@@ -101,15 +102,22 @@ def subset(args):
     return bool(getattr(args, "cases", None))
 
 
-def cmd_check(args):
+def cmd_check(args, verdicts=None):
+    """The gate; verdicts (a list), when given, gets the verdicts evaluated (validate's last line)."""
     all_cases = load_cases()
     checks = load_checks(all_cases)
     cases = selected(args, all_cases)
     refresh = None
     if args.tier == "full" or subset(args):
         refresh = functools.partial(refresh_known, checks, {c.name: c.tier for c in all_cases})
+
+    def evaluated(found):
+        if verdicts is not None:
+            verdicts.extend(found)
+        if refresh:
+            refresh(found)
     return gate(references.for_cases(checks, cases), default_store(all_cases), reports_root(), sys.stdout,
-                keep_others=subset(args), verbose=getattr(args, "verbose", False), on_verdicts=refresh)
+                keep_others=subset(args), verbose=getattr(args, "verbose", False), on_verdicts=evaluated)
 
 
 def refresh_known(checks, tiers, verdicts):
@@ -141,11 +149,16 @@ def cmd_report(args):
 
 
 def cmd_validate(args):
+    """Run, check, cost, stability, report, then compact what the report no longer needs
+    (compact.py; not with --keep-outputs).  Without -v the terminal gets a line or two per phase
+    and every failure, KNOWN row and finding; the detail of the sweeps, the bisections and the
+    probes goes to a Transient status line (console.py) and is in the report (issue 32, item 4)."""
     load_checks(load_cases())          # a broken reference file stops us before any run
     run_status = cmd_run(args)
-    check_status = cmd_check(args)
+    verdicts = []
+    check_status = cmd_check(args, verdicts)
     if not args.no_sweeps:
-        cmd_cost(args)
+        cost_phase(args)
     if not args.no_stability:
         # the first DEM variant of each case and the extreme probes (all variants:
         # `harness stability`); a measurement shown in the report, not a gate
@@ -154,13 +167,39 @@ def cmd_validate(args):
         stab.one_per_case, stab.extremes_only = True, False
         stab.no_extremes = subset(args) and not args.extremes
         stab.cap, stab.tolerance = 20000, 0.01
+        stab.quiet = not args.verbose
         try:
             cmd_stability(stab)
         except (RuntimeError, OSError, ValueError, CatalogueError) as exc:
             # a measurement for the report: its failure is said, not fatal to the gate
             print(f"stability: not measured: {exc}")
     cmd_report(args)
+    if not args.keep_outputs:
+        # the report is written: what no check, figure, report or resume reads again goes (compact.py)
+        tally = compact.compact(selected(args, load_cases()), runs_root(),
+                                None if args.no_sweeps else reports_root() / "sweeps")
+        print(f"kept {compact.disk(reports_root()) / 1e6:.0f} MB under {reports_root()}: {tally.text()} "
+              "(--keep-outputs keeps every file)")
+    print(f"validate: {counts_text(verdicts)}; the report: {reports_root() / 'summary.md'}, "
+          f"{reports_root() / 'index.html'}")
     return run_status or check_status
+
+
+def cost_phase(args):
+    """validate's sweeps: `cost`; without -v, each case's cheapest settings shown in passing (they
+    are in the report and in cost.tsv) and a sweep point past its stability limit only counted."""
+    if args.verbose:
+        cmd_cost(args)
+        return
+    detail = Transient(sys.stdout)      # each case's cost summary (sweep.summary_text)
+    runs = functools.partial(points.launch, resume=args.resume, limits=False)
+    try:
+        done = run_declared(args, detail, lambda jobs, binary, workers, _out: runs(jobs, binary, workers, sys.stdout))
+    finally:
+        detail.close()
+    n_points = sum(len(rows) for _, rows in done)
+    print(f"sweeps: {n_points} point(s) of {len(done)} case(s); each case's error against cost and cheapest settings "
+          f"are in the report ({reports_root() / 'sweeps'}/<case>/cost.tsv)")
 
 
 def cmd_rebaseline(args):
@@ -212,11 +251,17 @@ def cmd_sweep(args):
 
 def cmd_cost(args):
     """Every declared [sweep] of the selected cases: run, write reports/sweeps/<case>/cost.tsv."""
+    run_declared(args, sys.stdout, functools.partial(points.launch, resume=args.resume))
+    return 0
+
+
+def run_declared(args, out, runs):
+    """sweep.run_declared on the selected cases, its lines to out, its runs through runs (run_all's
+    signature); the list of (case, rows)."""
     all_cases = load_cases()
     checks = load_checks(all_cases)
-    sweeps.run_declared(selected(args, all_cases), checks, args.bin, args.jobs, runs_root(),
-                        reports_root() / "sweeps", sys.stdout, functools.partial(points.launch, resume=args.resume))
-    return 0
+    return sweeps.run_declared(selected(args, all_cases), checks, args.bin, args.jobs, runs_root(),
+                               reports_root() / "sweeps", out, runs)
 
 
 def cmd_study(args):
@@ -293,33 +338,60 @@ def cmd_stability(args):
 
 
 def _stability(args, work):
-    """cmd_stability's work, its trial runs in the scratch folder work."""
+    """cmd_stability's work, its trial runs in the scratch folder work.  args.quiet (validate's
+    default view): each bisection's limit and each probe's outcome shown in passing (Transient),
+    then one line per part; a limit outside its target and a finding are printed in full."""
     status = 0
-    if not args.extremes_only:
-        cases = selected(args, load_cases())
-        targets = stability.targets_for(cases, getattr(args, "one_per_case", False))
-        print(f"stability: bisecting {len(targets)} variant(s)")
-        limits = stability.measure_all(args.bin, targets, work, args.jobs, args.cap, args.tolerance, sys.stdout,
-                                       args.resume)
-        rows = stability.limit_rows(limits)
-        stability.merge_tsv(rows, stability.LIMIT_COLUMNS, reports_root() / "stability.tsv", ("case", "variant"))
-        print(f"wrote {reports_root() / 'stability.tsv'}")
-        status = 0 if all(r["in_target"] == "yes" for r in rows) else 1
-    if not args.no_extremes:
-        probes = extremes.load_probes(cases_root() / "extremes" / "extremes.txt")
-        print(f"stability: {len(probes)} extreme probe(s)")
-        rows = extremes.run_probes(args.bin, probes, work, args.jobs, sys.stdout, args.resume)
-        stability.merge_tsv(rows, extremes.EXTREME_COLUMNS, reports_root() / "extremes.tsv", ("probe",))
-        findings = 0
-        for r in rows:
-            print(f"  {r['group']}/{r['probe']}: {r['outcome']}")
-            if r["as_expected"] != "yes":
-                findings += 1
-                print(f"      finding: declared '{r['expect']}', behaved otherwise (above); a measurement "
-                      "for docs/stability.md, not a gate")
-        print(f"extreme probes: {len(rows) - findings} as declared, {findings} finding(s); the probes "
-              f"measure limits and never change the exit status; wrote {reports_root() / 'extremes.tsv'}")
+    quiet = getattr(args, "quiet", False)
+    # shown in passing: the bisections' lines; kept: the batch's account of an interrupt (runner._stop)
+    detail = Transient(sys.stdout, keep=lambda line: line.startswith(STOPPED)) if quiet else sys.stdout
+    try:
+        if not args.extremes_only:
+            cases = selected(args, load_cases())
+            targets = stability.targets_for(cases, getattr(args, "one_per_case", False))
+            print(f"stability: bisecting {len(targets)} variant(s)", file=detail)
+            limits = stability.measure_all(args.bin, targets, work, args.jobs, args.cap, args.tolerance, detail,
+                                           args.resume)
+            rows = stability.limit_rows(limits)
+            stability.merge_tsv(rows, stability.LIMIT_COLUMNS, reports_root() / "stability.tsv", ("case", "variant"))
+            status = 0 if all(r["in_target"] == "yes" for r in rows) else 1
+            if quiet:
+                _close(detail)
+                outside = [f"{r['case']}/{r['variant']} ({r['limit_fraction']} x estimate)"
+                           for r in rows if r["in_target"] != "yes"]
+                print(f"stability: {len(rows)} limit(s) bisected, {len(rows) - len(outside)} in [1, 1.25] of the "
+                      f"estimate" + (f"; outside: {', '.join(outside)}" if outside else "")
+                      + f"; wrote {reports_root() / 'stability.tsv'}")
+            else:
+                print(f"wrote {reports_root() / 'stability.tsv'}")
+        if not args.no_extremes:
+            probes = extremes.load_probes(cases_root() / "extremes" / "extremes.txt")
+            print(f"stability: {len(probes)} extreme probe(s)", file=detail)
+            rows = extremes.run_probes(args.bin, probes, work, args.jobs, sys.stdout, args.resume)
+            stability.merge_tsv(rows, extremes.EXTREME_COLUMNS, reports_root() / "extremes.tsv", ("probe",))
+            findings = 0
+            for r in rows:
+                print(f"  {r['group']}/{r['probe']}: {r['outcome']}", file=detail)
+                if r["as_expected"] != "yes":
+                    findings += 1
+                    if quiet:
+                        _close(detail)
+                        print(f"  finding {r['group']}/{r['probe']}: declared '{r['expect']}': {r['outcome']}")
+                    else:
+                        print(f"      finding: declared '{r['expect']}', behaved otherwise (above); a measurement "
+                              "for docs/stability.md, not a gate")
+            _close(detail)
+            print(f"extreme probes: {len(rows) - findings} as declared, {findings} finding(s); the probes "
+                  f"measure limits and never change the exit status; wrote {reports_root() / 'extremes.tsv'}")
+    finally:
+        _close(detail)
     return status
+
+
+def _close(stream):
+    """Erase a Transient's status line (sys.stdout has none)."""
+    if isinstance(stream, Transient):
+        stream.close()
 
 
 def sweep_variant(case, name):
@@ -354,11 +426,16 @@ def parser():
     validate = _runs(_selection(_command(sub, "validate", cmd_validate, "run + check + cost + report")))
     validate.add_argument("--no-sweeps", action="store_true", help="skip the declared sweeps (cost)")
     validate.add_argument("-v", "--verbose", action="store_true",
-                          help="list every check's row (default: the failures, KNOWN and SKIP rows and the counts)")
+                          help="list every check's row and each sweep's, limit's and probe's line (default: the "
+                               "failures, KNOWN and SKIP rows, the counts and a line or two per phase)")
     validate.add_argument("--extremes", action="store_true",
                           help="run the extreme probes even when cases are named (a validate of all cases runs them)")
     validate.add_argument("--no-stability", action="store_true",
                           help="skip the stability limits (first variant of each case) and extreme probes")
+    validate.add_argument("--keep-outputs", action="store_true",
+                          help="keep every file the runs wrote (default: once the report is written, a series.tsv "
+                               "of 64 KiB or more is gzipped and the tables of ensemble realisations and sweep "
+                               "points are removed: harness/compact.py)")
     rebase = _command(sub, "rebaseline", cmd_rebaseline, "rewrite the regression values of CASE from its current outputs")
     rebase.add_argument("case", metavar="CASE")
     sweep = _command(sub, "sweep", cmd_sweep, "run one variant at every point of a grid of --set values and "

@@ -11,7 +11,8 @@ marked open (open = 1, the exact solver's opened contacts).  Contacts are keyed 
 unordered pair of body names.
 
 Anything missing or malformed (a file, a column, a number, zero weight) raises EvalError,
-so a check built on it FAILs with the reason.
+so a check built on it FAILs with the reason (a table validate removed after its report says
+so: tables.removed_tables).  A table is read plain or gzipped (tables.read_text).
 """
 import math
 from pathlib import Path
@@ -19,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import EvalError
+from .tables import read_harness_record, read_text, removed_tables
 
 DISC_COLUMNS = ("id", "name", "x", "y", "r", "m", "fixed", "row")
 CONTACT_COLUMNS = ("a", "b", "kind", "x", "y", "nx", "ny", "fn", "dn")
@@ -30,9 +32,10 @@ class Table:
     def __init__(self, path, needed):
         self.path = Path(path)
         try:
-            lines = self.path.read_text(encoding="utf-8").splitlines()
+            lines = read_text(self.path).splitlines()
         except OSError as exc:
-            raise EvalError(f"{self.path.name} missing or unreadable: {self.path} ({exc.strerror})") from None
+            removed = removed_tables(self.path.parent, read_harness_record(self.path.parent), self.path.name)
+            raise EvalError(removed or f"{self.path.name} missing or unreadable: {self.path} ({exc.strerror})") from None
         if not lines:
             raise EvalError(f"{self.path}:1: {self.path.name} is empty (no header)")
         self.names = [n.strip() for n in lines[0].split("\t")]

@@ -54,7 +54,7 @@ from .compare import evaluate, evaluate_array
 from .errors import EvalError, PictureError, RunProblem, shown
 from .expressions import Siblings
 from .final_state import Table
-from .tables import read_run_json
+from .tables import present, read_run_json
 
 SNAPSHOTS = "snapshots"                 # the run folder's snapshot folder
 INDEX_COLUMNS = ("frame", "cycle", "time", "stage")
@@ -194,7 +194,7 @@ def _walls(path):
 def final_state(folder, info):
     """The final state of a run: discs.tsv, contacts.tsv, walls.tsv."""
     folder = Path(folder)
-    if not (folder / "discs.tsv").is_file():
+    if not present(folder / "discs.tsv"):        # plain, or gzipped by validate (compact.py)
         status = info.get("status", "?")
         raise PictureError(f"{shown(folder)} has no discs.tsv (run.json: status '{status}'"
                            + (f": {info['message']}" if info.get("message") else "") + ")")

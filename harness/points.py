@@ -59,11 +59,11 @@ def refuse(binary, jobs_, swept):
     core_info.refuse_bad_points(binary, [(job.variant, job.scene, job.sets, swept) for job in jobs_])
 
 
-def launch(jobs_, binary, workers, out, resume=False):
-    """Run the points (runner.run_all); their Outcomes.  An OSError naming the first run folder
+def launch(jobs_, binary, workers, out, resume=False, **options):
+    """Run the points (runner.run_all, with its other options); their Outcomes.  An OSError naming the first run folder
     the harness could not prepare or record (the command exits 3 with that line), and how many
     more: no table is made of runs that were not recorded."""
-    outcomes = run_all(jobs_, binary, workers, out, resume=resume)
+    outcomes = run_all(jobs_, binary, workers, out, resume=resume, **options)
     if unrecorded(outcomes):
         raise OSError(unrecorded(outcomes))
     return outcomes

@@ -53,12 +53,14 @@ from pathlib import Path
 from . import files
 from .children import options as child_options
 from .errors import RunProblem, Stopped, WriteError
-from .tables import read_harness_record, read_run_json, run_failure, skip_reason, unfinished_outputs
+from .tables import (read_harness_record, read_run_json, removed_tables, run_failure, skip_reason,
+                     unfinished_outputs)
 
 STDERR_TAIL = 5
 STOP_GRACE = 10.0    # seconds a terminated run has to write run.json and exit before SIGKILL
 INTERRUPTED = (130, -signal.SIGINT, -signal.SIGTERM)   # how a run that was interrupted ends
 POLL = 0.1           # seconds between the main thread's looks at the runs (see run_all)
+STOPPED = "interrupted:"   # how the account of an interrupted batch begins (_stop; console.Transient keeps it)
 PEER = Path(__file__).resolve().parent / "peer"
 # The cross-checks against LAMMPS (modules of harness/peer, not the core): command -> (the
 # module run with python3 -m, the files of harness/peer besides bin/ballast that decide its
@@ -371,10 +373,21 @@ def output_digests(folder):
             if p.is_file() and p.name != "harness.json"}
 
 
+def stored_outputs(record):
+    """{file name: SHA-256} a run folder should hold: the outputs harness.json lists, with each
+    table validate gzipped (its "compacted" entry: compact.py) as NAME.gz and its digest."""
+    outputs = dict(record.get("outputs") or {})
+    for name, digest in ((record.get("compacted") or {}).get("gzip") or {}).items():
+        outputs.pop(name, None)
+        outputs[name + ".gz"] = digest
+    return outputs
+
+
 def stale(job, ident):
     """Why job.out cannot stand for a run of ident ('' when it can): it must hold harness.json
     saying the run succeeded with exactly this identity (every input it read unchanged:
-    identity_change), every file it lists unchanged, no
+    identity_change), every file it lists unchanged (a table validate gzipped as its .gz:
+    stored_outputs; a run whose tables validate removed is made again), no
     other output file, and complete outputs (run.json status ok, the expected files, no .tmp)."""
     record = read_harness_record(job.out)
     if record is None:
@@ -384,8 +397,11 @@ def stale(job, ident):
     changed = identity_change(record.get("identity"), ident)
     if changed:
         return changed
+    removed = removed_tables(job.out, record)
+    if removed:
+        return removed
     recorded = record.get("outputs")
-    if not isinstance(recorded, dict) or output_digests(job.out) != recorded:
+    if not isinstance(recorded, dict) or output_digests(job.out) != stored_outputs(record):
         return "its files changed since the run"
     try:
         info = read_run_json(job.out)
@@ -490,13 +506,16 @@ class Progress:
     redrawn after every run on a terminal; off a terminal (a log, CI) printed after the first
     run, then at most once every `period` seconds, and at the end.
 
-    Either way a failed or skipped run's cause is printed at once, on a line of its own; the
-    rate counts the runs that ran (not those kept by --resume) over the time since the start;
+    Either way a failed or skipped run's cause is printed at once, on a line of its own, and so
+    is a sweep point past its stability limit unless limits is False (validate's default view:
+    the closing line counts them, the report tabulates them); the rate counts the runs that ran (not those kept by --resume) over the time since the start;
     the time left scales the elapsed time by the expected run times (case.txt `runtime`) of
     what is left against what has finished."""
 
-    def __init__(self, jobs, out, tty=None, long_batch=LONG_BATCH, period=PERIOD, clock=time.monotonic):
+    def __init__(self, jobs, out, tty=None, long_batch=LONG_BATCH, period=PERIOD, clock=time.monotonic,
+                 limits=True):
         self.total, self.done, self.out = len(jobs), 0, out
+        self.show_limits = limits
         self.expected_total = sum(j.expected for j in jobs)
         self.expected_done = 0.0
         self.tty = out.isatty() if tty is None else tty
@@ -530,8 +549,9 @@ class Progress:
         self.expected_done += outcome.job.expected
         if limit_found(outcome):
             self.limits += 1
-            self._write(f"LIMIT {outcome.job.label}: past its stability limit, the guards stopped it "
-                        f"(a measured point of the sweep, not a failure): {outcome.cause}", keep=True)
+            if self.show_limits:
+                self._write(f"LIMIT {outcome.job.label}: past its stability limit, the guards stopped it "
+                            f"(a measured point of the sweep, not a failure): {outcome.cause}", keep=True)
         elif not outcome.ok:
             self.failed += 1
             self._write(f"FAILED {outcome.job.label}: {outcome.cause}", keep=True)
@@ -657,7 +677,7 @@ def _stop(futures, pool, batch, out):
     # first run or first query (a bisection's `ballast info`) was refused.
     dropped = len(futures) - len(live) + batch.refused + \
         sum(o.cause == "interrupted before it started" for o in batch.outcomes)
-    print(f"\ninterrupted: {stopped} run(s) stopped, {dropped} not started; their folders hold no result "
+    print(f"\n{STOPPED} {stopped} run(s) stopped, {dropped} not started; their folders hold no result "
           "(--resume redoes only these)", file=out, flush=True)
 
 
@@ -710,12 +730,13 @@ def _single(job):
     return task
 
 
-def run_all(jobs, binary, workers=None, out=sys.stdout, tty=None, resume=False):
+def run_all(jobs, binary, workers=None, out=sys.stdout, tty=None, resume=False, limits=True):
     """Run jobs in parallel (workers defaults to os.cpu_count()); Outcomes in job order, each
     job's progress line printed as it ends.  resume: keep the jobs whose folder already holds
-    a complete run of the same identity.  SIGINT/SIGTERM: stop every run (see the module's
-    docstring), then KeyboardInterrupt."""
-    progress = Progress(jobs, out, tty)
+    a complete run of the same identity.  limits: a line for each sweep point past its stability
+    limit (Progress).  SIGINT/SIGTERM: stop every run (see the module's docstring), then
+    KeyboardInterrupt."""
+    progress = Progress(jobs, out, tty, limits=limits)
     outcomes = run_tasks([_single(job) for job in jobs], binary, workers, out, resume,
                          lambda i, outcome: progress.finished(outcome))
     progress.close(outcomes)

@@ -3,7 +3,10 @@
 load_run() gathers a run folder into a Run, or raises RunProblem with a message that
 says exactly what is missing or wrong; the checks turn that message into a FAIL.
 harness.json is the runner's own record of a run (command, exit code, wall time).
+A table that validate stored gzipped (NAME.gz beside no NAME: harness/compact.py) is read
+through read_text as the table itself.
 """
+import gzip
 import json
 import math
 from dataclasses import dataclass
@@ -25,11 +28,30 @@ class Run:
         return list(self.columns)
 
 
+def read_text(path):
+    """The text of an output table: path, or path + '.gz' decompressed when path is absent (a
+    table validate stored gzipped: compact.py).  An OSError when neither can be read."""
+    path = Path(path)
+    packed = path.with_name(path.name + ".gz")
+    if not path.exists() and packed.is_file():
+        try:
+            return gzip.decompress(packed.read_bytes()).decode("utf-8")
+        except (EOFError, gzip.BadGzipFile, ValueError) as exc:     # a cut or corrupt file
+            raise OSError(5, f"unreadable gzip file {packed.name}: {exc}", str(packed)) from None
+    return path.read_text(encoding="utf-8")
+
+
+def present(path):
+    """Whether an output table is there, plain or gzipped (read_text reads it)."""
+    path = Path(path)
+    return path.is_file() or path.with_name(path.name + ".gz").is_file()
+
+
 def read_series(path):
-    """series.tsv as {column name: float array}, in header order."""
+    """series.tsv (or series.tsv.gz: read_text) as {column name: float array}, in header order."""
     path = Path(path)
     try:
-        lines = path.read_text(encoding="utf-8").splitlines()
+        lines = read_text(path).splitlines()
     except OSError as exc:
         raise RunProblem(f"series.tsv missing or unreadable: {path} ({exc.strerror})") from None
     if not lines:
@@ -115,11 +137,12 @@ EXPECTED_OUTPUTS = {"run": ("series.tsv", "stress.tsv", "contacts.tsv", "discs.t
                     "peer_rolling": ("series.tsv", "run.json")}
 
 
-def unfinished_outputs(folder, command=None):
+def unfinished_outputs(folder, command=None, record=None):
     """Why a run folder's outputs are incomplete ('' when they are not): a NAME.tmp left behind
-    (a writer stopped before its rename), or a file the command always writes missing.  Without
-    a command (no harness.json) only the leftovers are looked at (load_run reads series.tsv and
-    run.json itself)."""
+    (a writer stopped before its rename), or a file the command always writes missing -- unless
+    record (its harness.json) says validate removed it after its report (removed_tables).
+    Without a command (no harness.json) only the leftovers are looked at (load_run reads
+    series.tsv and run.json itself)."""
     folder = Path(folder)
     try:
         leftovers = sorted(p.name for p in folder.iterdir() if p.name.endswith(".tmp"))
@@ -127,11 +150,24 @@ def unfinished_outputs(folder, command=None):
         return f"unfinished outputs: cannot list {folder} ({exc.strerror})"
     if leftovers:
         return f"unfinished outputs: {', '.join(leftovers)} left behind ({folder})"
+    removed = ((record or {}).get("compacted") or {}).get("removed") or {}
     missing = [n for n in EXPECTED_OUTPUTS.get(command, ())
-               if not (folder / n).is_file()]
+               if not present(folder / n) and n not in removed]
     if missing:
         return f"unfinished outputs: {', '.join(missing)} missing ({folder})"
     return ""
+
+
+def removed_tables(folder, record, name=None):
+    """Why a run's tables are gone, when validate removed them after its report (compact.py),
+    else ''; with name, only when that file is one of them."""
+    removed = ((record or {}).get("compacted") or {}).get("removed")
+    if not removed or (name is not None and name not in removed):
+        return ""
+    case = (record or {}).get("case") or "CASE"
+    what = name or ", ".join(sorted(n for n in removed if n.endswith(".tsv")) or sorted(removed))
+    return (f"{what} of {folder} was removed after the report of the validate that made the run, which "
+            f"kept its results; `harness run {case}` makes it again, and `validate --keep-outputs` keeps it")
 
 
 def load_run(folder):
@@ -144,7 +180,8 @@ def load_run(folder):
     if record and not record.get("ok", True):
         raise RunProblem(f"run failed: {record.get('cause') or 'no cause recorded'} ({folder})")
     info = read_run_json(folder)
-    failure = run_failure(folder, info) or unfinished_outputs(folder, record.get("kind") if record else None)
+    failure = (run_failure(folder, info) or removed_tables(folder, record, "series.tsv")
+               or unfinished_outputs(folder, record.get("kind") if record else None, record))
     if failure:
         raise RunProblem(failure)
     skipped = skip_reason(info)

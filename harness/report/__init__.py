@@ -1,20 +1,25 @@
-"""The report: reports/summary.md and a self-contained reports/index.html, with gnuplot figures.
+"""The report: reports/summary.md and reports/index.html, each case's page under reports/cases/,
+the stability page, and the gnuplot figures under reports/figures/.
 
-Per case: title, what it checks, its figures (from its [figure] sections), the checks table
-(measured beside reference, tolerance, kind, provenance, PASS/FAIL), each run's wall time,
-status and energy audit, and its error against cost; then the stability tables.  The page
-header has the git revision and the date.  One module per output:
+summary.md and index.html lead with the verdict, the failures, the skipped checks and the KNOWN
+list, then one row per case with its counts; they stay small whatever the catalogue's size
+(issue 32, item 4).  index.html shows, per case, what it checks, the rows that did not pass, its
+figures (linked from figures/) and its error against cost.  Each case's page (cases/<case>.md
+and .html) holds its full tables: the runs (status, wall time, steps), the energy audit, every
+check (measured beside reference, tolerance, kind, provenance, result) and every swept point;
+stability.md and .html hold the stability limits and the extreme probes.  Every page has the
+git revision and the date.  One module per output:
 
     contents.py   what the report shows, gathered once (runs, verdicts, figures, costs)
     plots.py      the figures of case.txt, drawn by gnuplot (network.py: the force network)
     cost_plot.py  the error-against-cost diagram
-    markdown.py   summary.md (the verdict, the failures, the KNOWN list, then each case)
+    markdown.py   summary.md and the case pages in markdown
     known_list.py every KNOWN discrepancy of the catalogue, from reference/known.tsv
-    html_page.py  index.html
+    html_page.py  index.html and the case pages in HTML
 
-write_report() below calls them in that order.  summary.md and index.html reach reports/
-through files.py (a temporary file, then rename), so a killed report leaves each of them old
-or new, never empty or cut.
+write_report() below calls them in that order.  Every page reaches reports/ through files.py (a
+temporary file, then rename), so a killed report leaves each of them old or new, never empty or
+cut; a case page that no case of this report has any more is removed.
 """
 import subprocess
 from datetime import datetime, timezone
@@ -23,9 +28,9 @@ from pathlib import Path
 from .. import REPO_ROOT, files
 from ..children import options as child_options
 from .contents import gather
-from .html_page import page, stability_html
+from .html_page import case_page as case_html, page, stability_page as stability_html_page
 from .known_list import html_section as known_html, markdown_lines as known_markdown, rows as known_rows
-from .markdown import markdown, stability_markdown
+from .markdown import CASES_DIR, STABILITY_PAGE, case_markdown, markdown, stability_page as stability_md_page
 
 
 def git_revision(root=REPO_ROOT):
@@ -43,17 +48,32 @@ def now_text():
 
 
 def write_report(cases, checks, store, runs_root, reports_dir, out=None, render=None):
-    """Render figures, write summary.md and index.html; return the index path.  render: the
-    case names whose figures are drawn anew (None: all; gather)."""
+    """Render figures, write summary.md, index.html, the case pages and the stability page; return
+    the index path.  render: the case names whose figures are drawn anew (None: all; gather)."""
     reports_dir = Path(reports_dir)
     reports = gather(cases, checks, store, runs_root, reports_dir, render)
     revision, date = git_revision(), now_text()
     record = known_rows()        # every KNOWN discrepancy, its case run or not (reference/known.tsv)
-    files.write_text(reports_dir / "summary.md", markdown(reports, revision, date, known_markdown(record, reports_dir))
-                     + stability_markdown(reports_dir))
+    pages = files.make_dirs(reports_dir / CASES_DIR)
+    written = set()
+    for r in reports:
+        for name, text in ((f"{r.case.name}.md", case_markdown(r, revision, date)),
+                           (f"{r.case.name}.html", case_html(r, revision, date))):
+            files.write_text(pages / name, text)
+            written.add(name)
+    for old in pages.iterdir():        # the page of a case this report no longer has
+        if old.is_file() and old.suffix in (".md", ".html") and old.name not in written:
+            files.remove(old)
+    for name, text in ((f"{STABILITY_PAGE}.md", stability_md_page(reports_dir, revision, date)),
+                       (f"{STABILITY_PAGE}.html", stability_html_page(reports_dir, revision, date))):
+        if text is None:
+            files.remove(reports_dir / name)
+        else:
+            files.write_text(reports_dir / name, text)
+    files.write_text(reports_dir / "summary.md",
+                     markdown(reports, revision, date, known_markdown(record, reports_dir), reports_dir))
     index = reports_dir / "index.html"
-    files.write_text(index, page(reports, revision, date, known_html(record, reports_dir)).replace("</body></html>",
-                                                                  stability_html(reports_dir) + "</body></html>"))
+    files.write_text(index, page(reports, revision, date, known_html(record, reports_dir), reports_dir))
     if out:
         print(f"wrote {reports_dir / 'summary.md'} and {index}", file=out)
     return index

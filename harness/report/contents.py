@@ -5,13 +5,14 @@ verdicts and its error-against-cost section (cost_plot.py); and the stability ta
 Verdicts come from reports/summary.json when it is newer than the runs and the references of
 a case, otherwise they are evaluated here.
 """
+import gzip
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from .. import files, sweep
 from ..compare import evaluate_all
 from ..errors import RunProblem
-from ..gate import read_summary
+from ..gate import known, read_summary, skipped, tally
 from ..references import reference_lines
 from ..stability import read_tsv
 from ..tables import read_harness_record, read_run_json
@@ -27,6 +28,22 @@ class CaseReport:
     verdicts: list
     verdict_source: str
     cost: object = None          # CostOut: the error-against-cost section (below)
+
+
+def case_counts(r):
+    """A case's counts for the table of cases: runs, runs ok, passed, failed, KNOWN, skipped."""
+    passed, failed = tally(r.verdicts)
+    return {"runs": len(r.runs), "runs_ok": sum(x["status"] == "ok" for x in r.runs), "passed": passed,
+            "failed": failed, "known": known(r.verdicts), "skipped": skipped(r.verdicts)}
+
+
+def skip_groups(verdicts):
+    """{(case, message): [check names]} of the skipped checks, as the gate table groups them."""
+    groups = {}
+    for v in verdicts:
+        if v.skipped:
+            groups.setdefault((v.case, v.message), []).append(v.check)
+    return groups
 
 
 # ---------------------------------------------------------------- runs
@@ -82,15 +99,47 @@ def with_references(figure, checks):
     return replace(figure, lines=list(figure.lines) + reference_lines(figure, checks))
 
 
+# An SVG above this is not shown on the page (a force network of thousands of lines, up to 8 MB):
+# its PNG is, with a link to the SVG, which is kept gzipped (NAME.svg.gz, a tenth of the size;
+# a browser does not open a gzipped SVG from a folder, a reader gunzips it to zoom in).
+SVG_LINK_MAX = 512 * 1024
+GZIP_LEVEL = 6
+
+
+def pack_vector(out, svg):
+    """The FigureOut of a figure just drawn to svg (its path whether drawn or not), its SVG gzipped
+    as svg.gz when above SVG_LINK_MAX and a PNG shows it; an older svg.gz of it removed otherwise."""
+    svg = Path(svg)
+    packed = svg.with_name(svg.name + ".gz")
+    if out.svg and out.png and out.svg.suffix == ".svg" and out.svg.stat().st_size > SVG_LINK_MAX:
+        files.write_bytes(packed, gzip.compress(out.svg.read_bytes(), compresslevel=GZIP_LEVEL, mtime=0))
+        files.remove(out.svg)
+        out.svg = packed
+    elif out.svg != packed:
+        files.remove(packed)
+    return out
+
+
 def drawn_before(case, figure, figures_dir):
     """The FigureOut of a figure an earlier report drew (its files, where they exist)."""
     out = FigureOut(figure.name, figure.title, figure.paper)
     png, svg = (Path(figures_dir) / f"{case.name}_{figure.name}.{ext}"
                 for ext in (RASTER.get(figure.kind, "png"), "svg"))
-    out.png, out.svg = (png if png.is_file() else None), (svg if svg.is_file() else None)
+    packed = svg.with_name(svg.name + ".gz")
+    out.png, out.svg = (png if png.is_file() else None), (svg if svg.is_file() else packed if packed.is_file() else None)
     if out.png is None and out.svg is None:
         out.notes.append("not drawn yet: run `harness report` (or validate) with this case")
     return out
+
+
+def tables_removed(case, runs_root):
+    """How many runs of case have had their tables removed by a validate after its report
+    (compact.py: the realisations of its ensembles); 0 when none has."""
+    removed = 0
+    for v in case.variants:
+        record = read_harness_record(Path(runs_root) / case.name / v.name) if v.ensemble else None
+        removed += bool(record and (record.get("compacted") or {}).get("removed"))
+    return removed
 
 
 def _saved(summary):
@@ -109,11 +158,18 @@ def gather(cases, checks, store, runs_root, reports_dir, render=None):
     reports = []
     for case in cases:
         verdicts, source = verdicts_for(case, checks, summary, saved, runs_root, store)
-        if render is None or case.name in render:
+        removed = tables_removed(case, runs_root)
+        if (render is None or case.name in render) and not removed:
             mine = [c for c in checks if c.case == case.name]
-            figures = [render_figure(case, with_references(f, mine), store, figures_dir) for f in case.figures]
+            figures = [pack_vector(render_figure(case, with_references(f, mine), store, figures_dir),
+                                   Path(figures_dir) / f"{case.name}_{f.name}.svg") for f in case.figures]
         else:
             figures = [drawn_before(case, f, figures_dir) for f in case.figures]
+            if removed:
+                for f in figures:
+                    f.notes.append(f"drawn by the report of the validate that made the runs; {removed} of them "
+                                   f"have their tables removed since (harness/compact.py): `harness run {case.name}` "
+                                   "makes them again")
         reports.append(CaseReport(case, run_rows(case, runs_root), figures, verdicts, source,
                                   cost_section(case, reports_dir, figures_dir)))
     return reports
@@ -171,6 +227,9 @@ def cost_section(case, reports_dir, figures_dir):
                          f"since (run `python3 -m harness cost {case.name}`)")
     out.cheapest = sweep.cheapest(out.rows)
     out.figure = render_cost(case, out.rows, figures_dir)
+    drawn = out.figure.svg or out.figure.png
+    if drawn:
+        pack_vector(out.figure, Path(drawn).with_suffix(".svg"))
     return out
 
 
@@ -183,8 +242,8 @@ STABILITY_LIMIT_HEADERS = [("case", "case"), ("variant", "variant"), ("estimate"
 STABILITY_EXTREME_HEADERS = [("group", "group"), ("probe", "probe"), ("what", "what"), ("expect", "expect"),
                              ("exit", "exit"), ("steps", "steps"), ("e_out_over_in", "E_out/E_in"),
                              ("overlap_max", "overlap/r"), ("outcome", "outcome"), ("as_expected", "as expected")]
-STABILITY_NOTE = ("Written by `python3 -m harness stability` (not by validate: it bisects every DEM variant, "
-                  "about 10 runs each). *limit / bound* is the largest stable dt over ballast's estimate (the "
+STABILITY_NOTE = ("Written by `harness stability` (every DEM variant, about 10 runs each) and by validate (the "
+                  "first DEM variant of each case). *limit / bound* is the largest stable dt over ballast's estimate (the "
                   "contact-network bound of core/timestep.c); a safe and tight estimate has it in [1, 1.25]. "
                   "*old* is C&S's single-spring 2 sqrt(m/k). The criteria are in harness/stability.py.")
 EXTREMES_NOTE = ("Extreme probes (cases/extremes/extremes.txt): each row a scene pushed to a limit of the physics; "
@@ -201,3 +260,30 @@ def stability_tables(reports_dir):
         if path.exists():
             out.append((title, note, headers, read_tsv(path)))
     return out
+
+
+def stability_digest(reports_dir):
+    """A few sentences on reports/stability.tsv and extremes.tsv for the top of the report: how many
+    limits were measured and how many lie in their target, how many probes behaved as declared,
+    and which did not (none when neither file exists; the tables are on the stability page)."""
+    out = []
+    for title, _, _, rows in stability_tables(reports_dir):
+        if title == "Stability limits":
+            inside = [r for r in rows if r.get("in_target") == "yes"]
+            fractions = sorted(float(r["limit_fraction"]) for r in rows if _number(r.get("limit_fraction")))
+            spread = f", limit / bound from {fractions[0]:g} to {fractions[-1]:g}" if fractions else ""
+            outside = [f"{r.get('case', '')}/{r.get('variant', '')}" for r in rows if r not in inside]
+            out.append(f"Stability limits: {len(rows)} variant(s) bisected{spread}; {len(inside)} in [1, 1.25]"
+                       + (f"; outside: {', '.join(outside)}" if outside else "") + ".")
+        else:
+            odd = [f"{r.get('group', '')}/{r.get('probe', '')}" for r in rows if r.get("as_expected") != "yes"]
+            out.append(f"Extreme probes: {len(rows)}, {len(rows) - len(odd)} as declared, {len(odd)} finding(s)"
+                       + (f": {', '.join(odd)}" if odd else "") + " (measurements, not a gate).")
+    return out
+
+
+def _number(text):
+    try:
+        return float(text) == float(text)
+    except (TypeError, ValueError):
+        return False

@@ -78,8 +78,8 @@ def test_report_tabulates_each_term_of_the_audit(project, runs, capsys):
     main(["check"])
     assert main(["report"]) == 0
     capsys.readouterr()
-    page = (project / "reports" / "index.html").read_text()
-    md = (project / "reports" / "summary.md").read_text()
+    page = (project / "reports" / "cases" / "spring.html").read_text()       # the case's page holds its tables
+    md = (project / "reports" / "cases" / "spring.md").read_text()
     assert "Energy audit" in page and "Energy audit" in md
     row = [line for line in md.splitlines() if line.startswith("| soft |") and "0.625" in line]
     assert row and "-0.75" in row[0] and "0.0416016" in row[0]

@@ -73,7 +73,7 @@ def test_default_report_lists_every_known_discrepancy(project, runs, capsys):
         assert check in page
     assert page.count('href="../cases/extra/README.md"') == 2
     # the verdict leads, then the KNOWN list, then the cases
-    assert md.index("passed") < md.index("## Known discrepancies (2)") < md.index("## spring:")
+    assert md.index("passed") < md.index("## Known discrepancies (2)") < md.index("## Cases (1)")
 
 
 def test_summary_lists_failures_before_the_known_list(project, runs, capsys):
@@ -81,7 +81,7 @@ def test_summary_lists_failures_before_the_known_list(project, runs, capsys):
     write_spring_runs(runs, ks=(("soft", 1), ("stiff", 3), ("stiffer", 3)))   # rel_last and the trend fail
     assert main(["report"]) == 0
     md = (project / "reports" / "summary.md").read_text()
-    assert md.index("failed") < md.index("## Failures") < md.index("## Known discrepancies") < md.index("## spring:")
+    assert md.index("failed") < md.index("## Failures") < md.index("## Known discrepancies") < md.index("## Cases")
     assert "- **FAIL** spring/rel_last (stiff):" in md
 
 

@@ -1,5 +1,6 @@
-"""The report: figures rendered by gnuplot, summary.md, and a self-contained index.html that
-shows per case the title, what it checks, figures, checks with provenance, runs and the header."""
+"""The report: figures rendered by gnuplot, a short summary.md and index.html that link the figures
+and each case's page (cases/<case>.md and .html: runs, checks with provenance), and the header."""
+import re
 import shutil
 import subprocess
 import time
@@ -39,28 +40,47 @@ def make_report(capsys, *args):
     capsys.readouterr()
 
 
+def assert_links_resolve(page_path):
+    """Every src and href of a page is an anchor of it or a file of the report folder that exists."""
+    page = parse(page_path)
+    for tag, attr, value in page.links:
+        if value.startswith("#"):
+            continue
+        assert "://" not in value and not value.startswith("data:"), (page_path.name, tag, attr, value[:40])
+        assert (page_path.parent / value.split("#")[0]).is_file(), (page_path.name, tag, attr, value)
+    return page
+
+
 @needs_gnuplot
-def test_report_is_self_contained_and_complete(project, runs, capsys):
+def test_report_links_its_figures_and_case_pages(project, runs, capsys):
+    """Issue 32, item 4: index.html links its figures (it was one page with every figure inlined,
+    9.8 MB for the catalogue) and the case's page holds the full tables."""
     write_spring_runs(runs)
     main(["check"])
     make_report(capsys)
     reports = project / "reports"
-    index = reports / "index.html"
-    page = parse(index)
-    for tag, attr, value in page.links:
-        assert value.startswith("data:image/") or value.startswith("#"), (tag, attr, value[:40])
+    page = assert_links_resolve(reports / "index.html")
     images = [v for t, a, v in page.links if t == "img"]
-    assert len(images) == 1 and images[0].startswith("data:image/svg+xml;base64,")
+    assert images == ["figures/spring_force.svg"]
+    assert ("a", "href", "cases/spring.html") in page.links
     text = " ".join(page.text)
     for words in ("A linear spring", "F = k x at every cycle; trend in k", "Spring force",
-                  "git revision", "F = k x with k = 1, x = 2", "a plausible range (second line)",
-                  "regress_mean", "6 passed, 0 failed", "wall s", "ok"):
+                  "git revision", "6 passed, 0 failed", "runs ok"):
+        assert words in text, words
+    assert "regress_mean" not in text          # the passing rows are on the case page, not here
+    case = assert_links_resolve(reports / "cases" / "spring.html")
+    assert [v for t, a, v in case.links if t == "img"] == ["../figures/spring_force.svg"]
+    text = " ".join(case.text)
+    for words in ("F = k x with k = 1, x = 2", "a plausible range (second line)", "regress_mean",
+                  "6 passed, 0 failed", "wall s", "ok"):
         assert words in text, words
     assert (reports / "figures" / "spring_force.png").stat().st_size > 1000
     assert (reports / "figures" / "spring_force.svg").read_text().lstrip().startswith("<?xml")
     md = (reports / "summary.md").read_text()
-    assert "## spring: A linear spring" in md and "figures/spring_force.png" in md
-    assert "| rel_last | stiff | 20 | 20 | rel 1e-9 | exact | PASS |" in md
+    assert "| spring | A linear spring | quick | 3/3 | 6 | 0 | 0 | 0 | [cases/spring.md](cases/spring.md) |" in md
+    page_md = (reports / "cases" / "spring.md").read_text()
+    assert "# spring: A linear spring" in page_md and "](../figures/spring_force.png)" in page_md
+    assert "| rel_last | stiff | 20 | 20 | rel 1e-9 | exact | PASS |" in page_md
 
 
 @needs_gnuplot
@@ -93,12 +113,13 @@ def test_report_uses_fresh_summary_and_reevaluates_stale_one(project, runs, caps
     write_spring_runs(runs)
     main(["check"])
     make_report(capsys, "spring")
-    assert "verdicts: reports/summary.json" in (project / "reports" / "index.html").read_text()
+    assert "verdicts: reports/summary.json" in (project / "reports" / "cases" / "spring.html").read_text()
     time.sleep(0.01)
     write_spring_runs(runs, (("soft", 1), ("stiff", 5), ("stiffer", 6)))       # newer than summary.json
     make_report(capsys, "spring")
-    html = (project / "reports" / "index.html").read_text()
+    html = (project / "reports" / "cases" / "spring.html").read_text()
     assert "evaluated by `report`" in html and "4 passed, 2 failed" in html
+    assert "4 passed, 2 failed" in (project / "reports" / "index.html").read_text()
 
 
 def test_report_never_writes_reference(project, runs, capsys):
@@ -124,4 +145,66 @@ def test_html_escapes_text(project, runs, capsys):
     ref.write_text(ref.read_text().replace("provenance = F grows with k", "provenance = <b>k</b> & co"))
     write_spring_runs(runs)
     make_report(capsys)
-    assert "&lt;b&gt;k&lt;/b&gt; &amp; co" in (project / "reports" / "index.html").read_text()
+    assert "&lt;b&gt;k&lt;/b&gt; &amp; co" in (project / "reports" / "cases" / "spring.html").read_text()
+
+
+def many_checks(project, n):
+    """n more passing checks of case spring (the catalogue's piles_poly has 1014 of them)."""
+    text = "".join(f"\n[check many_{i}]\ncase = spring\nvariant = soft\nquantity = at(F, 2)\nvalue = 2\n"
+                   f"tolerance = abs 1e-12\nkind = analytic\nprovenance = one of many\n" for i in range(n))
+    (project / "reference" / "many.ref").write_text(text)
+
+
+def test_summary_and_index_do_not_grow_with_the_checks(project, runs, capsys):
+    """Issue 32, item 4: summary.md and index.html list the failures, the KNOWN list and the counts
+    per case; every check's row is on the case's page (summary.md was 1.1 MB for 1 326 checks)."""
+    write_spring_runs(runs)
+    main(["check"])
+    make_report(capsys)
+    reports = project / "reports"
+    size = lambda page: (reports / page).stat().st_size if (reports / page).is_file() else 0
+    pages = ("summary.md", "index.html", "cases/spring.md", "cases/spring.html")
+    before = {p: size(p) for p in pages}
+    many_checks(project, 1000)
+    assert main(["check"]) == 0
+    make_report(capsys)
+    grown = {p: size(p) - before[p] for p in pages}
+    assert grown["summary.md"] < 50 and grown["index.html"] < 50, grown      # "1006 passed" for "6 passed"
+    assert grown["cases/spring.md"] > 1000 * 50 and grown["cases/spring.html"] > 1000 * 100, grown
+    assert "many_999" in (reports / "cases" / "spring.md").read_text()
+    assert "many_999" not in (reports / "summary.md").read_text()
+
+
+def md_links(path):
+    """The targets of the markdown links [text](target) of a file."""
+    return re.findall(r"\]\(([^)\s]+)\)", path.read_text())
+
+
+def test_summary_leads_with_the_verdict_and_the_failures_and_its_links_resolve(project, runs, capsys):
+    write_spring_runs(runs, ks=(("soft", 1), ("stiff", 3), ("stiffer", 3)))   # rel_last, ratio_k, trend_k fail
+    assert main(["report"]) == 0
+    capsys.readouterr()
+    reports = project / "reports"
+    md = (reports / "summary.md").read_text()
+    lines = md.splitlines()
+    assert lines[0] == "# ballast validation report" and "**3 passed, 3 failed.**" in lines[2]
+    assert md.index("## Failures (3)") < md.index("## Cases (1)")
+    assert "- **FAIL** spring/rel_last (stiff):" in md and "| rel_last |" not in md
+    assert "| spring | A linear spring | quick | 3/3 | 3 | **3** | 0 | 0 | [cases/spring.md](cases/spring.md) |" in md
+    for page in (reports / "summary.md", reports / "cases" / "spring.md"):
+        targets = md_links(page)
+        assert targets, page
+        for target in targets:
+            assert (page.parent / target).is_file(), (page.name, target)
+    html = (reports / "index.html").read_text()
+    assert html.index("Failures (3)") < html.index("case-spring")
+    assert_links_resolve(reports / "cases" / "spring.html")
+
+
+def test_report_removes_the_page_of_a_case_it_no_longer_has(project, runs, capsys):
+    write_spring_runs(runs)
+    (project / "reports" / "cases").mkdir()
+    for name in ("gone.md", "gone.html"):
+        (project / "reports" / "cases" / name).write_text("an old page")
+    make_report(capsys)
+    assert sorted(p.name for p in (project / "reports" / "cases").iterdir()) == ["spring.html", "spring.md"]

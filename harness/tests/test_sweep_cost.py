@@ -294,7 +294,7 @@ def test_report_section_draws_the_diagram_and_the_table(project, capsys):
     for tol in ("0.01", "0.001", "0.0001"):
         assert f"<td>{tol}</td>" in page
     assert "<td>default</td>" in page           # the default (error 0) is the cheapest meeting every tolerance
-    summary = (project / "reports" / "summary.md").read_text()
+    summary = (project / "reports" / "cases" / "spring.md").read_text()      # the case's page
     assert "**Error against cost**" in summary and "| 0.01 | default |" in summary
 
 
@@ -435,9 +435,9 @@ def test_report_draws_and_tabulates_failed_points_as_unstable(project, capsys):
     capsys.readouterr()
     svg = (project / "reports" / "figures" / "spring_error_cost_sweep.svg").read_text()
     assert "blows_up: unstable" in svg and "x2 unstable" in svg
-    page = (project / "reports" / "index.html").read_text()
+    page = (project / "reports" / "cases" / "spring.html").read_text()      # every point: on the case's page
     assert '<td class="bad">unstable</td>' in page
-    summary = (project / "reports" / "summary.md").read_text()
+    summary = (project / "reports" / "cases" / "spring.md").read_text()
     assert "- unstable (run failed, no error): blows_up x1, blows_up x2, no_output x1, no_output x2" in summary
 
 

@@ -392,16 +392,18 @@ def drop_project(drop, tmp_path, monkeypatch):
     return root
 
 
-def test_report_draws_the_snapshot_grid_and_inlines_the_movie(drop_project, drop):
+def test_report_draws_the_snapshot_grid_and_shows_the_movie(drop_project, drop):
     assert main(["report", "drop", "--tier", "full"]) == 0
     figures = drop_project / "reports" / "figures"
     assert png_size((figures / "drop_grid.png").read_bytes())
     n = len(table(drop / "snapshots" / "index.tsv"))
     assert gif_images((figures / "drop_anim.gif").read_bytes()) == len(range(0, n, 2)) + (1 if (n - 1) % 2 else 0)
     assert not list(figures.glob("*.svg"))          # grids and movies are raster only
-    page = (drop_project / "reports" / "index.html").read_text()
-    assert page.count("data:image/gif;base64,") == 1 and page.count("data:image/png;base64,") == 1
-    assert "figures/drop_anim.gif" in (drop_project / "reports" / "summary.md").read_text()
+    reports = drop_project / "reports"
+    for page, up in ((reports / "index.html", ""), (reports / "cases" / "drop.html", "../")):
+        text = page.read_text()
+        assert f'src="{up}figures/drop_grid.png"' in text and f'src="{up}figures/drop_anim.gif"' in text
+    assert "(../figures/drop_anim.gif)" in (reports / "cases" / "drop.md").read_text()
 
 
 def test_snapshot_grid_frames_run_from_first_to_the_last(drop_project, drop, tmp_path):

@@ -17,10 +17,10 @@ quantity expressions; the variants sharing an x drawn as one point at the mean o
 a bar from the least to the largest, joined per series, and the paper's published points beside,
 JYH Fig. 13); fit (per group of variants and per (x, y) pair, the points and their least-squares
 line drawn from x = 0 or the least x, whichever is smaller, to the largest x, its slope and
-intercept in the legend, JYH Fig. 12); snapshots and movie (the variants' snapshots drawn to scale
-by harness/pictures.py: a PNG grid of frames, an animated GIF).  Whatever a figure cannot show -- a variant without
-data, an expression that fails, a non-positive value on a log axis, non-finite values -- is
-listed in its notes, never silently dropped.
+intercept in the legend, JYH Fig. 12); snapshots and movie (the variants' snapshots drawn to
+scale by harness/pictures.py: a PNG grid of frames, an animated GIF).  Whatever a figure cannot
+show -- a variant without data, an expression that fails, a non-positive value on a log axis,
+non-finite values -- is listed in its notes, never silently dropped.
 
 gnuplot draws in a scratch folder; each figure reaches reports/figures through files.py
 (a temporary file, then rename), so a killed report leaves it old or new, never cut.
@@ -33,12 +33,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import files
+from .. import files, pictures
 from ..children import options as child_options
 from ..compare import evaluate, evaluate_array
 from ..errors import EvalError, RunProblem
 from ..expressions import Siblings
-from .. import pictures
 from ..families import piles
 from ..final_state import state
 from . import network

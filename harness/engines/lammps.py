@@ -642,16 +642,17 @@ def wall_lines(scene, opts):
     moves = moving_walls(scene)
     for k, w in enumerate(scene.walls):
         side = wall_side(scene, w)
-        ex, ey = w.bx - w.ax, w.by - w.ay
-        length = math.hypot(ex, ey)
-        nx, ny = -ey / length * side, ex / length * side
+        (qx, qy), (ex, ey) = wall_line(scene, w)
+        nx, ny = -ey * side, ex * side
         motion = ""
         if w.name in moves:
             out += [f"variable        W{k}_dx equal 0.0", f"variable        W{k}_dy equal 0.0",
                     f"variable        W{k}_th equal 0.0"]
             px, py = pivot(scene, w)
-            motion = f" move v_W{k}_dx v_W{k}_dy NULL rotate v_W{k}_th {fmt(px)} {fmt(py)} 0.0 0.0 0.0 1.0"
-        out.append(f"region          W{k} plane {fmt(w.ax)} {fmt(w.ay)} 0.0 {fmt(nx)} {fmt(ny)} 0.0 "
+            motion = f" move v_W{k}_dx v_W{k}_dy NULL"
+            if w.name in turning_walls(scene):
+                motion += f" rotate v_W{k}_th {fmt(px)} {fmt(py)} 0.0 0.0 0.0 1.0"
+        out.append(f"region          W{k} plane {fmt(qx)} {fmt(qy)} 0.0 {fmt(nx)} {fmt(ny)} 0.0 "
                    f"side in units box{motion}")
         for m, mat in enumerate(mats):
             kn, ks, mu, delta = pair_law(scene, mat, w.material)
@@ -667,12 +668,32 @@ def wall_lines(scene, opts):
     return out
 
 
+def wall_line(scene, wall):
+    """A point of the wall's line and its unit direction e, as the core builds them (build.c):
+    a [wall] section's P and (cos alpha, sin alpha), alpha = angle pi/180; a generated wall's
+    end A and (B - A)/|B - A|."""
+    keys = scene.wall_sections.get(wall.name, {})
+    if "p" in keys and "angle" in keys:
+        px, py = (float(v) for v in keys["p"].split())
+        alpha = float(keys["angle"]) * (math.pi / 180)
+        return (px, py), (math.cos(alpha), math.sin(alpha))
+    ex, ey = wall.bx - wall.ax, wall.by - wall.ay
+    length = math.hypot(ex, ey)
+    return (wall.ax, wall.ay), (ex / length, ey / length)
+
+
 def pivot(scene, wall):
     keys = scene.wall_sections.get(wall.name, {})
     if "p" in keys:
         px, py = (float(v) for v in keys["p"].split())
         return px, py
     return wall.ax, wall.ay
+
+
+def turning_walls(scene):
+    """The walls some stage turns (a `move` with omega != 0): only they get a region rotation
+    (an unturned one would add its transform's round-off)."""
+    return {c.wall for s in scene.stages for c in s.controls if c.kind == "move" and c.numbers(3)[2] != 0}
 
 
 def moving_walls(scene):
@@ -780,7 +801,7 @@ def stage_lines(scene, opts, work):
 def motion_lines(scene, stage, moves):
     """At a stage's start: each moving wall's displacement and angle from where it is, at its
     velocity and spin in this stage (0 for a wall this stage does not name)."""
-    out = []
+    out, held = [], []
     dt = scene.dt
     for k, w in enumerate(scene.walls):
         if w.name not in moves:
@@ -790,11 +811,12 @@ def motion_lines(scene, stage, moves):
             if c.kind == "move" and c.wall == w.name:
                 v1, v2, om = c.numbers(3)
         for var, rate in (("dx", v1), ("dy", v2), ("th", om)):
-            out += [f"variable        W{k}_{var}0 equal $(v_W{k}_{var}:%.17g)",
-                    f"variable        W{k}_{var} equal \"v_W{k}_{var}0+{fmt(rate * dt)}*(step-v_start)\""]
-    if out:
-        out.insert(0, "variable        start equal $(step)")
-    return out
+            # where the wall is (read before start moves on), then this stage's motion from there
+            held += [f"variable        W{k}_{var}0 equal $(v_W{k}_{var}:%.17g)"]
+            out += [f"variable        W{k}_{var} equal \"v_W{k}_{var}0+{fmt(rate * dt)}*(step-v_start)\""]
+    if not out:
+        return []
+    return held + ["variable        start equal $(step)"] + out
 
 
 # ---------------------------------------------------------------------------------- reading back

@@ -55,7 +55,7 @@ import numpy as np
 from .. import REPO_ROOT, files
 from . import APPROXIMATE, EXACT, REFUSED, Engine, Plan
 from . import scene as scenes
-from .trajectory import Frame, Trajectory, contacts_of
+from .trajectory import Frame, Trajectory, concatenate, contacts_of, empty_contacts
 
 LMP = "lmp"
 # apt-get's command line for LAMMPS (a test gives another to see the skip path).
@@ -73,6 +73,10 @@ CAP_ROUNDOFF = 1e-9
 # The wall's plane is infinite, ballast's wall a segment: a contact point this far (relative
 # to the wall's length) beyond an end is a contact ballast would not have made.
 WALL_END_ROUNDOFF = 1e-9
+# Passes of start_lines()'s fixed-point iteration for v_0: each divides the error by at least
+# 1/(dt/2 |da/dv|) >= 2 at a stable step (dt/2 eta/m <= zeta dt omega/2 < 1/2 for the catalogue's
+# damping ratios zeta <= 0.5), so 60 passes leave 2^-60 of the first correction, below round-off.
+START_PASSES = 60
 SEED = 1                   # fix langevin's seed: at T = 0 its random force is 0 x random
 
 
@@ -158,7 +162,7 @@ def parse_frames(text):
         body = lines[head + 1:head + 1 + count]
         if len(body) != count or any(l.startswith("ITEM:") for l in body):
             raise ValueError(f"dump frame of step {step} is cut short: announced {count} rows")
-        data = np.array([l.split() for l in body], dtype=float).reshape(count, len(names))
+        data = np.array(" ".join(body).split(), dtype=float).reshape(count, len(names))
         out = {n: data[:, j] for j, n in enumerate(names)}
         out["_step"] = step
         frames.append(out)
@@ -732,13 +736,19 @@ def start_lines(scene, opts):
         out.append("compute         pl all pair/local dist force p1 p2 p3 p4")
     out.append("compute         pid all property/local patom1 patom2")
     if scene.setting("integrator") == "centred":
-        out += ["dump            start all custom 1 start.dump id c_pa[1] c_pa[2] c_pa[3]",
+        # v_0 solves v_0 + dt/2 a_0(v_0) = v_1/2, a_0 LAMMPS's forces at t = 0 with the velocities
+        # v_0 (dashpots of contacts that touch at the start, global damping's drag): a fixed-point
+        # iteration from v_0 = v_1/2, each a `run 0`; it contracts by dt/2 |da/dv| per pass.
+        out += [f"fix             half free store/state 0 vx vy omegaz",
+                f"variable        it loop {START_PASSES}", "label           startpass",
+                "dump            start all custom 1 start.dump id c_pa[1] c_pa[2] c_pa[3]",
                 "run             0", "undump          start",
-                "variable        v0x atom vx-0.5*dt*fx/mass",
-                "variable        v0y atom vy-0.5*dt*fy/mass",
-                "variable        w0 atom c_pa[1]-0.5*dt*c_pa[2]/(0.5*mass*c_pa[3]^2)",
+                "variable        v0x atom f_half[1]-0.5*dt*fx/mass",
+                "variable        v0y atom f_half[2]-0.5*dt*fy/mass",
+                "variable        w0 atom f_half[3]-0.5*dt*c_pa[2]/(0.5*mass*c_pa[3]^2)",
                 "velocity        free set v_v0x v_v0y NULL",
-                "set             group free omega 0.0 0.0 v_w0"]
+                "set             group free omega 0.0 0.0 v_w0",
+                "next            it", "jump            SELF startpass", "unfix           half"]
     return out
 
 
@@ -837,7 +847,33 @@ class Reader:
         self.power = scene.setting("normal_law") == "power"
         self.nu, self.delta0 = scene.number("nu"), scene.number("delta0")
         self.dt = scene.dt
+        # the pair laws as tables over material indices (pair_law: 2 k_a k_b/(k_a + k_b), ...)
+        names = list(scene.materials)
+        self.mat_index = np.array([names.index(m) for m in self.mat], dtype=int)
+        laws = [[pair_law(scene, p, q) for q in names] for p in names]
+        self.law_table = [np.array([[law[f] for law in row] for row in laws]) for f in range(4)]
         self.beyond = 0            # wall contacts found beyond a wall's end (beyond_end)
+        # theta_r of each touching pair, summed from the half-step spins of every step (only when
+        # the frames are every step: track_theta())
+        self.theta, self.theta_step = None, None
+
+    def track_theta(self):
+        self.theta, self.theta_step = {}, 0
+
+    def accumulate_theta(self, rows, hw, step):
+        """theta_r = sum of (omega_a - omega_b)_{N-1/2} dt since the contact formed (JYH eqs
+        12-13, as the core keeps it); a wall does not turn here (plan() refuses rolling
+        against a turning wall).  Frames must come every step, in order."""
+        if step != self.theta_step + 1:
+            raise RuntimeError(f"theta_r needs every step: frame {step} after {self.theta_step}")
+        now = {}
+        c = rows
+        for k in range(len(c["a"])):
+            key = (int(c["a"][k]), int(c["b"][k]), int(c["wall"][k]))
+            spin = hw[key[0]] - (0.0 if key[2] else hw[key[1]])
+            now[key] = self.theta.get(key, 0.0) + spin * self.dt
+            c["theta_r"][k] = now[key]
+        self.theta, self.theta_step = now, step
 
     def law(self, ma, mb):
         return pair_law(self.scene, ma, mb)
@@ -846,6 +882,9 @@ class Reader:
         if self.power and self.nu != 1.0:
             return kn * self.delta0 * (delta / self.delta0) ** self.nu
         return kn * delta
+
+    def mat_of_wall(self, wk):
+        return list(self.scene.materials).index(self.scene.walls[wk].material)
 
     def frame(self, atoms, pairs, walls, gfac):
         """A Frame from one atoms frame and one pairs frame (dicts of columns), the walls'
@@ -868,72 +907,78 @@ class Reader:
             if "y" in h:
                 hy[k] = 0.0
         vx, vy, w = (np.where(self.fixed, 0.0, v) for v in (vx, vy, w))
-        rows = (self.disc_contacts(pairs, x, y, (hx, hy, hw), (vx, vy, w))
-                + self.wall_contacts(A, x, y, hx, hy, hw, walls, step))
-        return Frame(step, step * self.dt, x, y, vx, vy, w, contacts_of(rows), walls, gfac)
+        discs = self.disc_contacts(pairs, x, y, (hx, hy, hw), (vx, vy, w))
+        contacts = concatenate(discs, contacts_of(self.wall_contacts(A, x, y, hx, hy, hw, walls, step)))
+        if self.theta is not None:
+            self.accumulate_theta(contacts, hw, step)
+        return Frame(step, step * self.dt, x, y, vx, vy, w, contacts, walls, gfac)
 
     def dashpots(self, kn, ks, mu, ndot, sdot):
         eta = self.gamma_n + self.beta * kn
         return eta * ndot, (self.beta * ks * sdot if mu > 0 else 0.0)
 
     def disc_contacts(self, pairs, x, y, half, whole):
-        """The disc-disc contacts of a pair/local frame.  LAMMPS applied its dashpots at the
-        half-step velocities (half); compute pair/local's single() recomputes the forces with
-        the dump's whole-step ones (whole), so the springs are its forces less the whole-step
-        dashpots, and the dashpots reported are the half-step ones, as applied."""
+        """The disc-disc contacts of a pair/local frame, as contact columns (trajectory.py).
+        LAMMPS applied its dashpots at the half-step velocities (half); compute pair/local's
+        single() recomputes the forces with the dump's whole-step ones (whole), so the springs
+        are its forces less the whole-step dashpots, and the dashpots reported are the
+        half-step ones, as applied."""
         hx, hy, hw = half
         vx, vy, w = whole
-        rows = []
-        if not pairs or "c_pid[1]" not in pairs:
-            return rows
+        if not pairs or "c_pid[1]" not in pairs or not len(pairs["c_pid[1]"]):
+            return empty_contacts()
         ii, jj = pairs["c_pid[1]"].astype(int) - 1, pairs["c_pid[2]"].astype(int) - 1
-        ncol = len([k for k in pairs if k.startswith("c_pl[")])
-        for k in range(len(ii)):
-            i, j = ii[k], jj[k]
-            a, b = min(i, j), max(i, j)
-            dx, dy = x[b] - x[a], y[b] - y[a]
-            dist = math.hypot(dx, dy)
-            delta = self.r[a] + self.r[b] - dist
-            if delta <= 0:
-                continue
-            ex, ey = dx / dist, dy / dist
-            kn, ks, mu, droll = self.law(self.mat[a], self.mat[b])
-            fn = self.elastic_normal(kn, delta)
-            # tangential force on atom i (p1, p2); on a: the same or its opposite
-            ftx, fty = pairs["c_pl[3]"][k], pairs["c_pl[4]"][k]
-            if i != a:
-                ftx, fty = -ftx, -fty
-            tx, ty = ey, -ex
-            ft_on_a = ftx * tx + fty * ty          # the force on a is -(fs + ds) t
-            rvx, rvy = hx[a] - hx[b], hy[a] - hy[b]
-            ndot = rvx * ex + rvy * ey
-            sdot = rvx * tx + rvy * ty - (hw[a] * self.r[a] + hw[b] * self.r[b])
-            dn, ds = self.dashpots(kn, ks, mu, ndot, sdot)
-            wvx, wvy = vx[a] - vx[b], vy[a] - vy[b]
-            _, ds_whole = self.dashpots(kn, ks, mu, 0.0, wvx * tx + wvy * ty - (w[a] * self.r[a] + w[b] * self.r[b]))
-            fn_total = abs(pairs["c_pl[2]"][k])
-            sliding = int(mu > 0 and abs(ft_on_a) >= mu * fn_total * (1 - CAP_ROUNDOFF) and abs(ft_on_a) > 0)
-            if sliding:
-                ds = ds_whole = 0.0
-            row = dict(a=a, b=b, wall=0, nx=ex, ny=ey, delta=delta,
-                       px=x[a] + (self.r[a] - delta / 2) * ex, py=y[a] + (self.r[a] - delta / 2) * ey,
-                       fn=fn, dn=dn, fs=-ft_on_a - ds_whole, ds=ds, sliding=sliding)
-            if droll > 0 and ncol >= 8:
-                # the rolling pseudo-force on i (p5, p6); the couple on i is R_eff (n x F_roll),
-                # n = (x_i - x_j)/|.|; ballast's couple on a is -(mr + md)
-                r_eff = self.r[a] * self.r[b] / (self.r[a] + self.r[b])
-                frx, fry = pairs["c_pl[7]"][k], pairs["c_pl[8]"][k]
-                nix, niy = (x[i] - x[j]) / dist, (y[i] - y[j]) / dist
-                couple_i = r_eff * (nix * fry - niy * frx)
-                couple_a = couple_i if i == a else -couple_i
-                mu_m = (self.gamma_n + self.beta * kn) * droll ** 2 / 3 * r_eff ** 2
-                md, md_whole = mu_m * (hw[a] - hw[b]), mu_m * (w[a] - w[b])
-                m0 = droll / 3 * r_eff * fn_total
-                at_cap = abs(couple_a) >= m0 * (1 - CAP_ROUNDOFF) and m0 > 0
-                row.update(mr=-couple_a - (0.0 if at_cap else md_whole), md=0.0 if at_cap else md,
-                           rolling=int(at_cap))
-            rows.append(row)
-        return rows
+        a, b = np.minimum(ii, jj), np.maximum(ii, jj)
+        r = self.r
+        dx, dy = x[b] - x[a], y[b] - y[a]
+        dist = np.hypot(dx, dy)
+        delta = r[a] + r[b] - dist
+        touch = delta > 0
+        if not np.any(touch):
+            return empty_contacts()
+        sel = lambda v: v[touch]
+        ii, jj, a, b, dx, dy, dist, delta = map(sel, (ii, jj, a, b, dx, dy, dist, delta))
+        col = {k: sel(v) for k, v in pairs.items() if k != "_step"}
+        ex, ey = dx / dist, dy / dist
+        tx, ty = ey, -ex
+        kn, ks, mu, droll = (t[self.mat_index[a], self.mat_index[b]] for t in self.law_table)
+        fn = self.elastic_normal(kn, delta)
+        flip = np.where(ii == a, 1.0, -1.0)            # p1, p2 are the tangential force on atom i
+        ft_on_a = flip * (col["c_pl[3]"] * tx + col["c_pl[4]"] * ty)    # on a: -(fs + ds) along t
+        rvx, rvy = hx[a] - hx[b], hy[a] - hy[b]
+        ndot = rvx * ex + rvy * ey
+        sdot = rvx * tx + rvy * ty - (hw[a] * r[a] + hw[b] * r[b])
+        eta = self.gamma_n + self.beta * kn
+        shear = mu > 0
+        dn = eta * ndot
+        ds = np.where(shear, self.beta * ks * sdot, 0.0)
+        wvx, wvy = vx[a] - vx[b], vy[a] - vy[b]
+        ds_whole = np.where(shear, self.beta * ks * (wvx * tx + wvy * ty - (w[a] * r[a] + w[b] * r[b])), 0.0)
+        fn_total = np.abs(col["c_pl[2]"])
+        sliding = shear & (np.abs(ft_on_a) >= mu * fn_total * (1 - CAP_ROUNDOFF)) & (np.abs(ft_on_a) > 0)
+        ds = np.where(sliding, 0.0, ds)
+        ds_whole = np.where(sliding, 0.0, ds_whole)
+        arm = r[a] - delta / 2
+        n = len(a)
+        out = {"a": a, "b": b, "wall": np.zeros(n, dtype=int), "nx": ex, "ny": ey, "delta": delta,
+               "px": x[a] + arm * ex, "py": y[a] + arm * ey, "fn": fn, "dn": dn,
+               "fs": -ft_on_a - ds_whole, "ds": ds, "sliding": sliding.astype(int),
+               "mr": np.zeros(n), "md": np.zeros(n), "theta_r": np.zeros(n), "rolling": np.zeros(n, dtype=int)}
+        if np.any(droll > 0) and "c_pl[8]" in col:
+            # the rolling pseudo-force on atom i (p5, p6); the couple on i is R_eff (n_i x F_roll),
+            # n_i = (x_i - x_j)/|.| = -flip e, and a gets flip times i's: R_eff (-e x F_roll)
+            r_eff = r[a] * r[b] / (r[a] + r[b])
+            frx, fry = col["c_pl[7]"], col["c_pl[8]"]
+            couple_a = r_eff * (-ex * fry + ey * frx)
+            mu_m = eta * droll ** 2 / 3 * r_eff ** 2
+            md, md_whole = mu_m * (hw[a] - hw[b]), mu_m * (w[a] - w[b])
+            m0 = droll / 3 * r_eff * fn_total
+            at_cap = (m0 > 0) & (np.abs(couple_a) >= m0 * (1 - CAP_ROUNDOFF))
+            roll = droll > 0
+            out["mr"] = np.where(roll, -couple_a - np.where(at_cap, 0.0, md_whole), 0.0)
+            out["md"] = np.where(roll & ~at_cap, md, 0.0)
+            out["rolling"] = (roll & at_cap).astype(int)
+        return out
 
     def wall_contacts(self, A, x, y, hx, hy, hw, walls, step):
         rows = []
@@ -1123,6 +1168,8 @@ def trajectory_of(scene, opts, work, log):
     reader = Reader(scene, opts)
     reader.stage_cycles = schedule
     reader.pivots = [pivot(scene, w) for w in scene.walls]
+    if any(m.rolling > 0 for m in scene.materials.values()) and int(float(scene.setting("output_every"))) == 1:
+        reader.track_theta()
     atoms = {f["_step"]: f for f in parse_frames((work / "atoms.dump").read_text())}
     pairs = {f["_step"]: f for f in parse_frames((work / "pairs.dump").read_text())}
     total = sum(c for _, c in schedule)

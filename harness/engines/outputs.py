@@ -64,6 +64,27 @@ class Laws:
         self.scene = scene
         self.power = scene.setting("normal_law") == "power"
         self.nu, self.delta0 = scene.number("nu"), scene.number("delta0")
+        names = list(scene.materials)
+        laws = [[self.pair(p, q) for q in names] for p in names]
+        # kn, ks, friction, rolling as tables over material indices; each disc's and wall's index
+        self.table = [np.array([[law[f] for law in row] for row in laws]) for f in range(4)]
+        self.disc_mat = (np.array([names.index(m) for m in scene.disc_material], dtype=int)
+                         if scene.disc_material is not None else None)
+        self.wall_mat = np.array([names.index(w.material) for w in scene.walls], dtype=int)
+
+    def of(self, contacts):
+        """(kn, ks, friction, rolling) arrays of every contact."""
+        a = self.disc_mat[contacts["a"]]
+        wall = contacts["wall"].astype(bool)
+        b = np.where(wall, self.wall_mat[np.where(wall, contacts["b"], 0)] if len(self.wall_mat) else 0,
+                     self.disc_mat[np.where(wall, 0, contacts["b"])])
+        return [t[a, b] for t in self.table]
+
+    def normal_energies(self, kn, fn, delta):
+        if not self.power:
+            return fn * fn / (2 * kn)
+        d0 = self.delta0
+        return np.where(delta > 0, kn * d0 * d0 * (np.maximum(delta, 0) / d0) ** (self.nu + 1) / (self.nu + 1), 0.0)
 
     def pair(self, ma, mb):
         A, B = self.scene.materials[ma], self.scene.materials[mb]
@@ -156,21 +177,22 @@ class Measure:
         return float(np.sum(0.5 * self.m * (f.vx ** 2 + f.vy ** 2) + 0.5 * self.inertia * f.omega ** 2))
 
     def elastic(self):
-        c, names = self.c, self.s.disc_material
-        e = 0.0
-        for k in range(len(c["a"])):
-            ma = names[c["a"][k]]
-            mb = self.s.walls[c["b"][k]].material if c["wall"][k] else names[c["b"][k]]
-            kn, ks, _, delta_roll = self.laws.pair(ma, mb)
-            e += self.laws.normal_energy(kn, c["fn"][k], c["delta"][k])
-            e += c["fs"][k] ** 2 / (2 * ks) if ks > 0 else 0.0
-            if delta_roll > 0:
-                ra = self.r[c["a"][k]]
-                common = 2 * ra if c["wall"][k] else 2 * ra * self.r[c["b"][k]] / (ra + self.r[c["b"][k]])
-                bw = delta_roll * common
-                km = kn * bw * bw / 12
-                e += c["mr"][k] ** 2 / (2 * km)
-        return float(e)
+        """The springs' energy (measure.c): normal, F_s^2/(2 k_s), M^2/(2 K_m), K_m = k_n B^2/12
+        with B = delta r, r the common radius (2 r1 r2/(r1 + r2); 2 r against a wall)."""
+        c = self.c
+        if not len(c["a"]):
+            return 0.0
+        kn, ks, _, droll = self.laws.of(c)
+        e = self.laws.normal_energies(kn, c["fn"], c["delta"])
+        e = e + np.where(ks > 0, c["fs"] ** 2 / (2 * np.where(ks > 0, ks, 1.0)), 0.0)
+        if np.any(droll > 0):
+            ra = self.r[c["a"]]
+            wall = c["wall"].astype(bool)
+            rb = np.where(wall, 1.0, self.r[np.where(wall, 0, c["b"])])
+            common = np.where(wall, 2 * ra, 2 * ra * rb / (ra + rb))
+            km = kn * (droll * common) ** 2 / 12
+            e = e + np.where(droll > 0, c["mr"] ** 2 / (2 * np.where(km > 0, km, 1.0)), 0.0)
+        return float(np.sum(e))
 
     def unbalanced(self):
         c = self.c

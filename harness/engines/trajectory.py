@@ -49,6 +49,11 @@ def contacts_of(rows):
     return out
 
 
+def concatenate(first, second):
+    """Two sets of contact columns as one."""
+    return {k: np.concatenate([first[k], second[k]]) for k in CONTACT_FIELDS}
+
+
 @dataclass
 class Frame:
     step: int

@@ -64,8 +64,9 @@ PEER = Path(__file__).resolve().parent / "peer"
 # module run with python3 -m, the files of harness/peer besides bin/ballast that decide its
 # outputs).
 PEER_COMMANDS = {
-    "peer": ("harness.peer.check", ("check.py", "common.py", "in.peer")),
-    "peer_rolling": ("harness.peer.rolling", ("rolling.py", "common.py", "in.peer_rolling")),
+    "peer": ("harness.peer.check", ("check.py", "common.py", "../engines/lammps.py", "../engines/scene.py")),
+    "peer_rolling": ("harness.peer.rolling", ("rolling.py", "common.py", "../engines/lammps.py",
+                                              "../engines/scene.py")),
 }
 
 

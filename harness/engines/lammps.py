@@ -47,7 +47,6 @@ import pickle
 import re
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -493,9 +492,19 @@ def granular_coeff(scene, kn, ks, mu, delta, r_eff=None):
         normal = f"hertz {fmt(kn / math.sqrt(scene.number('delta0') * r_eff))} {fmt(eta_n)}"
     out = f"{normal} tangential linear_history {fmt(ks)} {fmt(xgamma)} {fmt(mu)}"
     if delta > 0:
-        d2 = delta * delta
-        out += f" rolling sds {fmt(kn * d2 / 3)} {fmt(eta_n * d2 / 3)} {fmt(delta / 3)}"
+        roll = rolling_sds(delta, kn, eta_n)
+        out += f" rolling sds {fmt(roll['k_roll'])} {fmt(roll['gamma_roll'])} {fmt(roll['mu_roll'])}"
     return out + " damping velocity"
+
+
+def rolling_sds(delta, kn, mu_n=0.0):
+    """LAMMPS's `rolling sds k_roll gamma_roll mu_roll` of JYH's Model 1 with shape parameter
+    delta, normal stiffness kn and normal dashpot mu_n (docs/engines.md): JYH's common radius is
+    2 R_eff at every contact, B = 2 delta R_eff, so K_m = k_n B^2/12 = (k_n delta^2/3) R_eff^2,
+    M_0 = F_n B/6 = (delta/3) R_eff F_n and mu_m = mu_n B^2/12 = (mu_n delta^2/3) R_eff^2: the
+    same three numbers for every pair of radii and for flat walls."""
+    d2 = delta * delta
+    return {"k_roll": kn * d2 / 3, "gamma_roll": mu_n * d2 / 3, "mu_roll": delta / 3}
 
 
 def data_text(scene, opts):
@@ -526,10 +535,11 @@ def _ids(indices):
     return " ".join(str(i + 1) for i in indices)
 
 
-def translate(scene, opts, work=None):
+def translate(scene, opts, work=None, extra=()):
     """The LAMMPS input of a resolved scene (its data file: data_text()): the one translation.
     With opts.dumps, the run's dumps (atoms.dump, pairs.dump) at ballast's series rows, and a
-    stop rule's checks through harness/engines (work: where the context pickle is)."""
+    stop rule's checks through harness/engines (work: where the context pickle is); extra:
+    lines of the caller's own (computes, dumps: harness/peer) before the stages' runs."""
     d = scene.discs
     n = len(d["x"])
     held = scenes.held(scene)
@@ -572,6 +582,7 @@ def translate(scene, opts, work=None):
                   + ("0.0 NULL NULL" if axis == "x" else "NULL 0.0 NULL")]
     L.append("fix             plane all enforce2d")
     L += start_lines(scene, opts)
+    L += list(extra)
     L += stage_lines(scene, opts, work)
     return "\n".join(L) + "\n"
 
@@ -739,7 +750,7 @@ def start_lines(scene, opts):
         # v_0 solves v_0 + dt/2 a_0(v_0) = v_1/2, a_0 LAMMPS's forces at t = 0 with the velocities
         # v_0 (dashpots of contacts that touch at the start, global damping's drag): a fixed-point
         # iteration from v_0 = v_1/2, each a `run 0`; it contracts by dt/2 |da/dv| per pass.
-        out += [f"fix             half free store/state 0 vx vy omegaz",
+        out += ["fix             half free store/state 0 vx vy omegaz",
                 f"variable        it loop {START_PASSES}", "label           startpass",
                 "dump            start all custom 1 start.dump id c_pa[1] c_pa[2] c_pa[3]",
                 "run             0", "undump          start",
@@ -827,6 +838,21 @@ def motion_lines(scene, stage, moves):
     if not out:
         return []
     return held + ["variable        start equal $(step)"] + out
+
+
+def run_scene(lmp, ballast, scene_path, work, extra=(), sets=(), **options):
+    """A ballast scene file through the translation and LAMMPS, without the adapter's dumps (the
+    cross-checks of harness/peer add theirs as extra): resolved by the core in work, written as
+    work/data.lmp and work/in.lmp and run there; LAMMPS's log figures (parse_log).
+    RuntimeError naming the features LAMMPS cannot express, when the scene has any."""
+    scene = scenes.read(scene_path, sets)
+    scenes.resolve(scene, ballast, work)
+    plan = Lammps(lmp).plan(scene, "run", dumps=False, **options)
+    if plan.refused():
+        raise RuntimeError("; ".join(f.line() for f in plan.refused()))
+    opts = plan.options["lammps"]
+    files.write_text(Path(work) / "data.lmp", data_text(scene, opts))
+    return run_lmp(lmp, work, translate(scene, opts, work, extra))
 
 
 # ---------------------------------------------------------------------------------- reading back

@@ -34,7 +34,7 @@ from .. import families  # noqa: F401 -- registers every case family's expressio
 from ..compare import RunStore, evaluate_check, folder_locator
 from ..errors import Busy, CatalogueError, IniError
 from ..lock import reports_lock
-from ..runner import Job, jobs_for, run_all, sigterm_as_interrupt
+from ..runner import jobs_for, run_all, sigterm_as_interrupt
 from ..tables import read_run_json
 from . import engines
 
@@ -163,7 +163,7 @@ def markdown(rows, engine, title, realisations, totals):
     lines += ["| | " + " | ".join(sorted(set(totals["ballast"]) | set(totals["engine"]))) + " |"]
     keys = sorted(set(totals["ballast"]) | set(totals["engine"]))
     lines += ["|---|" + "---|" * len(keys)]
-    lines += [f"| ballast | " + " | ".join(str(totals["ballast"].get(k, 0)) for k in keys) + " |",
+    lines += ["| ballast | " + " | ".join(str(totals["ballast"].get(k, 0)) for k in keys) + " |",
               f"| {t} | " + " | ".join(str(totals["engine"].get(k, 0)) for k in keys) + " |", ""]
     lines += ["| case | checks | ballast | " + t + " | cost ballast (particle-steps, s) | cost " + t + " |",
               "|---|---|---|---|---|---|"]

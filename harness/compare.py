@@ -193,7 +193,7 @@ def _value(expr, run, sibling=None):
     try:
         with np.errstate(all="ignore"):
             return eval(code, {**names, "__builtins__": {}})  # noqa: S307 -- no builtins, vetted names
-    except EvalError:
+    except (EvalError, RunNotExpressible):
         raise
     except Exception as exc:  # any failure of the expression is a FAIL with its reason
         raise EvalError(f"'{expr}' raised {type(exc).__name__}: {exc}") from None

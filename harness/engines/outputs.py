@@ -405,7 +405,7 @@ def stress_text(scene, frame, measure):
 
 def write(scene, plan, trajectory, out, base, wall_seconds):
     """Every output file of the run into out, run.json last."""
-    out = Path(out)
+    out = files.make_dirs(out)
     laws, bodies = Laws(scene), Bodies(scene)
     skip = unexpressible_probes(scene)
     skip.update(plan.unexpressible)

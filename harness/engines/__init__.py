@@ -112,6 +112,13 @@ def make_run(engine, scene_path, sets, command, out, ballast):
         _write_info(out, dict(base, status="skipped", message=problem, steps=0, n_discs=0))
         return 0
     base["engine_version"] = engine.version()
+    if command not in ("run", "exact"):
+        # harness/peer's cross-checks: ballast against LAMMPS already, with no scene of their own
+        message = (f"not expressible in {engine.title}: command {command}: the case is itself a "
+                   "cross-check of ballast against LAMMPS (harness/peer), whose runs are of both "
+                   "engines; it has no scene of its own to translate")
+        _write_info(out, dict(base, status="not_expressible", message=message, steps=0, n_discs=0))
+        return 0
     scene = scenes.read(scene_path, sets)
     scenes.resolve(scene, ballast, out / "work")
     plan = engine.plan(scene, command)

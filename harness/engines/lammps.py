@@ -76,6 +76,12 @@ WALL_END_ROUNDOFF = 1e-9
 # 1/(dt/2 |da/dv|) >= 2 at a stable step (dt/2 eta/m <= zeta dt omega/2 < 1/2 for the catalogue's
 # damping ratios zeta <= 0.5), so 60 passes leave 2^-60 of the first correction, below round-off.
 START_PASSES = 60
+# The adapter reads a run through dumps of every disc and contact at each series row: at most this
+# many disc-rows (about 100 MB of dumps with their contacts) before the rows are thinned (plan()).
+DUMP_BUDGET = 1e6
+# How many checks a stop rule is taken to need when the rows are thinned (the piles come to rest
+# within 7-30 checks of 500 cycles in ballast; the count only sets the thinning, not the run).
+STOP_CHECKS_GUESS = 20
 SEED = 1                   # fix langevin's seed: at T = 0 its random force is 0 x random
 
 
@@ -221,6 +227,7 @@ class Options:
         self.binsize, self.nsq, self.dumps = binsize, nsq, dumps
         self.sort_every, self.sort_binsize = sort_every, sort_binsize
         self.alpha = scene.number("alpha")
+        self.every = int(float(scene.setting("output_every")))     # the dumps' row spacing (plan())
         self.scale = 1 + self.alpha * scene.dt / 2                       # s = 1 + alpha dt/2
         keys = []
         for k, mat in enumerate(scene.disc_material):
@@ -379,8 +386,21 @@ class Lammps(Engine):
             plan.add(f"{len(opts.types)} atom types", REFUSED,
                      f"more than {MAX_TYPES} (material, radius) classes for per-pair Hertz coefficients")
         plan.options["lammps"] = opts
+        n = len(scene.discs["x"])
+        # a stage a stop rule may end early counts as STOP_CHECKS_GUESS checks of its rule
+        cycles = sum(min(st.cycles, STOP_CHECKS_GUESS * int(float(st.keys["check_every"])))
+                     if _stop_rule(st) else st.cycles for st in scene.stages)
+        rows = cycles / opts.every
+        if n * rows > DUMP_BUDGET:
+            thin = math.ceil(n * rows / DUMP_BUDGET)
+            opts.every *= thin
+            plan.add(f"series rows every {opts.every // thin} cycles", APPROXIMATE,
+                     f"written every {opts.every} cycles (and at each stage's end) instead: the adapter "
+                     f"reads LAMMPS's state through dumps of every disc and contact, and {n} discs x "
+                     f"{rows:.0f} rows is more than {DUMP_BUDGET:.0e} disc-rows; a check over the whole "
+                     "series sees these rows, one of its last row or final state the same")
         if rolling:
-            every = int(float(scene.setting("output_every")))
+            every = opts.every
             for p in scene.probes:
                 if p.quantity == "contact_theta_r" and every != 1:
                     plan.unexpressible[p.name] = ("theta_r is summed from the spins of every step; "
@@ -445,7 +465,12 @@ class Lammps(Engine):
             pickle.dump({"scene": scene, "options": opts}, f)
         text = translate(scene, opts, work)
         log = run_lmp(self.lmp, work, text)
-        return trajectory_of(scene, opts, work, log)
+        trajectory = trajectory_of(scene, opts, work, log)
+        if not os.environ.get("BALLAST_KEEP_DUMPS"):
+            # read whole into the run's files; the dumps are the bulk of a run folder
+            for name in ("atoms.dump", "pairs.dump", "start.dump"):
+                (work / name).unlink(missing_ok=True)
+        return trajectory
 
 
 def _sha256(path):
@@ -771,7 +796,7 @@ def stage_lines(scene, opts, work):
     """One run per stage (a stage with a stop rule: runs of check_every steps, the rule checked
     after each), the walls' motion redefined at each stage's start, and the dumps at ballast's
     series rows: every output_every steps and at each run's end."""
-    every = int(float(scene.setting("output_every")))
+    every = opts.every
     out = []
     if opts.dumps:
         out += ["variable        chunkend equal 0",
@@ -1099,10 +1124,10 @@ def gfac_at(scene, schedule, step):
     return 1.0
 
 
-def row_steps(scene, schedule):
-    """The cycles of ballast's series rows (sim.c): every output_every-th, each stage's last
-    (or the one its stop rule ended it at) when it has output_at_end or is the last stage."""
-    every = int(float(scene.setting("output_every")))
+def row_steps(scene, schedule, every):
+    """The cycles of ballast's series rows (sim.c): every `every`-th (output_every, or the
+    plan's thinned spacing), each stage's last (or the one its stop rule ended it at) when it
+    has output_at_end or is the last stage."""
     total = sum(c for _, c in schedule)
     rows = set(range(every, total + 1, every))
     n0 = 0
@@ -1194,13 +1219,13 @@ def trajectory_of(scene, opts, work, log):
     reader = Reader(scene, opts)
     reader.stage_cycles = schedule
     reader.pivots = [pivot(scene, w) for w in scene.walls]
-    if any(m.rolling > 0 for m in scene.materials.values()) and int(float(scene.setting("output_every"))) == 1:
+    if any(m.rolling > 0 for m in scene.materials.values()) and opts.every == 1:
         reader.track_theta()
     atoms = {f["_step"]: f for f in parse_frames((work / "atoms.dump").read_text())}
     pairs = {f["_step"]: f for f in parse_frames((work / "pairs.dump").read_text())}
     total = sum(c for _, c in schedule)
     frames = []
-    wanted = row_steps(scene, schedule)
+    wanted = row_steps(scene, schedule, opts.every)
     missing = [s for s in wanted if s not in atoms]
     if missing:
         raise RuntimeError(f"LAMMPS wrote no state at cycle(s) {missing[:5]} of the series rows")

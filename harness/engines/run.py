@@ -23,7 +23,8 @@ def main(argv=None):
     ap.add_argument("--engine", required=True, choices=sorted(engines()))
     ap.add_argument("--scene", required=True, type=Path)
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
-    ap.add_argument("--command", default="run", choices=("run", "exact"))
+    ap.add_argument("--command", default="run",
+                    help="the variant's command: run, exact, or a cross-check's (peer, peer_rolling)")
     ap.add_argument("--out", required=True, type=Path)
     ap.add_argument("--ballast", type=Path, default=REPO_ROOT / "bin" / "ballast",
                     help="the core that resolves the scene's initial state (default bin/ballast)")

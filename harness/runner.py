@@ -52,6 +52,7 @@ from pathlib import Path
 
 from . import files
 from .children import options as child_options
+from .engines.driver import engines
 from .errors import RunProblem, Stopped, WriteError
 from .tables import read_harness_record, read_run_json, run_failure, skip_reason, unfinished_outputs
 
@@ -337,7 +338,6 @@ def engine_identity(name):
     """What decides another engine's outputs besides the scene (its executable, the adapter's
     files: harness/engines), once per engine and process."""
     if name not in _ENGINE_IDS:
-        from .engines import engines
         known = engines()
         _ENGINE_IDS[name] = known[name]().identity() if name in known else {"unknown engine": name}
     return _ENGINE_IDS[name]

@@ -52,7 +52,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import REPO_ROOT, files
-from . import APPROXIMATE, EXACT, REFUSED, Engine, Plan
+from .interface import APPROXIMATE, EXACT, REFUSED, Engine, Plan
+from .outputs import Bodies, Laws, Measure
 from . import scene as scenes
 from .trajectory import Frame, Trajectory, concatenate, contacts_of, empty_contacts
 
@@ -1158,7 +1159,6 @@ def stop_check(work, stage):
     The rule is the core's (sim.c, stop_rule_met): E_k <= stop_ke E_el, the disc stresses'
     largest change since the last check <= stop_stress of the largest (never at the first
     check), the unbalanced-force ratio <= stop_unbalanced."""
-    from .outputs import Bodies, Laws, Measure
     work = Path(work)
     state = _STOP_STATE.get(str(work))
     if state is None:

@@ -36,7 +36,7 @@ from ..errors import Busy, CatalogueError, IniError
 from ..lock import reports_lock
 from ..runner import jobs_for, run_all, sigterm_as_interrupt
 from ..tables import read_run_json
-from . import engines
+from .driver import engines
 
 DEFAULT_REALISATIONS = 10     # per ensemble in the matrix (docs/engines.md: the full ones in the full tier)
 

@@ -15,7 +15,7 @@ import traceback
 from pathlib import Path
 
 from .. import REPO_ROOT, files
-from . import engines, make_run
+from .driver import engines, make_run
 
 
 def main(argv=None):

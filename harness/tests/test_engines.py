@@ -16,8 +16,9 @@ import pytest
 
 from harness import final_state
 from harness.compare import RunStore, evaluate_check, folder_locator
-from harness.engines import APPROXIMATE, EXACT, REFUSED, Engine, Plan, make_run
 from harness.engines import lammps, outputs, scene as scenes
+from harness.engines.driver import make_run
+from harness.engines.interface import APPROXIMATE, EXACT, REFUSED, Engine, Plan
 from harness.engines.trajectory import Frame, Trajectory, contacts_of
 from harness.references import Check
 from harness.tables import load_run

@@ -13,7 +13,7 @@ import pytest
 import harness.families  # noqa: F401 -- the expression functions the collision checks use
 from harness import catalogue, references
 from harness.compare import RunStore, evaluate_check, folder_locator
-from harness.engines import make_run
+from harness.engines.driver import make_run
 from harness.engines import matrix
 from harness.engines.lammps import Lammps
 from harness.tables import read_series

@@ -20,7 +20,6 @@ in run.json's `unexpressible`, so a check that reads one is "not expressible" (c
 """
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 

@@ -12,7 +12,8 @@ another engine, gated by the same references, side by side (`make validate-peers
 3. every check of those cases (reference/*.ref) evaluated on each engine's runs
    (compare.evaluate_check): PASS, FAIL, KNOWN, SKIP, or for the engine NOT EXPRESSIBLE;
 4. reports/peers/index.md, index.html and matrix.json: per case its cost in each engine
-   (particle-steps, seconds), then check by check both verdicts and values.
+   (particle-steps, seconds), then check by check both verdicts and values.  Given case names,
+   only their part of an existing matrix is replaced.
 
 Ensembles: --realisations N runs the first N seeds of every [ensemble] in both engines and
 evaluates the ensemble checks over those N in both (stated in the report); 0 runs them all.
@@ -256,6 +257,22 @@ def json_safe(x):
     return x
 
 
+def merged(rows, engine, out_dir):
+    """rows with the other cases of the matrix already in out_dir (of the same engine) kept, in
+    the catalogue's order: a run of some cases updates their part of the matrix only."""
+    try:
+        old = json.loads((Path(out_dir) / "matrix.json").read_text())
+    except (OSError, ValueError):
+        return rows
+    if old.get("engine") != engine:
+        return rows
+    order = [c.name for c in catalogue.load(cases_root())]
+    mine = {r["case"]: r for r in rows}
+    kept = {r["case"]: r for r in old.get("cases", []) if r.get("case") not in mine}
+    both = {**kept, **mine}
+    return sorted(both.values(), key=lambda r: order.index(r["case"]) if r["case"] in order else len(order))
+
+
 def write(rows, engine, title, realisations, out_dir):
     totals = {"ballast": {}, "engine": {}}
     for r in rows:
@@ -305,6 +322,8 @@ def main(argv=None):
             mine = [c for c in mine if all(v in members[c.case] for v in c.run_variants)]
             triples = evaluate(mine, cases, runs, engine_runs)
             rows = rows_of(cases, triples, runs, engine_runs, a.engine)
+            if a.cases:
+                rows = merged(rows, a.engine, peers_root())
             totals = write(rows, a.engine, engine.title, a.realisations, peers_root())
             print(f"validate-peers: ballast {tally_text_dict(totals['ballast'])}; "
                   f"{engine.title} {tally_text_dict(totals['engine'])}")

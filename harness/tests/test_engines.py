@@ -249,3 +249,23 @@ def test_a_trajectory_comes_back_through_ballasts_readers_with_ballasts_conventi
     v = 2 * math.sqrt(3) * 50 ** 2
     assert stress.numbers("sxx")[1] == pytest.approx(-(1e8 + 5) * 49.95 / v, rel=1e-14)
     assert stress.numbers("szz")[1] == pytest.approx((2.0 + 1.0) * 0.0, abs=1e-6)
+
+
+def test_a_matrix_of_some_cases_replaces_only_their_rows(tmp_path):
+    from harness.engines import matrix
+
+    def row(case, result):
+        return {"case": case, "title": case, "tier": "quick", "not_expressible": {},
+                "ballast": {"particle_steps": 1.0, "seconds": 1.0, "runs": 1, "variants": 1},
+                "engine": {"particle_steps": 1.0, "seconds": 2.0, "runs": 1, "variants": 1},
+                "checks": [{"check": "c", "variant": "v", "quantity": "q", "reference": 1.0,
+                            "tolerance": "rel 1", "kind": "analytic",
+                            "ballast": {"result": "PASS", "value": 1.0, "message": ""},
+                            "engine": {"result": result, "value": None, "message": "why"}}]}
+    out = tmp_path / "peers"
+    matrix.write([row("collisions", "PASS"), row("two_discs", "FAIL")], "lammps", "LAMMPS", 0, out)
+    rows = matrix.merged([row("two_discs", "NOT EXPRESSIBLE")], "lammps", out)
+    assert [r["case"] for r in rows] == ["collisions", "two_discs"]           # the catalogue's order
+    totals = matrix.write(rows, "lammps", "LAMMPS", 0, out)
+    assert totals["engine"] == {"PASS": 1, "NOT EXPRESSIBLE": 1} and totals["ballast"] == {"PASS": 2}
+    assert matrix.merged([row("two_discs", "PASS")], "other", out) == [row("two_discs", "PASS")]

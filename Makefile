@@ -10,6 +10,8 @@
 #   make test-slurm   harness export through a one-node Slurm on localhost (installs Slurm, MUNGE)
 #   make bench        dense-packing benchmark (median and spread of 5 repeats)
 #   make bench-peer   ballast against LAMMPS on the same physics (cross-check, then the race)
+#   make validate-peers  the catalogue through LAMMPS too, gated by the same references (reports/peers/)
+#   make test-peers   the engine adapters' tests with LAMMPS (installs it)
 #   make bench-flat   the 1 000 000- against the 20 000-disc rate, alternating in one process
 #   make bench-threads  2 OpenMP threads against 1 on the settled packing (20 000, 320 000 discs)
 #   make bench-cost   the cost model: per phase and particle-step, counts, bytes, cycles; the machine
@@ -39,7 +41,7 @@ BENCH_SRC := core/bench/bench.c
 .PHONY: all deps vtk-deps test test-c test-prefix test-py test-sanitize test-browser validate gate bench bench-scaling \
         bench-peer bench-modules bench-modules-count bench-scaling-count bench-flat bench-threads bench-cost bench-piles-poly \
         clean keys sweep \
-        test-valgrind test-slurm
+        test-valgrind test-slurm validate-peers test-peers
 
 all: deps bin/ballast
 
@@ -161,6 +163,23 @@ gate: all
 # (validate runs them too, between the gate and the report; `harness report` draws them).
 sweep: all
 	$(PYTHON) -m harness cost --tier $(TIER) -j $(JOBS)
+
+# The agreement matrix (issue 34, docs/engines.md): every case of TIER through ballast and LAMMPS,
+# each check evaluated on both engines' runs, side by side with their costs, in reports/peers/
+# (linked from the report).  LAMMPS is installed with apt-get when `lmp` is missing.  Not part of
+# validate or test.  RESUME=1 keeps the LAMMPS runs already made (ballast's identical runs are
+# always kept); REALISATIONS=N runs N realisations of each [ensemble] in both engines (default
+# 10; 0 for all, the full tier's); CASES="a b" those cases only.
+REALISATIONS ?= 10
+validate-peers: all
+	$(PYTHON) -m harness.engines.matrix --tier $(TIER) -j $(JOBS) --realisations $(REALISATIONS) \
+	  $(RESUME_FLAG) $(CASES)
+
+test-peers: all
+	@command -v lmp >/dev/null || $(PYTHON) -c "from harness.engines.lammps import lammps_problem; \
+	  import sys; p = lammps_problem(); sys.exit('test-peers: ' + p if p else 0)"
+	$(PYTHON) -m pytest -q harness/tests/test_engines_lammps.py harness/tests/test_engines.py \
+	  harness/tests/test_peer.py harness/tests/test_peer_rolling.py
 
 # ---- benchmark ------------------------------------------------------------
 $(BUILD)/bench: $(BENCH_SRC) $(BUILD)/libballast.a

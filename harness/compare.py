@@ -9,7 +9,8 @@ module knows no family: it asks the registry.  evaluate_check() turns one Check 
 anything that goes wrong (missing output, failed run, missing column, an expression that
 raises, a NaN/inf value) is a FAIL whose message says which, never a pass and never a skip.
 The one SKIP: a run that could not be made and says why (RunSkipped: a cross-check against
-LAMMPS where LAMMPS is absent and cannot be installed).
+LAMMPS where LAMMPS is absent and cannot be installed).  A check that reads a run another
+engine could not express (RunNotExpressible, harness/engines) is NOT EXPRESSIBLE, with why.
 evaluate_array() gives a figure (report/plots.py) an expression's whole row of numbers.
 """
 import ast
@@ -19,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import EvalError, RunProblem, RunSkipped
+from .errors import EvalError, RunNotExpressible, RunProblem, RunSkipped
 from .expressions import Siblings, functions
 from .tables import load_run
 
@@ -39,11 +40,15 @@ class Verdict:
     message: str
     skipped: bool = False  # SKIP: its run could not be made (passed is False, message says why)
     known: str = ""        # KNOWN: outside its tolerance, as reference/ says it is (the reason)
+    unexpressible: str = ""  # a run it reads is one another engine could not express (why)
 
     @property
     def result(self):
         """PASS, FAIL, SKIP or KNOWN (a documented discrepancy with a paper: neither passes nor
-        fails the gate, and is shown with its reason)."""
+        fails the gate, and is shown with its reason); NOT EXPRESSIBLE for a run of another
+        engine that could not express the scene (harness/engines)."""
+        if self.unexpressible:
+            return "NOT EXPRESSIBLE"
         return "SKIP" if self.skipped else "KNOWN" if self.known else "PASS" if self.passed else "FAIL"
 
     def as_dict(self):
@@ -58,13 +63,15 @@ class Verdict:
             out["skip"] = True
         if self.known:
             out["known"] = self.known
+        if self.unexpressible:
+            out["not_expressible"] = self.unexpressible
         return out
 
     @classmethod
     def from_dict(cls, d):
         return cls(d["case"], d["variant"], d["check"], d["quantity"], d["value"], d["reference"],
                    d["tolerance"], d["kind"], d["provenance"], d["pass"], d["message"],
-                   bool(d.get("skip", False)), d.get("known", ""))
+                   bool(d.get("skip", False)), d.get("known", ""), d.get("not_expressible", ""))
 
 
 def _json_number(x):
@@ -162,14 +169,31 @@ def _unknown_name(name, is_call, names):
     return f"column '{name}' missing from series.tsv (columns: {columns})"
 
 
+def _refuse_unexpressible(expr, run):
+    """A run of another engine lists in run.json `unexpressible` the columns and functions it
+    cannot give ({name: why}, harness/engines/outputs.py): an expression using one is not
+    expressible in that engine (RunNotExpressible), not a missing column."""
+    refused = run.info.get("unexpressible") if isinstance(run.info, dict) else None
+    if not refused:
+        return
+    try:
+        used = {n.id for n in ast.walk(ast.parse(expr, mode="eval")) if isinstance(n, ast.Name)}
+    except SyntaxError:
+        return
+    hit = sorted(used & set(refused))
+    if hit:
+        raise RunNotExpressible(f"{hit[0]}: {refused[hit[0]]}")
+
+
 def _value(expr, run, sibling=None):
     """The expression's value in run's outputs, whatever it is."""
+    _refuse_unexpressible(expr, run)
     names = namespace(run, sibling)
     code = _compile(expr, names, run.columns)
     try:
         with np.errstate(all="ignore"):
             return eval(code, {**names, "__builtins__": {}})  # noqa: S307 -- no builtins, vetted names
-    except EvalError:
+    except (EvalError, RunNotExpressible):
         raise
     except Exception as exc:  # any failure of the expression is a FAIL with its reason
         raise EvalError(f"'{expr}' raised {type(exc).__name__}: {exc}") from None
@@ -295,9 +319,11 @@ def quantity_text(check):
 def evaluate_check(check, store):
     """The Verdict of one check; any problem is a FAIL with its reason, but a run that could
     not be made (RunSkipped) makes it a SKIP with that run's reason."""
-    skipped = False
+    skipped, unexpressible = False, ""
     try:
         value, passed, message = JUDGES[check.tolerance](check, store)
+    except RunNotExpressible as exc:
+        value, passed, message, unexpressible = None, False, str(exc), str(exc)
     except RunSkipped as exc:
         value, passed, message, skipped = None, False, str(exc), True
     except (RunProblem, EvalError) as exc:
@@ -313,7 +339,8 @@ def evaluate_check(check, store):
     return Verdict(case=check.case, variant=check.variant_label, check=check.name,
                    quantity=quantity_text(check), value=value, reference=reference_of(check),
                    tolerance=check.tolerance_text, kind=check.kind, provenance=check.provenance,
-                   passed=bool(passed), message=message, skipped=skipped, known=known)
+                   passed=bool(passed), message=message, skipped=skipped, known=known,
+                   unexpressible=unexpressible)
 
 
 def evaluate_all(checks, store):

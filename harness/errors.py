@@ -55,6 +55,12 @@ class RunSkipped(RunProblem):
     FAIL (RunProblem)."""
 
 
+class RunNotExpressible(RunProblem):
+    """A run another engine could not make because the scene uses something that engine cannot
+    express (run.json status 'not_expressible', harness/engines): every check that reads it is
+    "not expressible in ENGINE", never a PASS, a FAIL or a SKIP."""
+
+
 class EvalError(Exception):
     """A quantity could not be evaluated to one finite number."""
 

@@ -27,7 +27,7 @@ refuses a clash at once, not at the first evaluation.
 """
 import numpy as np
 
-from .errors import EvalError, RunProblem
+from .errors import EvalError, RunNotExpressible, RunProblem
 
 # ---------------------------------------------------------------- the language's own
 
@@ -175,10 +175,13 @@ def ensemble_members(sibling, name, fname):
 
 def sibling_run(sibling, variant, fname):
     """The Run of another variant, for a family's function fname; EvalError when there are no
-    siblings here or that variant's run cannot be used."""
+    siblings here or that variant's run cannot be used (RunNotExpressible goes on as it is: a
+    run another engine could not express makes the check reading it not expressible)."""
     if sibling is None:
         raise EvalError(f"{fname}(): no other variants are available here")
     try:
         return sibling(variant)
+    except RunNotExpressible:
+        raise
     except RunProblem as problem:
         raise EvalError(f"{fname}(): variant '{variant}': {problem}") from None

@@ -52,6 +52,7 @@ from pathlib import Path
 
 from . import files
 from .children import options as child_options
+from .engines.driver import engines
 from .errors import RunProblem, Stopped, WriteError
 from .tables import (read_harness_record, read_run_json, removed_tables, run_failure, skip_reason,
                      unfinished_outputs)
@@ -66,8 +67,9 @@ PEER = Path(__file__).resolve().parent / "peer"
 # module run with python3 -m, the files of harness/peer besides bin/ballast that decide its
 # outputs).
 PEER_COMMANDS = {
-    "peer": ("harness.peer.check", ("check.py", "common.py", "in.peer")),
-    "peer_rolling": ("harness.peer.rolling", ("rolling.py", "common.py", "in.peer_rolling")),
+    "peer": ("harness.peer.check", ("check.py", "common.py", "../engines/lammps.py", "../engines/scene.py")),
+    "peer_rolling": ("harness.peer.rolling", ("rolling.py", "common.py", "../engines/lammps.py",
+                                              "../engines/scene.py")),
 }
 
 
@@ -120,6 +122,14 @@ def jobs_for(cases, runs_root):
 
 def command(job, binary):
     """The core's command line for a job."""
+    if ":" in job.command:
+        # A run of another engine (harness/engines), command ENGINE:COMMAND: the adapter, run from
+        # the run's folder (hence PYTHONPATH), with the core resolving the scene's initial state.
+        engine, what = job.command.split(":", 1)
+        root = PEER.parent.parent
+        return (["/usr/bin/env", f"PYTHONPATH={root}", "/usr/bin/python3", "-m", "harness.engines.run",
+                 "--engine", engine, "--command", what, "--scene", str(job.scene), "--out", str(job.out),
+                 "--ballast", str(binary)] + [a for kv in job.sets for a in ("--set", kv)])
     if job.command in PEER_COMMANDS:
         # A cross-code check against LAMMPS: a module of harness/peer, not the core, run from
         # the run's folder (hence PYTHONPATH) on the repository's bin/ballast, as identity() says.
@@ -320,6 +330,8 @@ def identity(job, binary, binary_id, inputs=None):
     bin/ballast: the hashes of the files it reads (PEER_COMMANDS) and of bin/ballast."""
     ident = {"command": job.command, "scene": str(job.scene), "scene_sha256": sha256_of(job.scene),
              "sets": list(job.sets), "binary": binary_id}
+    if ":" in job.command:
+        ident["engine"] = engine_identity(job.command.split(":", 1)[0])
     if job.command in PEER_COMMANDS:
         root = PEER.parent.parent
         ident["binary"] = {str(p): sha256_of(p) for p in
@@ -328,6 +340,18 @@ def identity(job, binary, binary_id, inputs=None):
     else:
         ident["inputs"] = (inputs or Inputs()).digests(binary, job.scene, job.sets)
     return ident
+
+
+_ENGINE_IDS = {}
+
+
+def engine_identity(name):
+    """What decides another engine's outputs besides the scene (its executable, the adapter's
+    files: harness/engines), once per engine and process."""
+    if name not in _ENGINE_IDS:
+        known = engines()
+        _ENGINE_IDS[name] = known[name]().identity() if name in known else {"unknown engine": name}
+    return _ENGINE_IDS[name]
 
 
 def inputs_change(before, now):

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import RunProblem, RunSkipped
+from .errors import RunNotExpressible, RunProblem, RunSkipped
 
 
 @dataclass
@@ -117,10 +117,19 @@ def skip_reason(info):
     return info.get("message") or "no reason given"
 
 
+def not_expressible(info):
+    """What another engine could not express of the run's scene, when its run.json says so
+    (status 'not_expressible', harness/engines), else None."""
+    if info.get("status") != "not_expressible":
+        return None
+    return info.get("message") or "no reason given"
+
+
 def run_failure(folder, info):
     """Why a run that wrote run.json still failed, or None when it succeeded (a skipped run
-    did not fail: its checks are SKIP, see load_run)."""
-    if info.get("status") not in ("ok", "skipped"):
+    did not fail: its checks are SKIP, see load_run; nor did one another engine could not
+    express: its checks say so)."""
+    if info.get("status") not in ("ok", "skipped", "not_expressible"):
         message = info.get("message") or "no message"
         return f"run failed: status '{info.get('status')}': {message} ({folder})"
     record = read_harness_record(folder)
@@ -135,6 +144,9 @@ EXPECTED_OUTPUTS = {"run": ("series.tsv", "stress.tsv", "contacts.tsv", "discs.t
                     "exact": ("series.tsv", "contacts.tsv", "discs.tsv", "walls.tsv", "run.json"),
                     "peer": ("series.tsv", "run.json"),
                     "peer_rolling": ("series.tsv", "run.json")}
+# A run of another engine (command ENGINE:COMMAND, harness/engines): run.json always; the rest
+# when it says 'ok' (load_run reads series.tsv; one that could not be expressed has no more).
+ENGINE_OUTPUTS = ("run.json",)
 
 
 def unfinished_outputs(folder, command=None, record=None):
@@ -151,8 +163,8 @@ def unfinished_outputs(folder, command=None, record=None):
     if leftovers:
         return f"unfinished outputs: {', '.join(leftovers)} left behind ({folder})"
     removed = ((record or {}).get("compacted") or {}).get("removed") or {}
-    missing = [n for n in EXPECTED_OUTPUTS.get(command, ())
-               if not present(folder / n) and n not in removed]
+    expected = EXPECTED_OUTPUTS.get(command, ENGINE_OUTPUTS if command and ":" in command else ())
+    missing = [n for n in expected if not present(folder / n) and n not in removed]
     if missing:
         return f"unfinished outputs: {', '.join(missing)} missing ({folder})"
     return ""
@@ -184,6 +196,9 @@ def load_run(folder):
                or unfinished_outputs(folder, record.get("kind") if record else None, record))
     if failure:
         raise RunProblem(failure)
+    refused = not_expressible(info)
+    if refused:
+        raise RunNotExpressible(refused)
     skipped = skip_reason(info)
     if skipped:
         raise RunSkipped(f"skipped: {skipped} ({folder})")

@@ -4,7 +4,8 @@
 
 A small fill of cases/bench/dense.scene (300 discs on the lattice, with the
 scene's random velocities, nothing touching) is written out disc by disc as a
-ballast scene and as a LAMMPS data file (harness/peer/common.py).  Both codes
+ballast scene (harness/peer/common.py), which ballast runs and the harness's
+translation (harness/engines/lammps.py) turns into LAMMPS's data file and input.  Both codes
 run the same 400 steps with gravity, three times: frictionless, with friction
 0.5, and with friction and half the time step.  The final positions,
 velocities, per-disc forces and torques, and every disc-disc contact's f_n and
@@ -23,10 +24,9 @@ import sys
 from pathlib import Path
 
 from .. import files
-from .common import (DENSITY, FIGURES, G, KN, KT, MU, TEMPLATE, ballast_scene, check_state,
-                     check_verdict, code_arguments, codes_of, compare, lammps_data, lammps_input,
-                     lammps_problem, parse_dump, run_ballast, run_lammps, skip_outputs,
-                     write_outputs)
+from .common import (FIGURES, MU, ballast_scene, check_state, check_verdict, code_arguments,
+                     codes_of, compare, lammps_problem, parse_dump, run_ballast, run_lammps,
+                     skip_outputs, write_outputs)
 
 # Three runs of the same 300 discs for CHECK_STEPS steps (see docs/benchmarks.md,
 # bench-peer, for the measured values):
@@ -53,6 +53,9 @@ TOL_FRICTION = dict(max_dx=1e-6, max_dv=2e-5, max_dF=1e-5, max_dT=1e-5, max_dfn=
                     max_dfs=1e-5)
 TOL_RATIO = 0.7
 
+# LAMMPS's neighbour settings of the cross-check (any would do: the physics does not depend
+# on them): skin 0.25, atoms sorted every 1000 steps.
+CHECK_NEIGHBOURS = dict(skin=0.25, sort_every=1000)
 CHECK_OUTPUT = """compute         pairs all pair/local dist force p1 p2 p4
 compute         ids all property/local patom1 patom2
 dump            atoms all custom @steps@ atoms.dump id radius mass x y vx vy omegaz fx fy tqz
@@ -74,19 +77,14 @@ def check_line(c, verdict, label, extra=""):
             f"touched={c['touched']}{extra} {'PASS' if verdict else 'FAIL'}")
 
 
-def cross_run(codes, work, template, state, box, dt, steps, friction, label):
+def cross_run(codes, work, state, box, dt, steps, friction, label):
     """Both codes on the same discs for `steps` steps; compare()'s figures."""
-    files.write_text(work / f"{label}.scene",
-                     ballast_scene(state, box, dt, steps,
-                                   f"peer cross-check {label}, {len(state['x'])} discs", mu=friction))
-    run_ballast(codes, ["run", work / f"{label}.scene"], work / f"{label}_ballast")
+    scene = work / f"{label}.scene"
+    files.write_text(scene, ballast_scene(state, box, dt, steps,
+                                          f"peer cross-check {label}, {len(state['x'])} discs", mu=friction))
+    run_ballast(codes, ["run", scene], work / f"{label}_ballast")
     lw = files.make_dirs(work / f"{label}_lammps")
-    files.write_text(lw / "data.lmp", lammps_data(state, box, dt))
-    text = lammps_input(template, data="data.lmp", density=DENSITY, kn=KN, kt=KT, mu=friction, g=G,
-                        dt=dt, steps=steps, output=CHECK_OUTPUT.replace("@steps@", str(steps)),
-                        skin=0.25, binsize=0, sort_every=1000, sort_binsize=0,
-                        xlo=box[0], xhi=box[1], ylo=box[2], yhi=box[3])
-    run_lammps(codes, lw, text)
+    run_lammps(codes, lw, scene, CHECK_OUTPUT.replace("@steps@", str(steps)), **CHECK_NEIGHBOURS)
     atoms = parse_dump((lw / "atoms.dump").read_text())
     if atoms["_step"] != steps:
         sys.exit(f"peer: the LAMMPS dump is of step {atoms['_step']}, not {steps}")
@@ -94,18 +92,18 @@ def cross_run(codes, work, template, state, box, dt, steps, friction, label):
     return compare(state, work / f"{label}_ballast", atoms, local, dt)
 
 
-def cross_check(codes, work, template, steps=CHECK_STEPS):
+def cross_check(codes, work, steps=CHECK_STEPS):
     """The three runs of the cross-check; prints a line each.  Returns (all passed,
     {"friction0", "friction", "half_dt": each run's figures, "ratio_dx", "ratio_dF"})."""
     work = files.make_dirs(work)
     state, box, dt = check_state(codes, work)
-    exact = cross_run(codes, work, template, state, box, dt, steps, 0.0, "frictionless")
+    exact = cross_run(codes, work, state, box, dt, steps, 0.0, "frictionless")
     ok0 = check_verdict(exact, TOL_EXACT)
     print(check_line(exact, ok0, "friction=0"), flush=True)
-    full = cross_run(codes, work, template, state, box, dt, steps, MU, "friction")
+    full = cross_run(codes, work, state, box, dt, steps, MU, "friction")
     ok1 = check_verdict(full, TOL_FRICTION)
     print(check_line(full, ok1, f"friction={MU:g}"), flush=True)
-    half = cross_run(codes, work, template, state, box, 0.5 * dt, 2 * steps, MU, "friction_half_dt")
+    half = cross_run(codes, work, state, box, 0.5 * dt, 2 * steps, MU, "friction_half_dt")
     rx, rf = convergence(full, half)
     ok2 = check_verdict(half, TOL_FRICTION) and rx <= TOL_RATIO and rf <= TOL_RATIO
     print(check_line(half, ok2, f"friction={MU:g},dt/2",
@@ -144,7 +142,7 @@ def run(out, codes):
         print(f"peer: skipped: {problem}", flush=True)
         write_outputs(out, *skip_outputs(problem))
         return 0
-    ok, results = cross_check(codes.pinned(out), out / "work", TEMPLATE.read_text())
+    ok, results = cross_check(codes.pinned(out), out / "work")
     write_outputs(out, *check_outputs(results, ok))
     return 0 if ok else 1
 

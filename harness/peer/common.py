@@ -1,42 +1,42 @@
 """harness/peer/common.py -- what the cross-checks and the race against LAMMPS share.
 
 The two programs (Codes: the ballast executable and LAMMPS's `lmp`, passed to every
-function that runs one), the material both codes get, the inputs written for each (a
-ballast scene listing every disc, a LAMMPS data file, a filled-in LAMMPS input), the
-outputs read back (ballast's discs.tsv, walls.tsv and contacts.tsv through
-harness/final_state.py's Table; LAMMPS's log and dumps), the comparison of one ballast
-run with one LAMMPS run (compare(), check_verdict()), the cross-check's initial state
-(check_state()), installing or refusing LAMMPS, and a cross-check's run outputs
-(series.tsv and run.json, written whole by harness/files.py).
+function that runs one), the material both codes get, the input written for both (a
+ballast scene listing every disc: ballast runs it, and harness/engines/lammps.py, the
+harness's one translation of a scene into LAMMPS, writes LAMMPS's data file and input from
+it: run_lammps()), the outputs read back (ballast's discs.tsv, walls.tsv and contacts.tsv
+through harness/final_state.py's Table; LAMMPS's log and dumps), the comparison of one
+ballast run with one LAMMPS run (compare(), check_verdict()), the cross-check's initial
+state (check_state()), installing or refusing LAMMPS (engines/lammps.py), and a
+cross-check's run outputs (series.tsv and run.json, written whole by harness/files.py).
 
-The physics of both sides (the same in both by construction; see
-harness/peer/in.peer for LAMMPS):
+The physics of both sides (the same in both by construction; docs/engines.md derives the
+translation):
   discs of unit thickness, m = density pi r^2, I = m r^2 / 2;
   F_n = k_n * overlap (ballast: normal_law = power, nu = 1, delta0 = 1;
   LAMMPS: gran/hooke/history); incremental shear spring k_t with the Coulomb
   cap mu F_n, moments at the full radius; no dashpots and no global damping
-  in either code (LAMMPS's dashpots scale with each contact's effective mass,
-  ballast's do not, so the only damping both can share is none);
-  the four box walls of the fill (ballast segments, LAMMPS wall/gran planes);
+  (gran/hooke's dashpots scale with each contact's effective mass, ballast's do
+  not: a damped scene goes to pair granular's `damping velocity`, whose arm for
+  F_s is r - delta/2, so the undamped cross-check keeps gran/hooke/history);
+  the four box walls of the fill (ballast segments, LAMMPS region planes);
   gravity 9.81 downwards; ballast's time step.
 
 Time integration: ballast's cycle N moves x_N = x_{N-1} + dt v_{N-1/2},
 computes forces at x_N with v_{N-1/2}, then v_{N+1/2} = v_{N-1/2} + dt a_N.
 LAMMPS's velocity Verlet gives the same sequence, its v_{n+1/2} after the
 first half kick.  A scene's velocities are ballast's v_{1/2}; LAMMPS's
-initial velocities are therefore v_{1/2} - dt a_0 / 2, where a_0 is gravity
-alone when nothing touches at t = 0 (the cross-check and the race's
-`settling`).  For the race's `dense` (overlapping at t = 0, starting at rest)
-both start with v = 0; the difference, dt^2 a_0 / 2 in the first move, does
-not matter to a timing.
+initial velocities are therefore v_0 with v_0 + dt a_0(v_0) / 2 = v_{1/2}, a_0
+LAMMPS's own forces at t = 0 (the translation solves it: engines/lammps.py,
+start_lines), for the race's settled `dense` (overlapping at t = 0) as for the
+cross-check's free discs.
 
 Only numpy, the standard library and the harness; LAMMPS (Debian package
-`lammps`) is installed with apt-get when `lmp` is missing.
+`lammps`) is installed with apt-get when `lmp` is missing (engines/lammps.py).
 """
 import json
 import math
 import os
-import re
 import shutil
 import subprocess
 import sys
@@ -47,16 +47,15 @@ import numpy as np
 
 from .. import REPO_ROOT
 from .. import files
+from ..engines import lammps as translation
+from ..engines.lammps import INSTALL, LMP, install_lammps, parse_dump, parse_frames  # noqa: F401
+from ..engines.lammps import parse_log as parse_lammps_log  # noqa: F401
 from ..final_state import Table
 from ..tables import read_run_json
 
 HERE = Path(__file__).resolve().parent
 BALLAST = REPO_ROOT / "bin" / "ballast"
 DENSE_SCENE = REPO_ROOT / "cases" / "bench" / "dense.scene"
-TEMPLATE = HERE / "in.peer"
-LMP = "lmp"
-# apt-get's command line for LAMMPS (a test gives another to see the skip path).
-INSTALL = ("apt-get", "install", "-y", "-qq", "--no-install-recommends", "lammps")
 
 # The material of cases/bench/dense.scene, for discs and box walls alike.
 KN = 1e5
@@ -180,62 +179,6 @@ def min_gaps(state, box):
     return gap, wall
 
 
-def parse_lammps_log(text):
-    """The figures of a LAMMPS log that the scripts use.
-
-    loop_seconds, procs, steps, atoms from "Loop time of X on P procs for S
-    steps with N atoms" (the last one); version from the banner; builds and
-    dangerous from the neighbour statistics."""
-    out = {}
-    m = re.search(r"^LAMMPS \((.*)\)\s*$", text, re.M)
-    out["version"] = m.group(1) if m else ""
-    loops = re.findall(r"^Loop time of ([-+0-9.eE]+) on (\d+) procs for (\d+) steps "
-                       r"with (\d+) atoms", text, re.M)
-    if not loops:
-        raise ValueError("no 'Loop time' line in the LAMMPS log")
-    sec, procs, steps, atoms = loops[-1]
-    out.update(loop_seconds=float(sec), procs=int(procs), steps=int(steps), atoms=int(atoms))
-    m = re.findall(r"^Neighbor list builds = (\d+)", text, re.M)
-    out["builds"] = int(m[-1]) if m else -1
-    m = re.findall(r"^Dangerous builds = (\d+)", text, re.M)
-    out["dangerous"] = int(m[-1]) if m else -1
-    return out
-
-
-def parse_frames(text):
-    """Every frame of a LAMMPS text dump (custom or local), in order: a list of
-    {column: float array, "_step": step}."""
-    lines = text.splitlines()
-    starts = [k for k, l in enumerate(lines) if l.startswith("ITEM: TIMESTEP")]
-    frames = []
-    for k in starts:
-        step = int(lines[k + 1])
-        count = int(lines[k + 3])
-        head = next(j for j in range(k, len(lines)) if lines[j].startswith("ITEM: ATOMS")
-                    or lines[j].startswith("ITEM: ENTRIES"))
-        names = lines[head].split()[2:]
-        body = lines[head + 1:head + 1 + count]
-        if len(body) != count or any(l.startswith("ITEM:") for l in body):
-            raise ValueError(f"dump frame of step {step} is cut short: announced {count} rows")
-        data = np.array([l.split() for l in body], dtype=float).reshape(count, len(names))
-        out = {n: data[:, j] for j, n in enumerate(names)}
-        out["_step"] = step
-        frames.append(out)
-    return frames
-
-
-def parse_dump(text):
-    """The last frame of a LAMMPS text dump (custom or local) -> {column: float array}."""
-    frames = parse_frames(text)
-    if not frames:
-        raise ValueError("no frame in the dump")
-    return frames[-1]
-
-
-# --------------------------------------------------------------------------
-# Writing the two codes' inputs
-# --------------------------------------------------------------------------
-
 def fmt(v):
     """A float written so that strtod reads back the same double."""
     return repr(float(v))
@@ -290,41 +233,6 @@ def ballast_scene(state, box, dt, steps, title, kn=KN, kt=KT, mu=MU, g=G, densit
         out += [f"[probe {name}]", f"quantity = {quantity}", f"a = {a}"] + \
             ([f"b = {b}"] if b is not None else []) + [""]
     return "\n".join(out)
-
-
-def lammps_data(state, box, dt, g=G, margin=2.0, half_kick=True, density=DENSITY):
-    """A LAMMPS data file (atom_style sphere) of the same discs.
-
-    The state's velocities are ballast's v_{1/2}.  With half_kick, LAMMPS gets
-    v_y + dt g / 2 (g the magnitude of gravity, pointing down), which its
-    first half kick takes back to v_{1/2} when nothing touches at t = 0 (see
-    the module docstring).  The simulation box is the wall box plus `margin`
-    on every side (LAMMPS's box is not a wall: boundary f f p)."""
-    xlo, xhi, ylo, yhi = box
-    x, y, r = state["x"], state["y"], state["r"]
-    vx, vy, w = state["vx"], state["vy"], state["omega"]
-    shift = 0.5 * dt * g if half_kick else 0.0
-    n = len(x)
-    out = ["LAMMPS data file written by harness/peer/common.py", "", f"{n} atoms", "1 atom types", "",
-           f"{fmt(xlo - margin)} {fmt(xhi + margin)} xlo xhi",
-           f"{fmt(ylo - margin)} {fmt(yhi + margin)} ylo yhi", "-0.5 0.5 zlo zhi", "",
-           "Atoms # sphere", ""]
-    out += [f"{k + 1} 1 {fmt(2 * r[k])} {fmt(density)} {fmt(x[k])} {fmt(y[k])} 0"
-            for k in range(n)]
-    out += ["", "Velocities", ""]
-    out += [f"{k + 1} {fmt(vx[k])} {fmt(vy[k] + shift)} 0 0 0 {fmt(w[k])}" for k in range(n)]
-    return "\n".join(out) + "\n"
-
-
-def lammps_input(template, **values):
-    """Fill in every @name@ of the template; a name left unfilled is an error."""
-    def sub(m):
-        key = m.group(1)
-        if key not in values:
-            raise KeyError(f"no value for @{key}@")
-        v = values[key]
-        return fmt(v) if isinstance(v, float) else str(v)
-    return re.sub(r"@(\w+)@", sub, template)
 
 
 # --------------------------------------------------------------------------
@@ -468,43 +376,10 @@ def check_verdict(c, tol):
 # Running the codes
 # --------------------------------------------------------------------------
 
-def install_lammps(install):
-    """Run the command line install (apt-get install lammps), after an apt-get update if the
-    first try fails (a machine that never ran one has no package lists); '' when it worked,
-    else why not."""
-    print("peer: installing LAMMPS (apt-get install lammps)", flush=True)
-    sudo = [] if os.geteuid() == 0 else ["sudo"]
-    env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
-    command = sudo + list(install)
-    try:
-        if subprocess.run(command, env=env).returncode == 0:
-            return ""
-        subprocess.run(sudo + [install[0], "update", "-qq"], env=env, check=True)
-        subprocess.run(command, env=env, check=True)
-    except (OSError, subprocess.CalledProcessError) as exc:
-        return f"`{' '.join(command)}` failed ({exc})"
-    return ""
-
-
 def lammps_problem(codes, styles=("gran/hooke/history",)):
     """Why LAMMPS cannot run a cross-check ('' when it can), installing it first when
-    codes.lmp is missing: not installed and the install failed, or no `lmp -h` listing
-    these styles of the GRANULAR package (pair or fix styles)."""
-    lmp = codes.lmp
-    if shutil.which(lmp) is None:
-        failed = install_lammps(codes.install)
-        if failed or shutil.which(lmp) is None:
-            return (f"LAMMPS is not installed (no `{lmp}` on PATH) and "
-                    f"{failed or 'the install left no ' + lmp + ' on PATH'}")
-    try:
-        help_text = subprocess.run([lmp, "-h"], capture_output=True, text=True).stdout
-    except OSError as exc:
-        return f"`{lmp} -h` cannot run ({exc})"
-    missing = [s for s in styles if not re.search(rf"(?<![\w/]){re.escape(s)}(?![\w/])", help_text)]
-    if "GRANULAR" not in help_text or missing:
-        return (f"this LAMMPS ({shutil.which(lmp)}) lacks the GRANULAR package's "
-                f"{', '.join(missing or styles)}")
-    return ""
+    codes.lmp is missing (engines/lammps.py, lammps_problem)."""
+    return translation.lammps_problem(codes.lmp, codes.install, styles)
 
 
 def skip_outputs(reason):
@@ -533,18 +408,16 @@ def run_ballast(codes, args, out):
     return run
 
 
-def run_lammps(codes, work, input_text):
-    """Run LAMMPS serially in `work` on an input; return parse_lammps_log()."""
+def run_lammps(codes, work, scene, extra="", **options):
+    """Run a ballast scene file in LAMMPS serially in `work` through the harness's one
+    translation (engines/lammps.py, run_scene), with extra, the caller's own LAMMPS lines
+    (computes, dumps) before the runs, and options for its neighbour settings (skin, binsize,
+    sort_every); return its log's figures (parse_lammps_log)."""
     work = files.make_dirs(work)
-    files.write_text(work / "in.lmp", input_text)
-    env = dict(os.environ, OMP_NUM_THREADS="1")
-    res = subprocess.run([codes.lmp, "-in", "in.lmp", "-log", "log.lammps", "-screen", "none",
-                          "-nocite"], cwd=work, capture_output=True, text=True, env=env)
-    log = (work / "log.lammps").read_text() if (work / "log.lammps").exists() else ""
-    if res.returncode != 0:
-        tail = "\n".join((log or res.stdout + res.stderr).splitlines()[-5:])
-        sys.exit(f"peer: LAMMPS failed ({res.returncode}) in {work}:\n{tail}")
-    return parse_lammps_log(log)
+    try:
+        return translation.run_scene(codes.lmp, codes.ballast, scene, work, extra.splitlines(), **options)
+    except RuntimeError as exc:
+        sys.exit(f"peer: {exc}")
 
 
 def check_state(codes, work):

@@ -44,8 +44,7 @@ import numpy as np
 from .. import REPO_ROOT
 from .. import files
 from . import check
-from .common import (DENSE_SCENE, DENSITY, G, KN, KT, MU, TEMPLATE, ballast_scene, box_of_walls,
-                     code_arguments, codes_of, disc_state, lammps_data, lammps_input,
+from .common import (DENSE_SCENE, ballast_scene, box_of_walls, code_arguments, codes_of, disc_state,
                      lammps_problem, parse_lammps_log, run_ballast, run_lammps)
 
 REPEATS = 5
@@ -138,13 +137,11 @@ def race_scene(name, state, box, dt, steps):
 class Race:
     """One scene of the race: its files and the runs of both codes."""
 
-    def __init__(self, name, work, state, box, dt, steps, template, codes):
+    def __init__(self, name, work, state, box, dt, steps, codes):
         self.name, self.work, self.state, self.box = name, Path(work), state, box
-        self.dt, self.steps, self.template, self.codes = dt, steps, template, codes
+        self.dt, self.steps, self.codes = dt, steps, codes
         self.n = len(state["x"])
         files.make_dirs(self.work)
-        self.data = self.work / "data.lmp"
-        files.write_text(self.data, lammps_data(state, box, dt, half_kick=name != "dense"))
         self.scenes = {}
 
     def scene(self, steps):
@@ -159,11 +156,11 @@ class Race:
         return self.n * run["steps"] / run["wall_seconds"], run
 
     def lammps(self, steps, s):
-        text = lammps_input(self.template, data=str(self.data), density=DENSITY, kn=KN, kt=KT,
-                            mu=MU, g=G, dt=self.dt, steps=steps, output="", skin=s["skin"],
-                            binsize=s["binsize"], sort_every=s["sort_every"], sort_binsize=0,
-                            xlo=self.box[0], xhi=self.box[1], ylo=self.box[2], yhi=self.box[3])
-        log = run_lammps(self.codes, self.work / "lammps", text)
+        """LAMMPS on the same scene through the harness's translation (engines/lammps.py) with
+        the neighbour settings s; the rate of its last loop (the race's steps: the runs that
+        solve for v_0 before it are runs of 0 steps, LAMMPS's set-up)."""
+        log = run_lammps(self.codes, self.work / "lammps", self.scene(steps), skin=s["skin"],
+                         binsize=s["binsize"], sort_every=s["sort_every"])
         if log["procs"] != 1 or log["atoms"] != self.n or log["steps"] != steps:
             sys.exit(f"peer: LAMMPS ran {log['steps']} steps of {log['atoms']} atoms on "
                      f"{log['procs']} procs")
@@ -270,7 +267,6 @@ def race_all(codes, quick=False):
     problem = lammps_problem(codes)
     if problem:
         sys.exit(f"peer: {problem}")
-    template = TEMPLATE.read_text()
     host = socket.gethostname() or "unknown"
     host_dir = REPO_ROOT / "reports" / "bench" / host
     work = host_dir / "peer"
@@ -280,7 +276,7 @@ def race_all(codes, quick=False):
     codes = codes.pinned(work)
 
     # 1. Cross-check: refuse to race different physics.
-    ok, results = check.cross_check(codes, work / "check", template)
+    ok, results = check.cross_check(codes, work / "check")
     if not ok:
         return 1
     c = results["friction"]
@@ -296,8 +292,8 @@ def race_all(codes, quick=False):
           f"normal_law = power: "
           f"E_k/E_el = {stage['ke_over_ee']:.2g}; dt = {dt:.6g}", flush=True)
     lattice, lbox, ldt = initial_lattice(codes, work, n, columns)
-    races = [Race("dense", work / "dense", state, box, dt, steps["dense"], template, codes),
-             Race("settling", work / "settling", lattice, lbox, ldt, steps["settling"], template, codes)]
+    races = [Race("dense", work / "dense", state, box, dt, steps["dense"], codes),
+             Race("settling", work / "settling", lattice, lbox, ldt, steps["settling"], codes)]
     version = parse_lammps_log((work / "check" / "friction_lammps" / "log.lammps").read_text())["version"]
     for race in races:
         best, _ = sweep(race, race.steps, quick, host_dir, stamp)

@@ -54,7 +54,7 @@ run.json, one column per figure):
    spins, for the record only: that term, amplified by the collisions, is
    1e-3 of the positions after 400 steps (docs/benchmarks.md).
 
-LAMMPS's neighbour lists are all-pairs without sorting (in.peer_rolling: in
+LAMMPS's neighbour lists are all-pairs without sorting (engines/lammps.py: in
 this LAMMPS a pair that changes sides at a rebuild has its rolling history
 negated).  Where LAMMPS is absent and cannot be installed, --out writes a
 skipped run (common.skip_outputs) and the case's checks are SKIP.
@@ -72,9 +72,9 @@ from .. import files
 from ..final_state import Table
 from ..tables import read_series
 from . import common
-from .common import DENSITY, FIGURES, KN, MU, fmt
+from ..engines.lammps import rolling_sds
+from .common import DENSITY, FIGURES, KN, MU
 
-TEMPLATE = common.HERE / "in.peer_rolling"
 DELTA = 0.8            # JYH's shape parameter of every test
 # Where the physics is the same in both codes (tests 1 and 2): round-off, as check.py's
 # frictionless check (collisions amplify it about e-fold per 50 steps; measured 1e-11 at
@@ -123,10 +123,10 @@ COLL_RATIO = (0.4, 0.6)
 
 def lammps_rolling(delta, kn, mu_n=0.0):
     """LAMMPS's pair granular `rolling sds k_roll gamma_roll mu_roll` of JYH's Model 1 with
-    shape parameter delta, normal stiffness kn and normal dashpot mu_n (the module
-    docstring): the same for every pair of radii and for flat walls."""
-    d2 = delta * delta
-    return {"k_roll": kn * d2 / 3, "gamma_roll": mu_n * d2 / 3, "mu_roll": delta / 3}
+    shape parameter delta, normal stiffness kn and normal dashpot mu_n (the module docstring):
+    the same for every pair of radii and for flat walls.  The translation's own
+    (engines/lammps.py, rolling_sds), which every LAMMPS input of the harness takes."""
+    return rolling_sds(delta, kn, mu_n)
 
 
 def contact_constants(delta, kn, r1, r2=None, mu_n=0.0):
@@ -144,23 +144,6 @@ def contact_constants(delta, kn, r1, r2=None, mu_n=0.0):
             "gamma_roll_R2": lmp["gamma_roll"] * r_eff * r_eff}
 
 
-def lammps_text(template, data, box, dt, steps, output, mu, g, kn=KN, delta=DELTA,
-                wall_rolling=True, wall_mu=None, beta=0.0):
-    """in.peer_rolling filled in: pair granular with the rolling of lammps_rolling() (the
-    same at the walls when wall_rolling, none there otherwise) and ballast's contact
-    damping beta: eta_n = beta k_n, the tangential dashpot x_gamma eta_n = beta k_t
-    (x_gamma = 1: k_t = k_n here), gamma_roll from mu_n = eta_n."""
-    roll = lammps_rolling(delta, kn, beta * kn)
-    rolling = f"rolling sds {fmt(roll['k_roll'])} {fmt(roll['gamma_roll'])} {fmt(roll['mu_roll'])}"
-    return common.lammps_input(template, data=data, density=DENSITY, kn=kn, kt=kn,
-                               eta_n=beta * kn, xgamma=1.0 if beta else 0.0, mu=mu,
-                               wall_mu=mu if wall_mu is None else wall_mu,
-                               k_roll=roll["k_roll"], gamma_roll=roll["gamma_roll"],
-                               mu_roll=roll["mu_roll"], wall_rolling=rolling if wall_rolling else "",
-                               g=g, dt=dt, steps=steps, output=output, skin=0.25,
-                               xlo=box[0], xhi=box[1], ylo=box[2], yhi=box[3])
-
-
 def state_of(x, y, r, vx, vy, omega):
     """A state of common.disc_state()'s form (m = density pi r^2) from lists."""
     out = {k: np.array(v, dtype=float) for k, v in
@@ -169,11 +152,12 @@ def state_of(x, y, r, vx, vy, omega):
     return out
 
 
-def run_both(codes, work, label, state, box, dt, steps, template, output, mu, g=common.G, kn=KN,
-             delta=DELTA, wall_rolling=True, beta=0.0, probes=(), output_every=None,
-             lammps_state=None):
-    """Write and run one test in both codes under work/label_ballast and work/label_lammps.
-    lammps_state: LAMMPS's initial state when it is not the ballast one (see two_discs)."""
+def run_both(codes, work, label, state, box, dt, steps, output, mu, g=common.G, kn=KN,
+             delta=DELTA, wall_rolling=True, beta=0.0, probes=(), output_every=None):
+    """Write one test as a ballast scene and run it in both codes under work/label_ballast and
+    work/label_lammps (LAMMPS through the harness's translation, engines/lammps.py, which maps
+    Model 1 to `rolling sds` with lammps_rolling()'s numbers and keeps every pair on one side:
+    all-pairs lists, no sorting)."""
     work = files.make_dirs(work)
     scene = work / f"{label}.scene"
     files.write_text(scene, common.ballast_scene(state, box, dt, steps, f"peer rolling {label}",
@@ -182,11 +166,7 @@ def run_both(codes, work, label, state, box, dt, steps, template, output, mu, g=
                                                  output_every=output_every, probes=probes, beta=beta))
     common.run_ballast(codes, ["run", scene], work / f"{label}_ballast")
     lw = files.make_dirs(work / f"{label}_lammps")
-    files.write_text(lw / "data.lmp", common.lammps_data(lammps_state or state, box, dt, g=g))
-    common.run_lammps(codes, lw, lammps_text(template, "data.lmp", box, dt, steps,
-                                             output.replace("@steps@", str(steps)), mu=mu, g=g,
-                                             kn=kn, delta=delta, wall_rolling=wall_rolling,
-                                             beta=beta))
+    common.run_lammps(codes, lw, scene, output.replace("@steps@", str(steps)), skin=0.25)
     return work / f"{label}_ballast", lw
 
 
@@ -205,20 +185,7 @@ def two_disc_state(omega0):
     return state_of([xa, xb], [2 * rb, 2 * rb], [ra, rb], [0, 0], [0, 0], [omega0, 0]), box
 
 
-def lammps_spins(state, mu_m, dt):
-    """LAMMPS's initial spins for ballast's omega_{1/2} of two discs whose only couple at
-    t = 0 is the rolling dashpot's -mu_m (omega_0 - omega_1) on disc 0: velocity Verlet
-    adds dt/2 of it before the first step (common.lammps_data's half kick, for a couple)."""
-    inertia = 0.5 * state["m"] * state["r"] ** 2
-    ca, cb = 0.5 * dt * mu_m / inertia
-    wa, wb = state["omega"]
-    d = (wa - wb) / (1 - ca - cb)
-    out = dict(state)
-    out["omega"] = np.array([wa + ca * d, wb - cb * d])
-    return out
-
-
-def two_discs(codes, work, template, damped=False):
+def two_discs(codes, work, damped=False):
     """Test 1 in both codes (undamped through the cap, or damped below it); its figures:
     max_dM (the couple on disc 0 at every step, relative to M_0), max_dw (both spins, to
     the initial spin), peak (largest |M| / M_0 in ballast: 1 at the cap), capped (steps
@@ -227,9 +194,8 @@ def two_discs(codes, work, template, damped=False):
     label = "two_damped" if damped else "two"
     state, box = two_disc_state(omega0)
     const = contact_constants(DELTA, KN, *TWO_R, mu_n=beta * KN)
-    bw, lw = run_both(codes, work, label, state, box, TWO_DT, TWO_STEPS, template, TWO_OUTPUT,
-                      mu=0.0, g=0.0, wall_rolling=False, beta=beta, probes=TWO_PROBES,
-                      output_every=1, lammps_state=lammps_spins(state, const["mu_m"], TWO_DT))
+    bw, lw = run_both(codes, work, label, state, box, TWO_DT, TWO_STEPS, TWO_OUTPUT,
+                      mu=0.0, g=0.0, wall_rolling=False, beta=beta, probes=TWO_PROBES, output_every=1)
     series = read_series(bw / "series.tsv")
     cycle, m, capped, w0, w1 = (series[k] for k in ("cycle", "m", "capped", "w0", "w1"))
     frames = {f["_step"]: f for f in common.parse_frames((lw / "spins.dump").read_text())}
@@ -341,12 +307,12 @@ def lammps_couples(local, atoms):
     return out
 
 
-def packing(codes, work, template, state, box, dt, steps, friction, label):
+def packing(codes, work, state, box, dt, steps, friction, label):
     """Test 2 on `state` in both codes: common.compare()'s figures, the tangential force
     taken at LAMMPS's arm (common.ballast_forces), and max_dM: every disc-disc contact's
     rolling couple, relative to the largest contact f_n times the mean radius; with
     rolling_contacts (those with a couple) and at_cap (those at the cap) in ballast."""
-    bw, lw = run_both(codes, work, label, state, box, dt, steps, template, PACK_OUTPUT,
+    bw, lw = run_both(codes, work, label, state, box, dt, steps, PACK_OUTPUT,
                       mu=friction)
     atoms = common.parse_dump((lw / "atoms.dump").read_text())
     if atoms["_step"] != steps:
@@ -390,7 +356,7 @@ def collision_state():
             (0.0, 12.0, 0.0, 10.0))
 
 
-def collision(codes, work, template, stiffness):
+def collision(codes, work, stiffness):
     """Test 3 at k_n = stiffness KN: the largest relative difference of the final spins and
     velocities (to the largest of each), with overlap (the largest f_n / k_n over the
     run), capped and sliding (steps at the rolling cap and sliding) in ballast."""
@@ -401,7 +367,7 @@ def collision(codes, work, template, stiffness):
               ("sliding", "contact_sliding", "d0", "d1"))
     out = ("dump            end all custom @steps@ end.dump id vx vy omegaz\n"
            "dump_modify     end sort id format float %.17g")
-    bw, lw = run_both(codes, work, f"collision_k{stiffness}", state, box, dt, steps, template,
+    bw, lw = run_both(codes, work, f"collision_k{stiffness}", state, box, dt, steps,
                       out, mu=MU, g=0.0, kn=stiffness * KN, wall_rolling=False, probes=probes,
                       output_every=1)
     b = common.disc_state(bw / "discs.tsv")
@@ -445,26 +411,26 @@ def collision_line(c, ok):
 # All of it, and the run's outputs
 # ---------------------------------------------------------------------------------------------
 
-def cross_check(codes, work, template):
+def cross_check(codes, work):
     """Every test, a line each; (all passed, {test: figures})."""
     work = Path(work)
     results, verdicts = {}, []
     for damped in (False, True):
         label = "two_damped" if damped else "two_discs"
-        c = two_discs(codes, work, template, damped)
+        c = two_discs(codes, work, damped)
         ok = two_disc_verdict(c, damped)
         print(two_disc_line(c, ok, label), flush=True)
         results[label], verdicts = c, verdicts + [ok]
     state, box, dt = common.check_state(codes, work / "fill")
-    c = packing(codes, work, template, spun(state), box, dt, PACK_STEPS, 0.0, "packing")
+    c = packing(codes, work, spun(state), box, dt, PACK_STEPS, 0.0, "packing")
     ok = packing_verdict(c)
     print(packing_line(c, ok, "packing"), flush=True)
     results["packing"], verdicts = c, verdicts + [ok]
-    c = collision_figures({s: collision(codes, work, template, s) for s in COLL_STIFFNESS})
+    c = collision_figures({s: collision(codes, work, s) for s in COLL_STIFFNESS})
     ok = collision_verdict(c)
     print(collision_line(c, ok), flush=True)
     results["collision"], verdicts = c, verdicts + [ok]
-    c = packing(codes, work, template, state, box, dt, FRICTION_STEPS, MU, "friction_packing")
+    c = packing(codes, work, state, box, dt, FRICTION_STEPS, MU, "friction_packing")
     print(packing_line(c, None, "friction_packing") + " (for the record)", flush=True)
     results["friction_packing"] = c
     return all(verdicts), results
@@ -500,7 +466,7 @@ def run(out, codes):
         print(f"peer rolling: skipped: {problem}", flush=True)
         common.write_outputs(out, *common.skip_outputs(problem))
         return 0
-    ok, results = cross_check(codes.pinned(out), out / "work", TEMPLATE.read_text())
+    ok, results = cross_check(codes.pinned(out), out / "work")
     common.write_outputs(out, *check_outputs(results, ok))
     return 0 if ok else 1
 

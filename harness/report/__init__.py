@@ -47,6 +47,18 @@ def now_text():
     return datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
 
 
+def peers_link(reports_dir, kind):
+    """A link to the agreement matrix with another engine (`make validate-peers`,
+    harness/engines/matrix.py) when one has been written; '' otherwise."""
+    if not (Path(reports_dir) / "peers" / "index.md").exists():
+        return ""
+    if kind == "md":
+        return ("\n## Other engines\n\nThe catalogue's checks on LAMMPS's runs beside ballast's: "
+                "[peers/index.md](peers/index.md).\n")
+    return ("<h2>Other engines</h2><p>The catalogue's checks on LAMMPS's runs beside ballast's: "
+            "<a href=\"peers/index.html\">peers/index.html</a>.</p>")
+
+
 def write_report(cases, checks, store, runs_root, reports_dir, out=None, render=None):
     """Render figures, write summary.md, index.html, the case pages and the stability page; return
     the index path.  render: the case names whose figures are drawn anew (None: all; gather)."""
@@ -71,9 +83,11 @@ def write_report(cases, checks, store, runs_root, reports_dir, out=None, render=
         else:
             files.write_text(reports_dir / name, text)
     files.write_text(reports_dir / "summary.md",
-                     markdown(reports, revision, date, known_markdown(record, reports_dir), reports_dir))
+                     markdown(reports, revision, date, known_markdown(record, reports_dir), reports_dir)
+                     + peers_link(reports_dir, "md"))
     index = reports_dir / "index.html"
-    files.write_text(index, page(reports, revision, date, known_html(record, reports_dir), reports_dir))
+    files.write_text(index, page(reports, revision, date, known_html(record, reports_dir), reports_dir)
+                     .replace("</body></html>", peers_link(reports_dir, "html") + "</body></html>"))
     if out:
         print(f"wrote {reports_dir / 'summary.md'} and {index}", file=out)
     return index

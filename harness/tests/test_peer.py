@@ -198,13 +198,21 @@ def test_ballast_scene_friction_can_be_switched_off(tsv):
     assert secs["[material grain]"]["friction"] == secs["[material box]"]["friction"] == "0.0"
 
 
-def test_lammps_data_has_the_same_discs_and_the_half_kick_shift(tsv):
+def test_the_cross_check_scene_translates_to_the_cross_checks_lammps_physics(tsv, tmp_path):
+    """The scene check.py writes, through the one translation (engines/lammps.py): the same
+    discs in the data file, gran/hooke/history with the scene's k_n, k_t and mu (no damping:
+    its arm is r, as ballast's), density/disc, the box walls as region planes on the discs'
+    side, gravity, the scene's step, the check's neighbour settings, and the start from v_1/2."""
+    from harness.engines import lammps, scene as scenes
     s = common.disc_state(tsv(DISCS_TSV))
-    dt = 8e-4
-    text = common.lammps_data(s, (0.0, 36.0, 0.0, 21.5), dt)
-    lines = text.splitlines()
-    assert "2 atoms" in lines and "1 atom types" in lines
-    assert "-2.0 38.0 xlo xhi" in lines and "-2.0 23.5 ylo yhi" in lines
+    path = tmp_path / "t.scene"
+    path.write_text(common.ballast_scene(s, (0.0, 36.0, 0.0, 21.5), 8e-4, 300, "t"))
+    sc = scenes.read(path)
+    scenes.resolve(sc, ROOT / "bin" / "ballast", tmp_path / "work")
+    plan = lammps.Lammps().plan(sc, "run", dumps=False, **check.CHECK_NEIGHBOURS)
+    assert not plan.refused()
+    opts = plan.options["lammps"]
+    lines = lammps.data_text(sc, opts).splitlines()
     atoms = lines[lines.index("Atoms # sphere") + 2:lines.index("Velocities") - 1]
     vels = [l for l in lines[lines.index("Velocities") + 2:] if l]
     assert len(atoms) == len(vels) == 2
@@ -213,42 +221,32 @@ def test_lammps_data_has_the_same_discs_and_the_half_kick_shift(tsv):
         assert (int(i), int(t), float(rho), float(z)) == (k + 1, 1, 1.0, 0.0)
         assert float(d) / 2 == s["r"][k] and (float(x), float(y)) == (s["x"][k], s["y"][k])
         i, vx, vy, vz, wx, wy, wz = vels[k].split()
-        assert float(vx) == s["vx"][k] and float(wz) == s["omega"][k]
-        assert float(vy) == s["vy"][k] + 0.5 * dt * common.G      # LAMMPS's first half kick takes it back
-        assert float(vz) == float(wx) == float(wy) == 0.0
-    still = common.lammps_data(s, (0.0, 36.0, 0.0, 21.5), dt, half_kick=False)
-    assert f"2 {s['vx'][1]!r} {s['vy'][1]!r} 0 0 0 0.5" in still.splitlines()
-
-
-def test_lammps_input_fills_the_template_and_refuses_a_missing_value():
-    template = common.TEMPLATE.read_text()
-    values = dict(data="data.lmp", density=1.0, kn=1e5, kt=1e5, mu=0.5, g=9.81, dt=7.9e-4,
-                  steps=300, output="", skin=0.25, binsize=0, sort_every=1000, sort_binsize=0,
-                  xlo=0.0, xhi=36.0, ylo=0.0, yhi=21.5)
-    text = common.lammps_input(template, **values)
-    assert "@" not in text
+        assert (float(vx), float(vy), float(wz)) == (s["vx"][k], s["vy"][k], s["omega"][k])
+    text = lammps.translate(sc, opts)
     cmds = [l.split("#")[0].split() for l in text.splitlines() if l.split("#")[0].strip()]
     first = {c[0] + (" " + c[3] if c[0] == "fix" else ""): c for c in cmds}
-    assert first["dimension"] == ["dimension", "2"] and first["atom_style"] == ["atom_style", "sphere"]
     assert first["pair_style"] == ["pair_style", "gran/hooke/history", "100000.0", "100000.0",
                                    "0.0", "0.0", "0.5", "0"]
-    assert first["set"][-2:] == ["density/disc", "1.0"]
+    assert ["set", "type", "1", "density/disc", "1.0"] in cmds
     assert first["fix nve/sphere"][-1] == "disc" and "fix enforce2d" in first
-    assert first["fix gravity"][4:] == ["9.81", "vector", "0", "-1", "0"]
-    walls = [c for c in cmds if c[0] == "fix" and c[3] == "wall/gran"]
-    assert [w[4:] for w in walls] == [
-        ["hooke/history", "100000.0", "100000.0", "0.0", "0.0", "0.5", "0", "xplane", "0.0", "36.0"],
-        ["hooke/history", "100000.0", "100000.0", "0.0", "0.0", "0.5", "0", "yplane", "0.0", "21.5"]]
-    assert first["neigh_modify"] == ["neigh_modify", "delay", "0", "every", "1", "check", "yes",
-                                     "binsize", "0"]
+    assert first["fix gravity"][4:] == ["v_gmag", "vector", "0.0", "-1.0", "0.0"]
+    assert 'variable        gmag equal "9.81*v_gfac"' in text
+    # each wall's plane through its P with the normal towards the discs (P and angle as the
+    # core builds the wall: bottom and top at angle 0, right and left at 90)
+    planes = np.array([[float(v) for v in c[3:9]] for c in cmds if c[0] == "region"])
+    assert planes == pytest.approx(np.array([[0.0, 0.0, 0.0, 0.0, 1.0, 0.0], [36.0, 0.0, 0.0, -1.0, 0.0, 0.0],
+                                             [0.0, 21.5, 0.0, 0.0, -1.0, 0.0], [0.0, 0.0, 0.0, 1.0, 0.0, 0.0]]),
+                                   abs=1e-16)
+    walls = [c for c in cmds if c[0] == "fix" and c[3] == "wall/gran/region"]
+    assert len(walls) == 4 and all(w[4:11] == ["hooke/history", "100000.0", "100000.0", "0.0", "0.0",
+                                               "0.5", "0"] for w in walls)
     assert first["neighbor"] == ["neighbor", "0.25", "bin"]
-    assert first["timestep"] == ["timestep", "0.00079"] and first["run"] == ["run", "300"]
+    assert first["atom_modify"] == ["atom_modify", "map", "array", "sort", "1000", "0.0"]
+    assert first["timestep"] == ["timestep", "0.0008"] and ["run", "300"] in cmds
+    assert "velocity        free set v_v0x v_v0y NULL" in text      # v_0 from v_1/2
     # the fixes that set forces come before enforce2d, which zeroes their z parts
-    order = [c[3] for c in cmds if c[0] == "fix"]
+    order = [c[3] for c in cmds if c[0] == "fix" and c[1] != "half"]
     assert order[-1] == "enforce2d"
-    del values["skin"]
-    with pytest.raises(KeyError, match="skin"):
-        common.lammps_input(template, **values)
 
 
 def test_check_output_dumps_forces_torques_and_contacts_to_full_precision():
@@ -262,7 +260,8 @@ def test_check_output_dumps_forces_torques_and_contacts_to_full_precision():
 def test_parse_lammps_log_reads_the_loop_time_and_the_neighbour_statistics():
     log = common.parse_lammps_log(LOG)
     assert log == {"version": "29 Sep 2021 - Update 2", "loop_seconds": 6.61234, "procs": 1,
-                   "steps": 3000, "atoms": 20000, "builds": 486, "dangerous": 0}
+                   "steps": 3000, "atoms": 20000, "builds": 486, "dangerous": 0,
+                   "total_seconds": 6.61234, "total_steps": 3000}
 
 
 def test_parse_lammps_log_takes_the_last_run_and_refuses_a_log_without_one():
@@ -461,7 +460,6 @@ def test_docstring_and_constants_agree_on_the_race():
     doc = race.__doc__
     assert "python3 -m harness.peer.race [--quick]" in doc and "peer dense N=20000" in doc
     assert race.RACE_N == 20000 and race.REPEATS == 5 and common.CHECK_N == 300
-    assert re.search(r"density/disc", common.TEMPLATE.read_text())
 
 
 # ---- the integrator convention the half-kick shift relies on ---------------------------
@@ -490,7 +488,7 @@ def test_race_scenes_give_ballast_its_motion_skin_and_the_cross_check_keeps_the_
     back into run.json's skin."""
     s = state_of([1.0, 4.0], [2.0, 2.0], [0.5, 0.6])
     assert race.RACE_SKIN_RULE == "motion"
-    r = race.Race("settling", tmp_path / "race", s, (0.0, 6.0, 0.0, 6.0), 1e-3, 5, "",
+    r = race.Race("settling", tmp_path / "race", s, (0.0, 6.0, 0.0, 6.0), 1e-3, 5,
                   common.Codes(ROOT / "bin" / "ballast"))
     secs = dict(sections(r.scene(5).read_text()))
     assert secs["[settings]"]["skin_rule"] == "motion"

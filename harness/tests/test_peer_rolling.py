@@ -71,34 +71,45 @@ def commands(text):
     return [line.split("#")[0].split() for line in text.splitlines() if line.split("#")[0].strip()]
 
 
-def test_lammps_input_has_the_mapped_rolling_all_pairs_and_no_sorting():
-    text = rolling.lammps_text(rolling.TEMPLATE.read_text(), "data.lmp", (0.0, 36.0, 0.0, 21.5),
-                               7.9e-4, 500, "", mu=0.5, g=9.81)
-    assert "@" not in text
+def translated(tmp_path, state, box, dt, steps, **scene):
+    """The LAMMPS input the translation (engines/lammps.py) writes for the scene rolling.py writes."""
+    from harness.engines import lammps, scene as scenes
+    path = tmp_path / "t.scene"
+    path.write_text(common.ballast_scene(state, box, dt, steps, "t", rolling=rolling.DELTA, **scene))
+    sc = scenes.read(path)
+    scenes.resolve(sc, ROOT / "bin" / "ballast", tmp_path / "work")
+    plan = lammps.Lammps().plan(sc, "run", dumps=False, skin=0.25)
+    assert not plan.refused()
+    return lammps.translate(sc, plan.options["lammps"])
+
+
+def test_lammps_input_has_the_mapped_rolling_all_pairs_and_no_sorting(tmp_path):
+    state = rolling.state_of([2.0, 5.0], [2.0, 2.0], [0.5, 0.75], [0.1, 0.0], [0.0, 0.0], [1.0, 0.0])
+    text = translated(tmp_path, state, (0.0, 36.0, 0.0, 21.5), 7.9e-4, 500, mu=0.5, g=9.81)
     cmds = commands(text)
     coeff = next(c for c in cmds if c[0] == "pair_coeff")
-    assert coeff == ["pair_coeff", "*", "*", "hooke", "100000.0", "0.0", "tangential", "linear_history",
+    assert coeff == ["pair_coeff", "1", "1", "hooke", "100000.0", "0.0", "tangential", "linear_history",
                      "100000.0", "0.0", "0.5", "rolling", "sds", repr(1e5 * (0.8 * 0.8) / 3), "0.0",
                      repr(0.8 / 3), "damping", "velocity"]
-    assert ["pair_style", "granular"] in cmds and ["atom_modify", "sort", "0", "0"] in cmds
+    assert ["pair_style", "granular"] in cmds and ["atom_modify", "map", "array", "sort", "0", "0.0"] in cmds
     assert next(c for c in cmds if c[0] == "neighbor")[2] == "nsq"
-    walls = [c for c in cmds if c[0] == "fix" and c[3] == "wall/gran"]
-    assert [w[4] for w in walls] == ["granular", "granular"]
+    walls = [c for c in cmds if c[0] == "fix" and c[3] == "wall/gran/region"]
+    assert len(walls) == 4 and {w[4] for w in walls} == {"granular"}
     for w in walls:
         assert w[w.index("rolling"):w.index("rolling") + 5] == coeff[11:16]
-    assert walls[0][-3:] == ["xplane", "0.0", "36.0"] and walls[1][-3:] == ["yplane", "0.0", "21.5"]
     assert next(c for c in cmds if c[:2] == ["fix", "integrate"])[-1] == "disc"
 
 
-def test_lammps_input_walls_without_rolling_and_with_damping():
-    text = rolling.lammps_text(rolling.TEMPLATE.read_text(), "d", (0.0, 1.0, 0.0, 1.0), 1e-4, 10, "",
-                               mu=0.0, g=0.0, wall_rolling=False, beta=1e-3)
+def test_lammps_input_walls_without_rolling_and_with_damping(tmp_path):
+    state = rolling.state_of([0.49, 1.73], [1.0, 1.0], [0.5, 0.75], [0.0, 0.0], [0.0, 0.0], [3.0, 0.0])
+    text = translated(tmp_path, state, (0.0, 2.47, 0.0, 3.0), 1e-4, 10, mu=0.0, g=0.0,
+                      wall_rolling=0.0, beta=1e-3)
     cmds = commands(text)
     coeff = next(c for c in cmds if c[0] == "pair_coeff")
     assert coeff[5] == "100.0" and coeff[9] == "1.0"              # eta_n = beta k_n, x_gamma = 1
     assert float(coeff[14]) == pytest.approx(100.0 * 0.64 / 3)    # gamma_roll = eta_n delta^2/3
-    for w in (c for c in cmds if c[0] == "fix" and c[3] == "wall/gran"):
-        assert "rolling" not in w and w[7] == "100.0"
+    walls = [c for c in cmds if c[0] == "fix" and c[3] == "wall/gran/region"]
+    assert walls and all("rolling" not in w and w[7] == "100.0" for w in walls)   # eta_n
 
 
 def sections(text):
@@ -138,17 +149,6 @@ def test_two_disc_state_balances_every_overlap():
     overlaps = (ra - (xa - xlo), ra + rb - (xb - xa), rb - (xhi - xb))
     assert overlaps == pytest.approx((rolling.TWO_OVERLAP,) * 3, abs=1e-15)
     assert state["omega"].tolist() == [20.0, 0.0] and state["y"][0] - rb > ylo and state["y"][0] + rb < yhi
-
-
-def test_lammps_spins_come_back_to_ballasts_after_the_first_half_kick():
-    state, _ = rolling.two_disc_state(3.0)
-    mu_m, dt = 1.92, 1e-4
-    w0 = rolling.lammps_spins(state, mu_m, dt)["omega"]
-    inertia = 0.5 * state["m"] * state["r"] ** 2
-    couple = -mu_m * (w0[0] - w0[1])                     # the dashpot at t = 0, on disc 0
-    half = w0 + 0.5 * dt * np.array([couple, -couple]) / inertia
-    assert half == pytest.approx(state["omega"], rel=1e-15, abs=1e-15)
-    assert rolling.lammps_spins(state, 0.0, dt)["omega"].tolist() == state["omega"].tolist()
 
 
 # ---- reading the outputs ---------------------------------------------------------------------

@@ -1,0 +1,412 @@
+"""harness/engines/lammps_input.py -- a resolved ballast scene as LAMMPS's data file and input:
+the harness's one translation (docs/engines.md derives each line; lammps.py decides, per
+scene, what is expressible and with which options).
+
+data_text() writes every disc (type, diameter, density, position, the scene's v_1/2); translate()
+the input: atom style and types, pair style and coefficients (pair_law: ballast's
+2 k_a k_b/(k_a + k_b)), the integrator, gravity with its ramp, C&S's global damping, the walls
+as moving region planes, the holds, the start from v_1/2 (start_lines), and the stages' runs
+with the dumps the reader takes back (stage_lines) and a stop rule's checks.
+"""
+import math
+
+import numpy as np
+
+from .. import REPO_ROOT
+from . import scene as scenes
+
+# LAMMPS's fix langevin takes a rotational drag of SINERTIA m r^2 / damp (a sphere's 0.4); a
+# disc's I is m r^2 / 2, so the drag -alpha I omega needs 1/damp = (0.5/0.4) alpha / s.
+LANGEVIN_SINERTIA = 0.4
+# Passes of start_lines()'s fixed-point iteration for v_0: each divides the error by at least
+# 1/(dt/2 |da/dv|) >= 2 at a stable step (dt/2 eta/m <= zeta dt omega/2 < 1/2 for the catalogue's
+# damping ratios zeta <= 0.5), so 60 passes leave 2^-60 of the first correction, below round-off.
+START_PASSES = 60
+SEED = 1                   # fix langevin's seed: at T = 0 its random force is 0 x random
+
+
+def fmt(v):
+    """A float written so that strtod reads back the same double."""
+    return repr(float(v))
+
+
+def wall_side(scene, wall):
+    """+1 or -1: the side of the wall's line (left of A->B is +1) where the discs lie; 0 when
+    discs lie on both sides within reach of the segment."""
+    ex, ey = wall.bx - wall.ax, wall.by - wall.ay
+    length = math.hypot(ex, ey)
+    ex, ey = ex / length, ey / length
+    d = scene.discs
+    signed = (d["x"] - wall.ax) * (-ey) + (d["y"] - wall.ay) * ex
+    along = (d["x"] - wall.ax) * ex + (d["y"] - wall.ay) * ey
+    near = (along > -d["r"]) & (along < length + d["r"])
+    pos, neg = np.any(near & (signed > 0)), np.any(near & (signed < 0))
+    if pos and neg:
+        return 0
+    return 1 if pos or not neg else -1
+
+
+def pair_law(scene, ma, mb):
+    A, B = scene.materials[ma], scene.materials[mb]
+    return (2 * A.kn * B.kn / (A.kn + B.kn), 2 * A.ks * B.ks / (A.ks + B.ks),
+            min(A.friction, B.friction), min(A.rolling, B.rolling))
+
+
+def granular_coeff(scene, kn, ks, mu, delta, r_eff=None):
+    """A pair granular coefficient string (pair_coeff or fix wall/gran granular) of one pair
+    law: hooke or hertz (r_eff given), damping velocity, linear_history, rolling sds."""
+    beta, gamma_n = scene.number("beta"), scene.number("gamma_n")
+    eta_n = gamma_n + beta * kn
+    xgamma = beta * ks / eta_n if eta_n > 0 else 0.0
+    if r_eff is None:
+        normal = f"hooke {fmt(kn)} {fmt(eta_n)}"
+    else:
+        normal = f"hertz {fmt(kn / math.sqrt(scene.number('delta0') * r_eff))} {fmt(eta_n)}"
+    out = f"{normal} tangential linear_history {fmt(ks)} {fmt(xgamma)} {fmt(mu)}"
+    if delta > 0:
+        roll = rolling_sds(delta, kn, eta_n)
+        out += f" rolling sds {fmt(roll['k_roll'])} {fmt(roll['gamma_roll'])} {fmt(roll['mu_roll'])}"
+    return out + " damping velocity"
+
+
+def rolling_sds(delta, kn, mu_n=0.0):
+    """LAMMPS's `rolling sds k_roll gamma_roll mu_roll` of JYH's Model 1 with shape parameter
+    delta, normal stiffness kn and normal dashpot mu_n (docs/engines.md): JYH's common radius is
+    2 R_eff at every contact, B = 2 delta R_eff, so K_m = k_n B^2/12 = (k_n delta^2/3) R_eff^2,
+    M_0 = F_n B/6 = (delta/3) R_eff F_n and mu_m = mu_n B^2/12 = (mu_n delta^2/3) R_eff^2: the
+    same three numbers for every pair of radii and for flat walls."""
+    d2 = delta * delta
+    return {"k_roll": kn * d2 / 3, "gamma_roll": mu_n * d2 / 3, "mu_roll": delta / 3}
+
+
+def data_text(scene, opts):
+    """The LAMMPS data file (atom_style sphere): every disc with its type, diameter, density
+    (the material's, times s when global damping acts: data_text's masses are LAMMPS's) and
+    position, and the scene's velocities (ballast's v_1/2; translate() takes them to v_0).
+    The box holds the discs and walls with a margin; its boundaries shrink-wrap (m m p)."""
+    d = scene.discs
+    x, y, r = d["x"], d["y"], d["r"]
+    xs = list(x - r) + list(x + r) + [c for w in scene.walls for c in (w.ax, w.bx)]
+    ys = list(y - r) + list(y + r) + [c for w in scene.walls for c in (w.ay, w.by)]
+    margin = float(r.max())
+    n = len(x)
+    out = [f"LAMMPS data file written by harness/engines/lammps.py from {scene.path}", "",
+           f"{n} atoms", f"{len(opts.types)} atom types", "",
+           f"{fmt(min(xs) - margin)} {fmt(max(xs) + margin)} xlo xhi",
+           f"{fmt(min(ys) - margin)} {fmt(max(ys) + margin)} ylo yhi", "-0.5 0.5 zlo zhi", "",
+           "Atoms # sphere", ""]
+    for k in range(n):
+        rho = scene.materials[scene.disc_material[k]].density * opts.scale
+        out.append(f"{k + 1} {opts.type_of[k]} {fmt(2 * r[k])} {fmt(rho)} {fmt(x[k])} {fmt(y[k])} 0")
+    out += ["", "Velocities", ""]
+    out += [f"{k + 1} {fmt(d['vx'][k])} {fmt(d['vy'][k])} 0 0 0 {fmt(d['omega'][k])}" for k in range(n)]
+    return "\n".join(out) + "\n"
+
+
+def _ids(indices):
+    return " ".join(str(i + 1) for i in indices)
+
+
+def translate(scene, opts, work=None, extra=()):
+    """The LAMMPS input of a resolved scene (its data file: data_text()): the one translation.
+    With opts.dumps, the run's dumps (atoms.dump, pairs.dump) at ballast's series rows, and a
+    stop rule's checks through harness/engines (work: where the context pickle is); extra:
+    lines of the caller's own (computes, dumps: harness/peer) before the stages' runs."""
+    d = scene.discs
+    n = len(d["x"])
+    held = scenes.held(scene)
+    fixed = [k for k in range(n) if held[k] == {"x", "y", "rotation"}]
+    dt = scene.dt
+    L = [f"# written by harness/engines/lammps.py from {scene.path}",
+         f"# --set {' '.join(scene.sets)}" if scene.sets else "# (no --set lines)",
+         "units           lj", "dimension       2", "atom_style      sphere",
+         f"atom_modify     map array sort {opts.sort_every} {fmt(opts.sort_binsize)}",
+         "boundary        m m p", "comm_modify     vel yes", "read_data       data.lmp"]
+    for t, (mat, _) in enumerate(opts.types):
+        L.append(f"set             type {t + 1} density/disc "
+                 f"{fmt(scene.materials[mat].density * opts.scale)}")
+    L.append("group           held id " + _ids(fixed) if fixed else "group           held empty")
+    L.append("group           free subtract all held")
+    for t, (mat, _) in enumerate(opts.types):
+        L.append(f"group           t{t + 1} type {t + 1}")
+    style = "nsq" if opts.nsq else "bin"
+    L.append(f"neighbor        {fmt(opts.skin)} {style}")
+    L.append("neigh_modify    delay 0 every 1 check yes"
+             + (f" binsize {fmt(opts.binsize)}" if opts.binsize and not opts.nsq else "")
+             + (" exclude group held held" if fixed else ""))
+    L += pair_lines(scene, opts)
+    L.append(f"timestep        {fmt(dt)}")
+    L.append("fix             integrate free nve/sphere disc")
+    L += gravity_lines(scene, opts)
+    if opts.alpha > 0:
+        damp = opts.scale / (opts.alpha * 0.5 / LANGEVIN_SINERTIA)
+        excess = opts.alpha * (0.5 / LANGEVIN_SINERTIA - 1)          # langevin's -1.25 alpha m v, less alpha
+        L += [f"fix             drag free langevin 0.0 0.0 {fmt(damp)} {SEED} omega yes",
+              f"variable        trimx atom {fmt(excess)}*mass/{fmt(opts.scale)}*vx",
+              f"variable        trimy atom {fmt(excess)}*mass/{fmt(opts.scale)}*vy",
+              "fix             trim free addforce v_trimx v_trimy 0.0"]
+    L += wall_lines(scene, opts)
+    for axis in ("x", "y"):
+        part = [k for k in range(n) if axis in held[k] and held[k] != {"x", "y", "rotation"}]
+        if part:
+            L += [f"group           hold{axis} id {_ids(part)}",
+                  f"fix             hold{axis} hold{axis} setforce "
+                  + ("0.0 NULL NULL" if axis == "x" else "NULL 0.0 NULL")]
+    L.append("fix             plane all enforce2d")
+    L += start_lines(scene, opts)
+    L += list(extra)
+    L += stage_lines(scene, opts, work)
+    return "\n".join(L) + "\n"
+
+
+def pair_lines(scene, opts):
+    if not opts.granular:
+        # one law for every pair: gran/hooke/history's coefficients are global
+        laws = {pair_law(scene, a, b) for a, _ in opts.types for b, _ in opts.types}
+        if len(laws) == 1:
+            kn, ks, mu, _ = laws.pop()
+            return [f"pair_style      gran/hooke/history {fmt(kn)} {fmt(ks)} 0.0 0.0 {fmt(mu)} 0",
+                    "pair_coeff      * *"]
+    out = ["pair_style      granular"]
+    for i, (ma, ra) in enumerate(opts.types):
+        for j, (mb, rb) in enumerate(opts.types):
+            if j < i:
+                continue
+            kn, ks, mu, delta = pair_law(scene, ma, mb)
+            r_eff = ra * rb / (ra + rb) if opts.hertz else None
+            out.append(f"pair_coeff      {i + 1} {j + 1} {granular_coeff(scene, kn, ks, mu, delta, r_eff)}")
+    return out
+
+
+def gfac_expr(scene, starts):
+    """gfac(step) as an equal-style formula: (step - N0)/C in each ramp stage, 1 elsewhere."""
+    terms, covered = [], []
+    for stage, n0 in zip(scene.stages, starts):
+        if stage.number("ramp") and stage.cycles > 0:
+            c = stage.cycles
+            inside = f"(step>{n0})*(step<={n0 + c})"
+            terms.append(f"{inside}*(step-{n0})/{c}")
+            covered.append(inside)
+    if not terms:
+        return "1"
+    return "+".join(terms) + "+(1-(" + "+".join(covered) + "))"
+
+
+def stage_starts(scene):
+    out, n = [], 0
+    for s in scene.stages:
+        out.append(n)
+        n += s.cycles
+    return out
+
+
+def gravity_lines(scene, opts):
+    gx, gy = scene.gravity()
+    size = math.hypot(gx, gy)
+    if size == 0:
+        return []
+    ramps = any(s.number("ramp") for s in scene.stages)
+    has_stop = any(_stop_rule(s) for s in scene.stages)
+    if ramps and has_stop:
+        # a ramp after a stop rule would start at a step known only at run time
+        first_stop = next(k for k, s in enumerate(scene.stages) if _stop_rule(s))
+        if any(s.number("ramp") for s in scene.stages[first_stop + 1:]):
+            raise scenes.SceneError("a gravity ramp after a stage with a stop rule")
+    g = fmt(size / opts.scale)
+    return [f"variable        gfac equal \"{gfac_expr(scene, stage_starts(scene))}\"",
+            f"variable        gmag equal \"{g}*v_gfac\"",
+            f"fix             gravity free gravity v_gmag vector {fmt(gx / size)} {fmt(gy / size)} 0.0"]
+
+
+def wall_lines(scene, opts):
+    """A region plane and fix wall/gran/region per wall and disc material; moving walls get
+    displacement and angle variables Wk_dx, Wk_dy, Wk_th that stage_lines() redefines per stage."""
+    out = []
+    mats = []
+    for mat, _ in opts.types:
+        if mat not in mats:
+            mats.append(mat)
+    moves = moving_walls(scene)
+    for k, w in enumerate(scene.walls):
+        side = wall_side(scene, w)
+        (qx, qy), (ex, ey) = wall_line(scene, w)
+        nx, ny = -ey * side, ex * side
+        motion = ""
+        if w.name in moves:
+            out += [f"variable        W{k}_dx equal 0.0", f"variable        W{k}_dy equal 0.0",
+                    f"variable        W{k}_th equal 0.0"]
+            px, py = pivot(scene, w)
+            motion = f" move v_W{k}_dx v_W{k}_dy NULL"
+            if w.name in turning_walls(scene):
+                motion += f" rotate v_W{k}_th {fmt(px)} {fmt(py)} 0.0 0.0 0.0 1.0"
+        out.append(f"region          W{k} plane {fmt(qx)} {fmt(qy)} 0.0 {fmt(nx)} {fmt(ny)} 0.0 "
+                   f"side in units box{motion}")
+        for m, mat in enumerate(mats):
+            kn, ks, mu, delta = pair_law(scene, mat, w.material)
+            types = [t + 1 for t, (tm, _) in enumerate(opts.types) if tm == mat]
+            group = f"m{m}"
+            if k == 0:
+                out.append(f"group           {group} type {' '.join(map(str, types))}")
+            if opts.granular:
+                law = "granular " + granular_coeff(scene, kn, ks, mu, delta)
+            else:
+                law = f"hooke/history {fmt(kn)} {fmt(ks)} 0.0 0.0 {fmt(mu)} 0"
+            out.append(f"fix             W{k}m{m} {group} wall/gran/region {law} region W{k} contacts")
+    return out
+
+
+def wall_line(scene, wall):
+    """A point of the wall's line and its unit direction e, as the core builds them (build.c):
+    a [wall] section's P and (cos alpha, sin alpha), alpha = angle pi/180; a generated wall's
+    end A and (B - A)/|B - A|."""
+    keys = scene.wall_sections.get(wall.name, {})
+    if "p" in keys and "angle" in keys:
+        px, py = (float(v) for v in keys["p"].split())
+        alpha = float(keys["angle"]) * (math.pi / 180)
+        return (px, py), (math.cos(alpha), math.sin(alpha))
+    ex, ey = wall.bx - wall.ax, wall.by - wall.ay
+    length = math.hypot(ex, ey)
+    return (wall.ax, wall.ay), (ex / length, ey / length)
+
+
+def pivot(scene, wall):
+    keys = scene.wall_sections.get(wall.name, {})
+    if "p" in keys:
+        px, py = (float(v) for v in keys["p"].split())
+        return px, py
+    return wall.ax, wall.ay
+
+
+def turning_walls(scene):
+    """The walls some stage turns (a `move` with omega != 0): only they get a region rotation
+    (an unturned one would add its transform's round-off)."""
+    return {c.wall for s in scene.stages for c in s.controls if c.kind == "move" and c.numbers(3)[2] != 0}
+
+
+def moving_walls(scene):
+    return {c.wall for s in scene.stages for c in s.controls if c.kind == "move"
+            and any(v != 0 for v in c.numbers(3))}
+
+
+def wall_fixes(scene, opts):
+    """The names of the wall fixes, (wall index, fix id), in wall_lines()'s order."""
+    mats = []
+    for mat, _ in opts.types:
+        if mat not in mats:
+            mats.append(mat)
+    return [(k, f"W{k}m{m}") for k in range(len(scene.walls)) for m in range(len(mats))]
+
+
+def atom_columns(scene, opts):
+    cols = ["id", "x", "y", "vx", "vy", "c_pa[1]", "fx", "fy", "c_pa[2]", "mass"]
+    for _, fid in wall_fixes(scene, opts):
+        cols += [f"f_{fid}[{j}]" for j in (1, 2, 3, 5, 6)]
+    return cols
+
+
+def pair_columns(opts):
+    extra = 8 if opts.granular else 4
+    return ["c_pid[1]", "c_pid[2]"] + [f"c_pl[{j}]" for j in range(1, extra + 3)]
+
+
+def start_lines(scene, opts):
+    """The setup run, then the scene's v_1/2 taken to v_0 = v_1/2 - dt/2 a_0 (a_0 from LAMMPS's
+    forces at t = 0, with LAMMPS's masses), for the free discs (centred scheme only)."""
+    out = ["compute         pa all property/atom omegaz tqz radius"]
+    if opts.granular:
+        out.append("compute         pl all pair/local dist force p1 p2 p3 p4 p5 p6 p7 p8")
+    else:
+        out.append("compute         pl all pair/local dist force p1 p2 p3 p4")
+    out.append("compute         pid all property/local patom1 patom2")
+    if scene.setting("integrator") == "centred":
+        # v_0 solves v_0 + dt/2 a_0(v_0) = v_1/2, a_0 LAMMPS's forces at t = 0 with the velocities
+        # v_0 (dashpots of contacts that touch at the start, global damping's drag): a fixed-point
+        # iteration from v_0 = v_1/2, each a `run 0`; it contracts by dt/2 |da/dv| per pass.
+        out += ["fix             half free store/state 0 vx vy omegaz",
+                f"variable        it loop {START_PASSES}", "label           startpass",
+                "dump            start all custom 1 start.dump id c_pa[1] c_pa[2] c_pa[3]",
+                "run             0", "undump          start",
+                "variable        v0x atom f_half[1]-0.5*dt*fx/mass",
+                "variable        v0y atom f_half[2]-0.5*dt*fy/mass",
+                "variable        w0 atom f_half[3]-0.5*dt*c_pa[2]/(0.5*mass*c_pa[3]^2)",
+                "velocity        free set v_v0x v_v0y NULL",
+                "set             group free omega 0.0 0.0 v_w0",
+                "next            it", "jump            SELF startpass", "unfix           half"]
+    return out
+
+
+def _stop_rule(stage):
+    return stage.number("stop_ke") > 0 or stage.number("stop_stress") > 0 or stage.number("stop_unbalanced") > 0
+
+
+def stage_lines(scene, opts, work):
+    """One run per stage (a stage with a stop rule: runs of check_every steps, the rule checked
+    after each), the walls' motion redefined at each stage's start, and the dumps at ballast's
+    series rows: every output_every steps and at each run's end."""
+    every = opts.every
+    out = []
+    if opts.dumps:
+        out += ["variable        chunkend equal 0",
+                f"variable        nm equal \"(floor(step/{every})+1)*{every}\"",
+                "variable        dumpnext equal \"(step<v_chunkend)*((v_nm<v_chunkend)*v_nm+"
+                "(v_nm>=v_chunkend)*v_chunkend)+(step>=v_chunkend)*v_nm\"",
+                "dump            atoms all custom 1 atoms.dump " + " ".join(atom_columns(scene, opts)),
+                "dump_modify     atoms sort id format float %.17g every v_dumpnext",
+                "dump            pairs all local 1 pairs.dump " + " ".join(pair_columns(opts)),
+                "dump_modify     pairs format float %.17g every v_dumpnext"]
+    if any(_stop_rule(s) for s in scene.stages):
+        code = ("import sys\n    sys.path.insert(0, %r)\n    from harness.engines import lammps_output\n"
+                "    return lammps_output.stop_check(%r, stage)" % (str(REPO_ROOT), str(work)))
+        out += ["variable        stage equal 0",
+                f"python          stoprule input 1 v_stage return v_met format ii here \"\"\"\n"
+                f"def stoprule(stage):\n    {code}\n\"\"\"",
+                "variable        met python stoprule"]
+    moves = moving_walls(scene)
+    first = [True]
+
+    def run(steps):
+        pre = "" if first[0] else " pre no post no"
+        first[0] = False
+        return ["variable        chunkend equal $(step+%d)" % steps, f"run             {steps}{pre}"]
+
+    for g, stage in enumerate(scene.stages):
+        out.append(f"# stage {stage.name}: {stage.cycles} cycles")
+        out += motion_lines(scene, stage, moves)
+        if stage.cycles <= 0:
+            continue
+        if not _stop_rule(stage):
+            out += run(stage.cycles)
+            continue
+        k = int(float(stage.keys["check_every"]))
+        checks, rest = divmod(stage.cycles, k)
+        out.append(f"variable        stage equal {g}")
+        if checks:
+            out += [f"variable        n{g} loop {checks}", f"label           loop{g}"]
+            out += run(k)
+            out += [f"if              \"${{met}} > 0\" then \"jump SELF stopped{g}\"",
+                    f"next            n{g}", f"jump            SELF loop{g}"]
+        if rest:
+            out += run(rest)
+        out += [f"label           stopped{g}"]
+    return out
+
+
+def motion_lines(scene, stage, moves):
+    """At a stage's start: each moving wall's displacement and angle from where it is, at its
+    velocity and spin in this stage (0 for a wall this stage does not name)."""
+    out, held = [], []
+    dt = scene.dt
+    for k, w in enumerate(scene.walls):
+        if w.name not in moves:
+            continue
+        v1 = v2 = om = 0.0
+        for c in stage.controls:
+            if c.kind == "move" and c.wall == w.name:
+                v1, v2, om = c.numbers(3)
+        for var, rate in (("dx", v1), ("dy", v2), ("th", om)):
+            # where the wall is (read before start moves on), then this stage's motion from there
+            held += [f"variable        W{k}_{var}0 equal $(v_W{k}_{var}:%.17g)"]
+            out += [f"variable        W{k}_{var} equal \"v_W{k}_{var}0+{fmt(rate * dt)}*(step-v_start)\""]
+    if not out:
+        return []
+    return held + ["variable        start equal $(step)"] + out

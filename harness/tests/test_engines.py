@@ -1,0 +1,271 @@
+"""harness/engines: the adapter interface without LAMMPS.
+
+- a fake engine that cannot express a feature: its run is status 'not_expressible' and every
+  check that reads it (directly, through another variant, or a column the engine lists as
+  unexpressible) is NOT EXPRESSIBLE -- never PASS, FAIL or SKIP;
+- the LAMMPS translation of small scenes (what plan() maps, refuses; the input's lines);
+- a round trip: an engine Trajectory written as ballast's files and read back by the harness's
+  own readers with ballast's conventions.
+The real LAMMPS runs are in test_engines_lammps.py (make test-peers)."""
+import json
+import math
+import pathlib
+
+import numpy as np
+import pytest
+
+from harness import final_state
+from harness.compare import RunStore, evaluate_check, folder_locator
+from harness.engines import lammps, outputs, scene as scenes
+from harness.engines.driver import make_run
+from harness.engines.interface import APPROXIMATE, EXACT, REFUSED, Engine, Plan
+from harness.engines.trajectory import Frame, Trajectory, contacts_of
+from harness.references import Check
+from harness.tables import load_run
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+BALLAST = ROOT / "bin" / "ballast"
+TWO_DISCS = ROOT / "cases" / "two_discs" / "two_discs.scene"
+COLLISION = ROOT / "cases" / "collisions" / "collision.scene"
+needs_ballast = pytest.mark.skipif(not BALLAST.exists(), reason="bin/ballast not built (make bin/ballast)")
+
+
+# ---- a fake engine ------------------------------------------------------------------------
+
+class Fake(Engine):
+    """An engine that cannot express global damping; otherwise it keeps every disc where it
+    starts (no contacts), which is enough to write ballast's files."""
+    name, title = "fake", "FakeDEM"
+
+    def problem(self):
+        return ""
+
+    def identity(self):
+        return {"fake": 1}
+
+    def plan(self, scene, command):
+        plan = Plan()
+        if scene.number("alpha") > 0:
+            plan.add(f"global damping alpha = {scene.number('alpha'):g}", REFUSED, "FakeDEM has no drag")
+        plan.add("walls", EXACT, "kept where they are")
+        plan.unexpressible["Ee"] = "FakeDEM keeps no springs"
+        return plan
+
+    def simulate(self, scene, plan, work):
+        d = scene.discs
+        walls = [(w.ax, w.ay, w.bx, w.by) for w in scene.walls]
+        frames = [Frame(n, n * scene.dt, d["x"], d["y"], 0 * d["x"], 0 * d["x"], 0 * d["x"],
+                        contacts_of([]), walls) for n in range(1, scene.total_cycles + 1)]
+        stages = [{"name": s.name, "cycles": s.cycles, "max_cycles": s.cycles, "stop_rule": False,
+                   "stopped": False} for s in scene.stages]
+        return Trajectory(frames, frames[-1], stages, scene.total_cycles, 0.5)
+
+
+def check(name, variant, quantity, lo=-1e300, hi=1e300, case="two_discs"):
+    return Check(name=name, case=case, quantity=quantity, tolerance="interval",
+                 tolerance_text="interval", kind="analytic", provenance="test", variant=variant,
+                 lo=lo, hi=hi)
+
+
+@needs_ballast
+def test_a_feature_the_engine_cannot_express_makes_every_check_reading_it_not_expressible(tmp_path):
+    root = tmp_path / "runs"
+    assert make_run(Fake(), TWO_DISCS, ["settings.alpha=8"], "run", root / "two_discs" / "damped", BALLAST) == 0
+    assert make_run(Fake(), TWO_DISCS, [], "run", root / "two_discs" / "plain", BALLAST) == 0
+    info = json.loads((root / "two_discs" / "damped" / "run.json").read_text())
+    assert info["status"] == "not_expressible" and "global damping alpha = 8: FakeDEM has no drag" in info["message"]
+    assert info["message"].startswith("not expressible in FakeDEM")
+    assert [f["status"] for f in info["features"]] == [REFUSED, EXACT]
+    store = RunStore(folder_locator(root))
+    direct = evaluate_check(check("c1", "damped", "last(Fn_B)"), store)
+    # read through another variant (series() of a sibling): not expressible as well
+    sibling = evaluate_check(check("c2", "plain", "last(series('damped', 'Fn_B'))"), store)
+    for v in (direct, sibling):
+        assert v.result == "NOT EXPRESSIBLE" and not v.passed and not v.skipped and not v.known
+        assert "FakeDEM has no drag" in v.unexpressible and v.as_dict()["not_expressible"] == v.unexpressible
+    # the expressible run is checked as any run: a pass, and a fail
+    assert evaluate_check(check("c3", "plain", "last(Fn_B)", hi=1.0), store).result == "PASS"
+    assert evaluate_check(check("c4", "plain", "last(Fn_B)", lo=1.0), store).result == "FAIL"
+    # a column the engine cannot give: that check alone is not expressible, with the engine's reason
+    v = evaluate_check(check("c5", "plain", "max(Ee) + last(Fn_B)"), store)
+    assert v.result == "NOT EXPRESSIBLE" and "Ee: FakeDEM keeps no springs" in v.message
+    # and the energy audit, which is ballast's own ledger
+    v = evaluate_check(check("c6", "plain", "energy('relative_imbalance')"), store)
+    assert v.result == "NOT EXPRESSIBLE" and "energy ledger" in v.message
+
+
+def test_a_not_expressible_run_is_neither_a_failure_nor_unfinished(tmp_path):
+    from harness.tables import run_failure, unfinished_outputs
+    info = {"status": "not_expressible", "message": "not expressible in X: y"}
+    (tmp_path / "run.json").write_text(json.dumps(info))
+    assert run_failure(tmp_path, info) is None
+    assert unfinished_outputs(tmp_path, "lammps:run") == ""
+    (tmp_path / "run.json").unlink()
+    assert "run.json missing" in unfinished_outputs(tmp_path, "lammps:run")
+
+
+# ---- the scene as the adapters read it ----------------------------------------------------
+
+def test_set_lines_replace_keys_a_walls_motion_and_cycles_for_time(tmp_path):
+    path = tmp_path / "s.scene"
+    path.write_text("[settings]\ndt = 0.01\n[material m]\nkn = 5\n[stage a]\ntime = 2\n"
+                    "move = w1 1 0 0\nmove = w2 0 1 0\n[probe p]\nquantity = n_contacts\n")
+    s = scenes.read(path, ["settings.alpha=3", "material.m.kn=7", "stage.a.move=w1 0 0 2",
+                           "stage.a.cycles=4"])
+    assert s.number("alpha") == 3 and s.materials["m"].kn == 7 and s.materials["m"].ks == 7
+    stage = s.stages[0]
+    assert "time" not in stage.keys and stage.keys["cycles"] == "4"
+    assert [(c.wall, c.words) for c in stage.controls] == [("w2", ["0", "1", "0"]), ("w1", ["0", "0", "2"])]
+    with pytest.raises(scenes.SceneError, match="no \\[material q\\]"):
+        scenes.read(path, ["material.q.kn=1"])
+
+
+# ---- the LAMMPS translation of small scenes ------------------------------------------------
+
+def resolved(tmp_path, path, sets=()):
+    s = scenes.read(path, sets)
+    return scenes.resolve(s, BALLAST, tmp_path / "work")
+
+
+def cmds(text):
+    return [l.split("#")[0].split() for l in text.splitlines() if l.split("#")[0].strip()]
+
+
+@needs_ballast
+def test_hertz_gets_one_type_per_radius_and_k_over_sqrt_delta0_r_eff(tmp_path):
+    s = resolved(tmp_path, COLLISION, ["settings.nu=1.5", "material.disc.kn=50000", "settings.gamma_n=40"])
+    plan = lammps.Lammps().plan(s, "run")
+    assert not plan.refused() and plan.options["lammps"].types == [("disc", 1.0), ("disc", 0.75)]
+    coeffs = {(c[1], c[2]): c for c in cmds(lammps.translate(s, plan.options["lammps"])) if c[0] == "pair_coeff"}
+    for (i, j), ra, rb in ((("1", "1"), 1.0, 1.0), (("1", "2"), 1.0, 0.75), (("2", "2"), 0.75, 0.75)):
+        c = coeffs[(i, j)]
+        assert c[3] == "hertz" and float(c[4]) == 50000 / math.sqrt(1.0 * ra * rb / (ra + rb))
+        assert c[5] == "40.0" and c[-2:] == ["damping", "velocity"]     # gamma_n, not scaled by m_eff
+    assert "pair_style      granular" in lammps.translate(s, plan.options["lammps"])
+
+
+@needs_ballast
+def test_what_lammps_cannot_express_is_refused_feature_by_feature(tmp_path):
+    engine = lammps.Lammps()
+    refused = lambda sets, command="run": [f.name for f in engine.plan(resolved(tmp_path, COLLISION, sets),
+                                                                       command).refused()]
+    assert refused([]) == []
+    assert refused(["settings.nu=2"]) == ["normal law: power, nu = 2"]
+    assert refused(["settings.gamma_n=4", "settings.psi=0.5"]) == [
+        "viscous normal damping gamma_n (delta/delta0)^psi, psi = 0.5"]
+    assert refused(["settings.integrator=gear5"]) == ["integrator: gear5"]
+    assert refused(["material.disc.rolling=0.5", "settings.rolling_model=model2"]) == [
+        "rolling resistance: JYH Model 2 (elasto-brittle)"]
+    assert refused(["material.disc.cohesion=1"]) == ["cohesion"]
+    assert refused([], "exact") == ["command: exact (ballast's static solver)"]
+    plan = engine.plan(resolved(tmp_path, TWO_DISCS, []), "run")
+    assert [f.status for f in plan.features if f.name.startswith("normal law")] == [APPROXIMATE]
+
+
+@needs_ballast
+def test_global_damping_maps_exactly_through_mass_langevin_and_a_trim(tmp_path):
+    s = resolved(tmp_path, TWO_DISCS, ["settings.alpha=10"])
+    opts = lammps.Lammps().plan(s, "run").options["lammps"]
+    h = 10 * 0.01 / 2
+    assert opts.scale == 1 + h
+    text = lammps.translate(s, opts)
+    c = cmds(text)
+    drag = next(x for x in c if x[:2] == ["fix", "drag"])
+    # rotational drag -0.4 m' r^2 omega / damp = -alpha I omega: 1/damp = 1.25 alpha / s
+    assert drag[3] == "langevin" and float(drag[6]) == pytest.approx((1 + h) / (1.25 * 10), rel=1e-15)
+    assert drag[-2:] == ["omega", "yes"] and drag[4:6] == ["0.0", "0.0"]
+    assert f"variable        trimx atom 2.5*mass/{1 + h!r}*vx" in text        # +alpha m v/4
+    data = lammps.data_text(s, opts)
+    assert f" {1000 * (1 + h)!r} " in data                                    # densities times s
+
+
+@needs_ballast
+def test_walls_move_from_where_each_stage_found_them(tmp_path):
+    s = resolved(tmp_path, TWO_DISCS, [])
+    text = lammps.translate(s, lammps.Lammps().plan(s, "run").options["lammps"])
+    assert "region          W0 plane 0.0 0.0 0.0 1.0 -6.123233995736766e-17 0.0 side in units box " \
+           "move v_W0_dx v_W0_dy NULL" in text
+    lines = text.splitlines()
+    load, hold = lines.index("# stage load: 40 cycles"), lines.index("# stage hold: 600 cycles")
+    # the displacement is read (immediate) before `start` moves on, then this stage's rate
+    assert lines[load + 1] == "variable        W0_dx0 equal $(v_W0_dx:%.17g)"
+    assert 'variable        W0_dx equal "v_W0_dx0+0.0012*(step-v_start)"' in lines[load:hold]
+    assert 'variable        W0_dx equal "v_W0_dx0+0.0*(step-v_start)"' in lines[hold:]
+    assert lammps.walls_at(s, [(s.stages[0], 40), (s.stages[1], 600)], 100)[0][0] == pytest.approx(0.048)
+
+
+def test_the_gravity_ramp_is_the_cores_c_plus_one_over_c():
+    class S:
+        def __init__(self, cycles, ramp):
+            self.cycles, self.keys = cycles, {"ramp": str(ramp)}
+
+        def number(self, key):
+            return float(self.keys[key])
+
+    class Sc:
+        stages = [S(10, 0), S(4000, 1), S(5, 0)]
+    expr = lammps.gfac_expr(Sc, [0, 10, 4010])
+    value = lambda step: eval(expr.replace("step", str(step)))    # LAMMPS's booleans are Python's here
+    assert [value(n) for n in (5, 10, 11, 12, 4010, 4011)] == [1, 1, 1 / 4000, 2 / 4000, 1, 1]
+
+
+# ---- round trip: a trajectory as ballast's files -------------------------------------------
+
+@needs_ballast
+def test_a_trajectory_comes_back_through_ballasts_readers_with_ballasts_conventions(tmp_path):
+    """Two discs x (50, 0) and y (149.9, 0), r = 50: overlap 0.1, F_n = 1e8 + dashpot 5; x
+    also touches the left wall (its line x = 0) with overlap 0.02.  What the files say must be
+    what the frame says, in ballast's conventions."""
+    s = resolved(tmp_path, TWO_DISCS, [])
+    x, y = np.array([50.0, 149.9]), np.zeros(2)
+    rows = [dict(a=0, b=1, wall=0, nx=1.0, ny=0.0, px=99.95, py=0.0, delta=0.1, fn=1e8, dn=5.0, fs=2.0, ds=1.0),
+            dict(a=0, b=0, wall=1, nx=-1.0, ny=0.0, px=-0.01 + 0.0, py=0.0, delta=0.02, fn=2e7, dn=0.0,
+                 fs=0.0, ds=0.0)]
+    walls = [(w.ax, w.ay, w.bx, w.by) for w in s.walls]
+    frame = Frame(1, 0.01, x, y, np.array([0.1, -0.1]), np.zeros(2), np.zeros(2), contacts_of(rows), walls)
+    traj = Trajectory([frame], frame, [{"name": "load", "cycles": 1, "max_cycles": 40, "stop_rule": False,
+                                        "stopped": False}], 1, 0.25)
+    out = tmp_path / "out"
+    plan = Plan()
+    outputs.write(s, plan, traj, out, {"engine": "test"}, 1.0)
+    run = load_run(out)
+    assert run.info["status"] == "ok" and run.info["particle_steps"] == 2 and run.info["engine_seconds"] == 0.25
+    assert run.columns["Fn_B"].tolist() == [1e8] and run.columns["Fn_A"].tolist() == [2e7]
+    e_el = 1e8 ** 2 / 2e9 + 2.0 ** 2 / 2e9 + 2e7 ** 2 / 2e9          # F_n^2/(2 k_n) + F_s^2/(2 k_s)
+    assert run.columns["Ek"][0] == pytest.approx(2 * 0.5 * s.discs["m"][0] * 0.01)
+    assert run.columns["Ee"][0] == pytest.approx(e_el, rel=1e-15)
+    assert "Ee" not in run.info["unexpressible"] and "energy" in run.info["unexpressible"]
+    st = final_state.state(run)
+    forces = st.contacts()
+    byname = {tuple(sorted(c["key"])): c for c in forces}
+    assert byname[("x", "y")]["force"] == 1e8 + 5.0
+    # contacts.tsv: the force on a is -(fn + dn) e - (fs + ds) t, t = (ny, -nx)
+    t = final_state.Table(out / "contacts.tsv", ("a", "b", "kind", "nx", "fn", "fs", "dn", "ds"))
+    assert t.text("a") == ["x", "x"] and t.text("b") == ["y", "left"] and t.numbers("ds").tolist() == [1.0, 0.0]
+    walls = final_state.Table(out / "walls.tsv", ("name", "f1", "f2"))
+    assert walls.numbers("f1").tolist() == [-2e7, 0.0]             # the disc pushes the left wall to -x
+    stress = final_state.Table(out / "stress.tsv", ("name", "sxx", "szz", "V"))
+    # disc y: f = (fn + dn) e on y, l = -(r - delta/2) e: sxx = -(1e8 + 5)(50 - 0.05)/V
+    v = 2 * math.sqrt(3) * 50 ** 2
+    assert stress.numbers("sxx")[1] == pytest.approx(-(1e8 + 5) * 49.95 / v, rel=1e-14)
+    assert stress.numbers("szz")[1] == pytest.approx((2.0 + 1.0) * 0.0, abs=1e-6)
+
+
+def test_a_matrix_of_some_cases_replaces_only_their_rows(tmp_path):
+    from harness.engines import matrix
+
+    def row(case, result):
+        return {"case": case, "title": case, "tier": "quick", "not_expressible": {},
+                "ballast": {"particle_steps": 1.0, "seconds": 1.0, "runs": 1, "variants": 1},
+                "engine": {"particle_steps": 1.0, "seconds": 2.0, "runs": 1, "variants": 1},
+                "checks": [{"check": "c", "variant": "v", "quantity": "q", "reference": 1.0,
+                            "tolerance": "rel 1", "kind": "analytic",
+                            "ballast": {"result": "PASS", "value": 1.0, "message": ""},
+                            "engine": {"result": result, "value": None, "message": "why"}}]}
+    out = tmp_path / "peers"
+    matrix.write([row("collisions", "PASS"), row("two_discs", "FAIL")], "lammps", "LAMMPS", 0, out)
+    rows = matrix.merged([row("two_discs", "NOT EXPRESSIBLE")], "lammps", out)
+    assert [r["case"] for r in rows] == ["collisions", "two_discs"]           # the catalogue's order
+    totals = matrix.write(rows, "lammps", "LAMMPS", 0, out)
+    assert totals["engine"] == {"PASS": 1, "NOT EXPRESSIBLE": 1} and totals["ballast"] == {"PASS": 2}
+    assert matrix.merged([row("two_discs", "PASS")], "other", out) == [row("two_discs", "PASS")]

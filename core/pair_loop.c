@@ -266,14 +266,26 @@ add_side(double *restrict f, float *restrict dsh, int k, const int minus,
 /* ------------------------------------------------------------------ */
 
 #if defined(BAL_X2)
-/* The lanes of a pair of contacts whose flags do not say BROKEN (Model 2:
- * the rolling resistance is gone), as a mask: a table indexed by the two
- * flags (a mask built lane by lane from the flags cost 17 instructions a
- * pair of contacts, callgrind). */
-static inline __attribute__((always_inline)) bal_v2m live_x2(uint8_t fa, uint8_t fb)
+/* The flags of a pair of contacts in one word: contact a's in bits 0-7,
+ * contact b's in bits 8-15 (two bytes kept apart cost the loop a register
+ * each, and spills).  FL2(flag): the flag in both; fl2_lanes(bits, flag):
+ * the flag in the contacts whose bit is set in a movemask's bits (bit 0:
+ * a, bit 1: b). */
+#define FL2(flag) ((unsigned)(flag) * 0x101u)
+static inline __attribute__((always_inline)) unsigned fl2_lanes(int bits, unsigned flag)
+{
+    return (unsigned)((bits & 1) | (bits & 2) << 7) * flag;
+}
+
+/* The lanes of a pair of contacts whose flags (fl2) do not say BROKEN
+ * (Model 2: the rolling resistance is gone), as a mask: a table indexed by
+ * the two flags (a mask built lane by lane cost 17 instructions a pair of
+ * contacts, callgrind). */
+static inline __attribute__((always_inline)) bal_v2m live_x2(unsigned fl2)
 {
     static const bal_v2m live[4] = {{-1, -1}, {0, -1}, {-1, 0}, {0, 0}};
-    return live[((fa & BAL_PAIR_BROKEN) != 0) | ((fb & BAL_PAIR_BROKEN) != 0) << 1];
+    _Static_assert(BAL_PAIR_BROKEN == 8, "live_x2 reads the BROKEN flag as bits 3 and 11");
+    return live[((fl2 >> 3) & 1) | ((fl2 >> 10) & 2)];
 }
 
 /* What lane l of a pair of contacts, of discs i < j, adds to their sums:
@@ -363,11 +375,9 @@ two_at_a_time(struct bal_sim *restrict s, const struct bal_law_params *params, c
         pfn[cb] = fn[1];
         bal_v2 ftn = fn, fts = zero, dn = zero, ds = zero, mu_n = zero;
         /* A contact's lost rolling resistance (Model 2) lasts while it does. */
-        uint8_t fla = BAL_PAIR_TOUCHING, flb = BAL_PAIR_TOUCHING;
-        if (roll) {
-            fla |= pflags[ca] & BAL_PAIR_BROKEN;
-            flb |= pflags[cb] & BAL_PAIR_BROKEN;
-        }
+        unsigned fl = FL2(BAL_PAIR_TOUCHING);
+        if (roll)
+            fl |= (pflags[ca] | (unsigned)pflags[cb] << 8) & FL2(BAL_PAIR_BROKEN);
         if (damp) {
             mu_n = bal_law_dashpot_coef_x2(P, L, k.delta);
             dn = mu_n * k.ndot;
@@ -384,14 +394,11 @@ two_at_a_time(struct bal_sim *restrict s, const struct bal_law_params *params, c
             const int slide = bal_v2_bits(slid);
             if (slide) {
                 /* the slip's losses, contact by contact in the list's order */
-                if (slide & 1) {
+                if (slide & 1)
                     *lost_fric += loss[0];
-                    fla |= BAL_PAIR_SLIDING;
-                }
-                if (slide & 2) {
+                if (slide & 2)
                     *lost_fric += loss[1];
-                    flb |= BAL_PAIR_SLIDING;
-                }
+                fl |= fl2_lanes(slide, BAL_PAIR_SLIDING);
             }
             pfs[ca] = fs[0];
             pfs[cb] = fs[1];
@@ -413,22 +420,19 @@ two_at_a_time(struct bal_sim *restrict s, const struct bal_law_params *params, c
             ptr[cb] += dtheta[1];
             bal_v2 loss;
             bal_v2m capped;
-            bal_v2m live = live_x2(fla, flb);
+            bal_v2m live = live_x2(fl);
             mr = bal_law_roll_moment_x2(P, R, fn, dtheta, (bal_v2){pmr[ca], pmr[cb]}, live, &loss,
                                         &capped);
             const int cap = bal_v2_bits(capped);
             if (cap) {
                 /* the losses, contact by contact in the list's order */
-                const uint8_t flag = P->rolling_model == BAL_ROLLING_MODEL2 ? BAL_PAIR_BROKEN
-                                                                             : BAL_PAIR_ROLLING;
-                if (cap & 1) {
+                const unsigned flag = P->rolling_model == BAL_ROLLING_MODEL2 ? BAL_PAIR_BROKEN
+                                                                              : BAL_PAIR_ROLLING;
+                if (cap & 1)
                     *lost_roll += loss[0];
-                    fla |= flag;
-                }
-                if (cap & 2) {
+                if (cap & 2)
                     *lost_roll += loss[1];
-                    flb |= flag;
-                }
+                fl |= fl2_lanes(cap, flag);
                 if (P->rolling_model == BAL_ROLLING_MODEL2)
                     live &= ~capped; /* broken now */
             }
@@ -439,8 +443,8 @@ two_at_a_time(struct bal_sim *restrict s, const struct bal_law_params *params, c
                 mr = mr + md;
             }
         }
-        pflags[ca] = fla;
-        pflags[cb] = flb;
+        pflags[ca] = (uint8_t)fl;
+        pflags[cb] = (uint8_t)(fl >> 8);
         /* The force +(F_n e + F_s t) on j, the opposite on i (Fig. 3); the
          * moments: the shear force's, and the couple. */
         const bal_v2 fcx = ftn * ex + fts * ey;

@@ -44,8 +44,9 @@
  *                                         biaxial test and polydisperse pile
  *                                         against the race's dense scene,
  *                                         alternating: make bench)
- *        bench --biaxial BIAXIAL DELTA  (one biaxial test of --workload, its
- *                                         shearing counted under callgrind)
+ *        bench --biaxial BIAXIAL DELTA [SHEAR_CYCLES]  (one biaxial test of
+ *                                         --workload, its shearing counted
+ *                                         under callgrind)
  */
 #include <math.h>
 #include <stdio.h>
@@ -1126,13 +1127,13 @@ static const char *const biaxial_sets[] = {
 /* The sets of one biaxial test: biaxial_sets, the rolling resistance, the
  * shearing's length; returns how many. */
 #define BIAXIAL_SETS 16
-static int biaxial_variant(const char *sets[BIAXIAL_SETS], const char *rolling)
+static int biaxial_variant(const char *sets[BIAXIAL_SETS], const char *rolling, const char *shear)
 {
     const int n = (int)(sizeof biaxial_sets / sizeof biaxial_sets[0]);
     for (int k = 0; k < n; k++)
         sets[k] = biaxial_sets[k];
     sets[n] = rolling;
-    sets[n + 1] = "stage.shear.cycles=" BIAXIAL_SHEAR_TEXT;
+    sets[n + 1] = shear ? shear : "stage.shear.cycles=" BIAXIAL_SHEAR_TEXT;
     return n + 2;
 }
 
@@ -1241,15 +1242,18 @@ static void print_spread(const char *key, double *v, int n)
     printf(" %s=%.4g min=%.4g max=%.4g", key, v[n / 2], v[0], v[n - 1]);
 }
 
-/* One biaxial test of the workload (rolling: the δ of material grain), its
- * line; the timed window is what callgrind counts when run under it with
+/* One biaxial test of the workload (rolling: the δ of material grain;
+ * shear: its cycles of shearing, or NULL for the workload's), its line; the
+ * timed window is what callgrind counts when run under it with
  * --instr-atstart=no --collect-atstart=no (the profile of docs/benchmarks.md). */
-static int biaxial_one(const char *biaxial, const char *rolling)
+static int biaxial_one(const char *biaxial, const char *rolling, const char *shear)
 {
-    char set[64];
+    char set[64], cycles[64];
     const char *sets[BIAXIAL_SETS];
     snprintf(set, sizeof set, "material.grain.rolling=%s", rolling);
-    const int n = biaxial_variant(sets, set);
+    if (shear)
+        snprintf(cycles, sizeof cycles, "stage.shear.cycles=%s", shear);
+    const int n = biaxial_variant(sets, set, shear ? cycles : NULL);
     struct run_figures fig;
     if (workload_run(biaxial, sets, n, NULL, 1, &fig))
         return 1;
@@ -1287,8 +1291,8 @@ static int workload_bench(const char *dense, const char *biaxial, const char *po
         steps = (long)fmax(100, TARGET_SECONDS / (t / (double)steps));
     rc = rc || t < 0;
     const char *m0[BIAXIAL_SETS], *m1[BIAXIAL_SETS];
-    const int n_biax = biaxial_variant(m0, "material.grain.rolling=0");
-    biaxial_variant(m1, "material.grain.rolling=1.6");
+    const int n_biax = biaxial_variant(m0, "material.grain.rolling=0", NULL);
+    biaxial_variant(m1, "material.grain.rolling=1.6", NULL);
     double rate[W_KINDS][MAX_ROUNDS], ratio[W_KINDS][MAX_ROUNDS];
     struct run_figures fig[W_KINDS] = {{0}};
     for (int r = 0; r < rounds && rc == 0; r++) {
@@ -1369,8 +1373,8 @@ int main(int argc, char **argv)
         return threads_bench(argv[2], atol(argv[3]), atoi(argv[4]), argc == 6 ? atoi(argv[5]) : 9);
     if (strcmp(argv[1], "--cost") == 0 && argc == 5)
         return cost_run(argv[2], atol(argv[3]), atol(argv[4]));
-    if (strcmp(argv[1], "--biaxial") == 0 && argc == 4)
-        return biaxial_one(argv[2], argv[3]);
+    if (strcmp(argv[1], "--biaxial") == 0 && (argc == 4 || argc == 5))
+        return biaxial_one(argv[2], argv[3], argc == 5 ? argv[4] : NULL);
     if (strcmp(argv[1], "--workload") == 0 && (argc == 5 || argc == 6))
         return workload_bench(argv[2], argv[3], argv[4], argc == 6 ? atoi(argv[5]) : REPEATS);
     if (strcmp(argv[1], "--modules-summary") == 0 && argc == 7)

@@ -70,7 +70,7 @@
  * (each block's in par.block_sums): the cycle asks the neighbour search
  * whether the lists still hold (grid.c, bal_grid_due).
  *
- * Kept whole (about 640 lines, a third of them the derivations above): the
+ * Kept whole (about 740 lines, a third of them the derivations above): the
  * three laws of motion are rows of one table with the same two halves, and
  * they share the force-to-acceleration step, the gravity ramp, the held
  * components and the displacement tracking; a file per law would copy or

@@ -5,7 +5,7 @@
  * Matuttis, Luding & Herrmann eqs 2–3).  The disc–wall loop is
  * wall_loop.c's; how the list is shared between threads, threads.c's.
  *
- * Kept whole (about 650 lines, a third of them comments): each variant of
+ * Kept whole (about 780 lines, a third of them comments): each variant of
  * the table at the end compiles the passes above it with its own constant
  * MOD_* bits (inline functions, always inlined), so the passes and the
  * table must be one translation unit, and the passes read as one piece.
@@ -56,16 +56,18 @@
  * (docs/benchmarks.md, speed round two).  The chain is one_contact(), what
  * a contact adds to the sums add_side().
  *
- * Two at a time.  The commonest law (power law with ν = 1, tangential
- * spring, no damping or rolling, one material) takes its contacts two at a
- * time in the third pass, D and e included (two_at_a_time): the kernels are
- * the _x2 twins of those the one-contact chain calls, compiled from the
- * same source (laws_lanes.h), so the same bits, and an edit of a kernel
- * reaches both.  The sums and the friction losses are then added contact by
- * contact in the list's order.  Every variant's loop is held to its
- * one-contact run byte for byte (check_contacts.c,
- * contacts_every_variant_same_at_both_widths), and the catalogue's case
- * `coulomb` checks eq. (19) on scenes that run it.
+ * Two at a time.  The linear power law (ν = 1) on discs of one material,
+ * the catalogue's commonest (the race, the biaxial test, the piles), takes
+ * its contacts two at a time in the third pass, D and e included
+ * (two_at_a_time), with whatever sub-models the variant has (tangential
+ * spring, dashpots and viscous damping, rolling resistance of Model 1 or
+ * 2; issue 33; before it, the tangential spring alone): the kernels are the
+ * _x2 twins of those the one-contact chain calls, compiled from the same
+ * source (laws_lanes.h), so the same bits, and an edit of a kernel reaches
+ * both.  The sums and the losses are then added contact by contact in the
+ * list's order.  Every variant's loop is held to its one-contact run byte
+ * for byte (check_contacts.c, contacts_every_variant_same_at_both_widths),
+ * and the catalogue's case `coulomb` checks eq. (19) on scenes that run it.
  */
 #include <math.h>
 #include <stdlib.h>

@@ -1,7 +1,7 @@
 /*
  * bench.c — the dense-packing benchmark behind `make bench`.
  *
- * Kept whole (about 1000 lines): one benchmark program, whose modes share
+ * Kept whole (about 1400 lines): one benchmark program, whose modes share
  * the packing, the settling, the timing and the reporting.
  *
  * For each N it loads the benchmark scene through the ordinary scene

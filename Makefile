@@ -8,7 +8,8 @@
 #   make test-sanitize  C unit tests under AddressSanitizer + UndefinedBehaviorSanitizer
 #   make test-valgrind  one case under valgrind memcheck
 #   make test-slurm   harness export through a one-node Slurm on localhost (installs Slurm, MUNGE)
-#   make bench        dense-packing benchmark (median and spread of 5 repeats)
+#   make bench        dense-packing benchmark (median and spread of 5 repeats); the biaxial test
+#                     and the polydisperse pile against the race's dense scene, in one run
 #   make bench-peer   ballast against LAMMPS on the same physics (cross-check, then the race)
 #   make validate-peers  the catalogue through LAMMPS too, gated by the same references (reports/peers/)
 #   make test-peers   the engine adapters' tests with LAMMPS (installs it)
@@ -189,6 +190,8 @@ bench: deps $(BUILD)/bench
 	$(BUILD)/bench cases/bench/dense.scene
 	$(BUILD)/bench --settling cases/bench/dense.scene 20000
 	$(BUILD)/bench --pile cases/piles/pile30_bumpy.scene
+	$(BUILD)/bench --workload cases/bench/dense.scene cases/biaxial/biaxial.scene \
+	  cases/piles_poly/pile_poly.scene
 
 # Realisations per hour per core of the polydisperse L0 = 100 pile at r_d = 1/30
 # (issue 22): 20 seeds one after the other, CPU time per realisation, cycles to rest,

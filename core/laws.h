@@ -42,18 +42,18 @@
  * variants compiled without the kernels a scene switches off, so a scene
  * without friction or damping never runs their code or touches their
  * history; the disc–wall loop (wall_loop.c) calls every kernel (walls are
- * few).  The kernels the disc–disc loop also runs two contacts at a time
- * (normal, tangential) are written once for both widths, in laws_lanes.h
- * (see "the kernels of both widths" below): an edit there reaches every
- * loop.
+ * few).  The kernels are written once for both widths, one contact and
+ * two at a time, in laws_lanes.h (see "the kernels of both widths" below):
+ * an edit there reaches every loop.
  *
- * Adding a sub-model: one kernel here (with the stored energy of its spring,
- * if it has one, for the audit), one history column in struct bal_pairs
+ * Adding a sub-model: one kernel in laws_lanes.h, written with its lane
+ * operations (and here the stored energy of its spring, if it has one, for
+ * the audit, and its one-contact wrapper if it flags), one history column in struct bal_pairs
  * (state.h) with its reserve line (pairs.c) and its gather line in the
  * rebuild's merge (grid.c, install), and one switch: a flag the disc–disc
  * loop is specialised on (a MOD_* bit and its PAIR_VARIANT rows in
- * pair_loop.c) and the disc–wall loop tests.  A kernel that a two-lane loop
- * is to run goes into laws_lanes.h, written with its lane operations.
+ * pair_loop.c, where one_contact and two_at_a_time call it) and the
+ * disc–wall loop tests.
  *
  * Sign conventions are those of ballast.h (C&S Figs 2–3): ṅ = (ẋ − ẏ)·e > 0
  * closes the contact; F_n + D_n and F_s + D_s act on x along −e and −t.
@@ -99,9 +99,10 @@ struct bal_kin {
 
 /* ------------------------------------------------- the kernels of both widths */
 
-/* The kernels the disc–disc loop also runs two contacts at a time (the
- * normal law, the shear spring and its Coulomb cap) are written once, in
- * laws_lanes.h, on an abstract real BAL_R with a few lane operations, and
+/* The kernels of the chain (the normal law, the dashpots, the shear spring
+ * and its Coulomb cap, the rolling spring and its cap, the rolling dashpot)
+ * are written once, in laws_lanes.h, on an abstract real BAL_R with a few
+ * lane operations, and
  * compiled here twice: for one contact (BAL_R = double: bal_law_normal,
  * bal_law_shear, ...) and, where SSE2 exists (every x86-64), for two
  * (BAL_R = bal_v2, a GCC vector of two doubles: bal_law_normal_x2, ...).
@@ -117,6 +118,8 @@ struct bal_kin {
 #define BAL_SPLAT(x) (x)                   /* a constant in every lane */
 #define BAL_ANY(m) (m)                     /* is the mask set in some lane? */
 #define BAL_SELECT(m, a, b) ((m) ? (a) : (b))
+#define BAL_KEEP(m, x) ((m) ? (x) : 0.0)   /* x where the mask is set, else +0 */
+#define BAL_DROP(m, x) ((m) ? 0.0 : (x))   /* +0 where the mask is set, else x */
 #define BAL_ABS(x) fabs(x)
 #define BAL_COPYSIGN(mag, sgn) copysign(mag, sgn)
 #define BAL_SQRT(x) sqrt(x)
@@ -146,6 +149,9 @@ static inline bal_v2 bal_v2_select(bal_v2m m, bal_v2 a, bal_v2 b)
 {
     return (bal_v2)((m & (bal_v2m)a) | (~m & (bal_v2m)b));
 }
+/* x where m is set, +0 (all bits clear) elsewhere; and the other way round */
+static inline bal_v2 bal_v2_keep(bal_v2m m, bal_v2 x) { return (bal_v2)(m & (bal_v2m)x); }
+static inline bal_v2 bal_v2_drop(bal_v2m m, bal_v2 x) { return _mm_andnot_pd((__m128d)m, x); }
 static inline bal_v2m bal_v2_sign(void) { return (bal_v2m)bal_v2_splat(-0.0); }
 static inline bal_v2 bal_v2_abs(bal_v2 x) { return (bal_v2)(~bal_v2_sign() & (bal_v2m)x); }
 /* |mag| with the sign of sgn, as copysign */
@@ -163,6 +169,8 @@ static inline bal_v2 bal_v2_pow(bal_v2 x, double e) { return (bal_v2){pow(x[0], 
 #define BAL_SPLAT(x) bal_v2_splat(x)
 #define BAL_ANY(m) bal_v2_any(m)
 #define BAL_SELECT(m, a, b) bal_v2_select(m, a, b)
+#define BAL_KEEP(m, x) bal_v2_keep(m, x)
+#define BAL_DROP(m, x) bal_v2_drop(m, x)
 #define BAL_ABS(x) bal_v2_abs(x)
 #define BAL_COPYSIGN(mag, sgn) bal_v2_copysign(mag, sgn)
 #define BAL_SQRT(x) bal_v2_sqrt(x)
@@ -198,21 +206,14 @@ static inline double bal_law_normal_stiffness(const struct bal_law_params *P,
 
 /* --------------------------------------------------------------- damping */
 
-/* The coefficient γ_n (δ/δ0)^ψ of MLH eq. (3). */
-static inline double bal_law_viscous(const struct bal_law_params *P, double delta)
-{
-    if (P->gamma_n == 0)
-        return 0;
-    if (P->psi == 0)
-        return P->gamma_n;
-    return P->gamma_n * pow(delta / P->delta0, P->psi);
-}
+/* bal_law_viscous (γ_n (δ/δ0)^ψ), bal_law_dashpot_coef (μ_n = c_n + γ_n
+ * (δ/δ0)^ψ) and bal_law_shear_dashpot_of: laws_lanes.h, above. */
 
 /* D_n = (c_n + γ_n (δ/δ0)^ψ) ṅ. */
 static inline double bal_law_normal_dashpot(const struct bal_law_params *P,
                                             const struct bal_pair_law *L, const struct bal_kin *k)
 {
-    return (L->cn + bal_law_viscous(P, k->delta)) * k->ndot;
+    return bal_law_dashpot_coef(P, L, k->delta) * k->ndot;
 }
 
 /* D_s = c_s ṡ.  It acts only while the contact does not slide (C&S p. 52):
@@ -221,7 +222,7 @@ static inline double bal_law_normal_dashpot(const struct bal_law_params *P,
  * zero, which would turn its −0 into +0). */
 static inline double bal_law_shear_dashpot(const struct bal_pair_law *L, const struct bal_kin *k)
 {
-    return L->cs * k->sdot;
+    return bal_law_shear_dashpot_of(L, k, 0);
 }
 
 /* ------------------------------------------------------------ tangential */
@@ -253,65 +254,38 @@ static inline double bal_law_shear_energy(const struct bal_pair_law *L, double f
 
 /* --------------------------------------------------------------- rolling */
 
-/* The rolling parameters of a contact of common radius r (JYH eqs 24, 29,
- * 33, 49c): B = δ r, K_m = K_n B²/12, M_0 = F_n B/6, μ_m = μ_n B²/12
- * (the divisions by 12 and 6 written as products with their reciprocals:
- * the pair loop avoids a division a contact; round-off of a few ulps). */
-struct bal_roll {
-    double b;              /* contact width B */
-    double km;             /* rolling stiffness K_m */
-};
+/* struct bal_roll (B, K_m), bal_law_roll_of, bal_law_common_radius, and the
+ * kernels bal_law_roll_moment and bal_law_roll_dashpot: laws_lanes.h, above.
+ * M_0 = F_n B/6 (JYH eq. 33) and μ_m = μ_n B²/12 (eq. 49c) are computed in
+ * the kernels. */
 
-static inline struct bal_roll bal_law_roll_of(const struct bal_pair_law *L, double r)
-{
-    const double b = L->rolling * r;
-    return (struct bal_roll){b, L->kn * b * b * (1.0 / 12)};
-}
-
-/* The common radius 2 r1 r2/(r1 + r2) of two discs (eq. 9b). */
-static inline double bal_law_common_radius(double r1, double r2)
-{
-    return 2 * r1 * r2 / (r1 + r2);
-}
-
-/* The elastic rolling moment M at t_N from its history m_prev and the
- * increment of relative rotation dtheta = (ω_x − ω_y) Δt, with the elastic
- * F_n of this cycle (the cap follows the current normal force).  Model 1
- * caps |M| at M_0: the capped spring gives up (|M| − M_0)/K_m of plastic
- * rolling against M_0, added to *lost, and the contact is flagged ROLLING.
- * Model 2: a contact flagged BROKEN carries no moment; one whose |M| would
- * pass M_0 is flagged BROKEN and its spring's energy M²/(2 K_m) is lost. */
+/* The elastic rolling moment M at t_N (bal_law_roll_moment) of one contact,
+ * with its flags: a contact flagged BROKEN (Model 2) carries no moment; one
+ * capped is flagged ROLLING (Model 1: its loss to plastic rolling added to
+ * *lost) or BROKEN (Model 2: its spring's energy M²/(2 K_m) added). */
 static inline double bal_law_rolling(const struct bal_law_params *P, struct bal_roll R, double fn,
                                      double dtheta, double m_prev, double *lost, uint8_t *flags)
 {
-    if (*flags & BAL_PAIR_BROKEN)
-        return 0;
-    double m = m_prev + R.km * dtheta;
-    const double m0 = fn * R.b * (1.0 / 6);
-    if (fabs(m) > m0) {
-        if (P->rolling_model == BAL_ROLLING_MODEL2) {
-            *lost += m * m / (2 * R.km);
-            *flags |= BAL_PAIR_BROKEN;
-            return 0;
-        }
-        *lost += m0 * (fabs(m) - m0) / R.km;
-        m = copysign(m0, m);
-        *flags |= BAL_PAIR_ROLLING;
+    double loss;
+    int capped;
+    const double m = bal_law_roll_moment(P, R, fn, dtheta, m_prev, !(*flags & BAL_PAIR_BROKEN),
+                                         &loss, &capped);
+    if (capped) {
+        *lost += loss;
+        *flags |= P->rolling_model == BAL_ROLLING_MODEL2 ? BAL_PAIR_BROKEN : BAL_PAIR_ROLLING;
     }
     return m;
 }
 
-/* The rolling dashpot's moment M_d = μ_m θ̇_r, μ_m = μ_n B²/12 (eq. 49c),
- * with μ_n the pair's normal dashpot coefficient at overlap δ.  A contact
- * flagged BROKEN (Model 2: its width B is gone, Sec. 3.1) has none: μ_m is
- * the normal dashpots spread over B (eqs 44–47), and they go with it. */
+/* The rolling dashpot's moment M_d = μ_m θ̇_r (bal_law_roll_dashpot) of one
+ * contact at overlap δ, with its flags after the rolling kernel (none if
+ * BROKEN). */
 static inline double bal_law_rolling_dashpot(const struct bal_law_params *P,
                                              const struct bal_pair_law *L, struct bal_roll R,
                                              double delta, double theta_dot, uint8_t flags)
 {
-    if (flags & BAL_PAIR_BROKEN)
-        return 0;
-    return (L->cn + bal_law_viscous(P, delta)) * R.b * R.b * (1.0 / 12) * theta_dot;
+    return bal_law_roll_dashpot(bal_law_dashpot_coef(P, L, delta), R, theta_dot,
+                                !(flags & BAL_PAIR_BROKEN));
 }
 
 /* The energy the rolling spring stores, M²/(2 K_m). */

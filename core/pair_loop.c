@@ -5,7 +5,7 @@
  * Matuttis, Luding & Herrmann eqs 2–3).  The disc–wall loop is
  * wall_loop.c's; how the list is shared between threads, threads.c's.
  *
- * Kept whole (about 650 lines, a third of them comments): each variant of
+ * Kept whole (about 780 lines, a third of them comments): each variant of
  * the table at the end compiles the passes above it with its own constant
  * MOD_* bits (inline functions, always inlined), so the passes and the
  * table must be one translation unit, and the passes read as one piece.
@@ -56,16 +56,18 @@
  * (docs/benchmarks.md, speed round two).  The chain is one_contact(), what
  * a contact adds to the sums add_side().
  *
- * Two at a time.  The commonest law (power law with ν = 1, tangential
- * spring, no damping or rolling, one material) takes its contacts two at a
- * time in the third pass, D and e included (two_at_a_time): the kernels are
- * the _x2 twins of those the one-contact chain calls, compiled from the
- * same source (laws_lanes.h), so the same bits, and an edit of a kernel
- * reaches both.  The sums and the friction losses are then added contact by
- * contact in the list's order.  Every variant's loop is held to its
- * one-contact run byte for byte (check_contacts.c,
- * contacts_every_variant_same_at_both_widths), and the catalogue's case
- * `coulomb` checks eq. (19) on scenes that run it.
+ * Two at a time.  The linear power law (ν = 1) on discs of one material,
+ * the catalogue's commonest (the race, the biaxial test, the piles), takes
+ * its contacts two at a time in the third pass, D and e included
+ * (two_at_a_time), with whatever sub-models the variant has (tangential
+ * spring, dashpots and viscous damping, rolling resistance of Model 1 or
+ * 2; issue 33; before it, the tangential spring alone): the kernels are the
+ * _x2 twins of those the one-contact chain calls, compiled from the same
+ * source (laws_lanes.h), so the same bits, and an edit of a kernel reaches
+ * both.  The sums and the losses are then added contact by contact in the
+ * list's order.  Every variant's loop is held to its one-contact run byte
+ * for byte (check_contacts.c, contacts_every_variant_same_at_both_widths),
+ * and the catalogue's case `coulomb` checks eq. (19) on scenes that run it.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -170,8 +172,10 @@ one_contact(const struct bal_law_params *P, const struct bal_pair_law *L, const 
     /* A contact's lost rolling resistance (Model 2) lasts while it does. */
     uint8_t flags = roll ? (uint8_t)(BAL_PAIR_TOUCHING | (pflags[c] & BAL_PAIR_BROKEN))
                          : BAL_PAIR_TOUCHING;
+    double mu_n = 0; /* the normal dashpot's coefficient, which the rolling one also uses */
     if (damp) {
-        dn = bal_law_normal_dashpot(P, L, &k);
+        mu_n = bal_law_dashpot_coef(P, L, k.delta);
+        dn = mu_n * k.ndot;
         ftn += dn;
     }
     if (shear && L->shear) {
@@ -195,7 +199,7 @@ one_contact(const struct bal_law_params *P, const struct bal_pair_law *L, const 
         mr = bal_law_rolling(P, R, fn, dtheta, pmr[c], lost_roll, &flags);
         pmr[c] = mr;
         if (damp) {
-            md = bal_law_rolling_dashpot(P, L, R, k.delta, wrel, flags);
+            md = bal_law_roll_dashpot(mu_n, R, wrel, !(flags & BAL_PAIR_BROKEN));
             mr += md;
         }
     }
@@ -264,29 +268,92 @@ add_side(double *restrict f, float *restrict dsh, int k, const int minus,
 /* ------------------------------------------------------------------ */
 
 #if defined(BAL_X2)
-/* Pass 3 of the commonest loop (linear power law, tangential spring, no
- * damping or rolling, one material, no logging) two contacts at a time:
- * the same kinematics as the one-contact pass, lane by lane, and the _x2
- * kernels of laws_lanes.h, so the same bits; the force sums are then added
- * contact by contact in the list's order, and the losses of sliding
- * contacts too.  Returns the contacts done (nt rounded down to even); the
- * one-contact pass does the last. */
-static inline __attribute__((always_inline)) int
-two_at_a_time(struct bal_sim *restrict s, const struct bal_law_params *params, long c0,
-              const int32_t *restrict tc, const double *restrict tq, const double *restrict tdx,
-              const double *restrict tdy, int nt, double budget, int *over, double *lost_fric)
+/* The flags of a pair of contacts in one word: contact a's in bits 0-7,
+ * contact b's in bits 8-15 (two bytes kept apart cost the loop a register
+ * each, and spills).  FL2(flag): the flag in both; fl2_lanes(bits, flag):
+ * the flag in the contacts whose bit is set in a movemask's bits (bit 0:
+ * a, bit 1: b). */
+#define FL2(flag) ((unsigned)(flag) * 0x101u)
+static inline __attribute__((always_inline)) unsigned fl2_lanes(int bits, unsigned flag)
 {
+    return (unsigned)((bits & 1) | (bits & 2) << 7) * flag;
+}
+
+/* The lanes of a pair of contacts whose flags (fl2) do not say BROKEN
+ * (Model 2: the rolling resistance is gone), as a mask: a table indexed by
+ * the two flags (a mask built lane by lane cost 17 instructions a pair of
+ * contacts, callgrind). */
+static inline __attribute__((always_inline)) bal_v2m live_x2(unsigned fl2)
+{
+    static const bal_v2m live[4] = {{-1, -1}, {0, -1}, {-1, 0}, {0, 0}};
+    _Static_assert(BAL_PAIR_BROKEN == 8, "live_x2 reads the BROKEN flag as bits 3 and 11");
+    return live[((fl2 >> 3) & 1) | ((fl2 >> 10) & 2)];
+}
+
+/* What lane l of a pair of contacts, of discs i < j, adds to their sums:
+ * −(F_x, F_y) to i's force and +(F_x, F_y) to j's (fxy: the two as one
+ * pair of lanes), the moments tqi and tqj; with damping the dashpots' share
+ * of each, in float as s->dash (dxy: the force's share, (F_x, F_y) of the
+ * contact, and dtq: i's moment, j's moment, in the two low floats).  The
+ * same additions to the same sums as add_side() on i, then on j; the
+ * floats two at a time where they are adjacent (IEEE's operations lane by
+ * lane: the same bits). */
+static inline __attribute__((always_inline)) void
+add_contact_x2(double *restrict f, float *restrict dsh, int i, int j, __m128d fxy, double tqi,
+               double tqj, __m128 dxy, __m128 dtq, const int mods)
+{
+    const int shear = (mods & MOD_SHEAR) != 0, damp = (mods & MOD_DAMP) != 0;
+    double *restrict fi = f + 3 * (size_t)i, *restrict fj = f + 3 * (size_t)j;
+    _mm_storeu_pd(fi, _mm_sub_pd(_mm_loadu_pd(fi), fxy));
+    _mm_storeu_pd(fj, _mm_add_pd(_mm_loadu_pd(fj), fxy));
+    if (shear) {
+        fi[2] += tqi;
+        fj[2] += tqj;
+    }
+    if (damp) {
+        float *restrict di = dsh + 3 * (size_t)i, *restrict dj = dsh + 3 * (size_t)j;
+        const __m128 z = _mm_setzero_ps();
+        _mm_storel_pi((__m64 *)di, _mm_sub_ps(_mm_loadl_pi(z, (const __m64 *)di), dxy));
+        _mm_storel_pi((__m64 *)dj, _mm_add_ps(_mm_loadl_pi(z, (const __m64 *)dj), dxy));
+        if (shear) {
+            _mm_store_ss(di + 2, _mm_add_ss(_mm_load_ss(di + 2), dtq));
+            _mm_store_ss(dj + 2,
+                         _mm_add_ss(_mm_load_ss(dj + 2), _mm_shuffle_ps(dtq, dtq, 1)));
+        }
+    }
+}
+
+/* Pass 3 of a loop of the linear power law on discs of one material (the
+ * catalogue's commonest: the race, the biaxial test, the piles), in the
+ * chunks that do not log, two contacts at a time: the same kinematics as
+ * the one-contact pass, lane by lane, and the _x2 kernels of laws_lanes.h
+ * in one_contact()'s order, so the same bits; the force sums are then
+ * added contact by contact in the list's order, and the losses of sliding
+ * and rolling contacts too.  Returns the contacts done (nt rounded down to
+ * even); the one-contact pass does the last.  The variant's bits (mods)
+ * leave out what it does not run, as in one_contact(). */
+static inline __attribute__((always_inline)) int
+two_at_a_time(struct bal_sim *restrict s, const struct bal_law_params *params, const int mods,
+              long c0, const int32_t *restrict tc, const double *restrict tq,
+              const double *restrict tdx, const double *restrict tdy, int nt, double budget,
+              int *over, double *lost_fric, double *lost_roll)
+{
+    const int damp = (mods & MOD_DAMP) != 0, roll = (mods & MOD_ROLL) != 0;
     /* The law's parameters in locals: through pointers, the compiler
      * reloaded (and broadcast) each one after every store to the sums. */
     const struct bal_law_params P_ = *params, *P = &P_;
     const struct bal_pair_law L_ = *s->disc_law, *L = &L_;
+    const int shear = (mods & MOD_SHEAR) && L->shear, rolling = roll && L->rolling > 0;
     const struct bal_pairs *p = &s->pp;
     const int32_t *restrict pi = p->i, *restrict pj = p->j;
     double *restrict pfn = p->fn, *restrict pfs = p->fs;
+    double *restrict pmr = p->mr, *restrict ptr = p->tr;
     uint8_t *restrict pflags = p->flags;
     const double *restrict r = s->r, *restrict vx = s->vx, *restrict vy = s->vy;
     const double *restrict w = s->w;
     double *restrict f = s->f;
+    float *restrict dsh = s->dash;
+    const bal_v2 zero = bal_v2_splat(0.0);
     int ov = 0;
     const int n2 = nt & ~1;
     for (int q = 0; q < n2; q += 2) {
@@ -303,49 +370,110 @@ two_at_a_time(struct bal_sim *restrict s, const struct bal_law_params *params, l
         k.delta = (ri + rj) - dist;
         ov |= bal_v2_bits(k.delta > budget);
 
-        /* The chain: normal -> tangential (one_contact's, lane by lane). */
+        /* The chain of one_contact(), lane by lane: normal -> damping ->
+         * tangential -> rolling. */
         const bal_v2 fn = bal_law_normal_x2(P, L, &k, (bal_v2){pfn[ca], pfn[cb]});
-        const bal_v2 tx = ey, ty = -ex;
-        k.sdot = rvx * tx + rvy * ty - ((bal_v2){w[ia], w[ib]} * ri + (bal_v2){w[ja], w[jb]} * rj);
-        bal_v2 loss;
-        bal_v2m slid;
-        const bal_v2 fs = bal_law_shear_x2(P, L, &k, fn, (bal_v2){pfs[ca], pfs[cb]}, &loss, &slid);
-        uint8_t fla = BAL_PAIR_TOUCHING, flb = BAL_PAIR_TOUCHING;
-        const int slide = bal_v2_bits(slid);
-        if (slide) {
-            /* the slip's losses, contact by contact in the list's order */
-            if (slide & 1) {
-                *lost_fric += loss[0];
-                fla |= BAL_PAIR_SLIDING;
-            }
-            if (slide & 2) {
-                *lost_fric += loss[1];
-                flb |= BAL_PAIR_SLIDING;
-            }
-        }
         pfn[ca] = fn[0];
         pfn[cb] = fn[1];
-        pfs[ca] = fs[0];
-        pfs[cb] = fs[1];
-        pflags[ca] = fla;
-        pflags[cb] = flb;
-        /* moments F_s r, and the force +(F_n e + F_s t) on j */
-        const bal_v2 tqi = fs * ri, tqj = fs * rj;
-        const bal_v2 fcx = fn * ex + fs * ey;
-        const bal_v2 fcy = fn * ey - fs * ex;
-        /* (F_x, F_y) of each contact as one pair of lanes: the same
-         * additions to the same sums, in the same order */
-        const __m128d fa_ = _mm_unpacklo_pd(fcx, fcy), fb_ = _mm_unpackhi_pd(fcx, fcy);
-        double *restrict fa = f + 3 * (size_t)ia, *restrict fja = f + 3 * (size_t)ja;
-        _mm_storeu_pd(fa, _mm_sub_pd(_mm_loadu_pd(fa), fa_));
-        _mm_storeu_pd(fja, _mm_add_pd(_mm_loadu_pd(fja), fa_));
-        fa[2] += tqi[0];
-        fja[2] += tqj[0];
-        double *restrict fb = f + 3 * (size_t)ib, *restrict fjb = f + 3 * (size_t)jb;
-        _mm_storeu_pd(fb, _mm_sub_pd(_mm_loadu_pd(fb), fb_));
-        _mm_storeu_pd(fjb, _mm_add_pd(_mm_loadu_pd(fjb), fb_));
-        fb[2] += tqi[1];
-        fjb[2] += tqj[1];
+        bal_v2 ftn = fn, fts = zero, dn = zero, ds = zero, mu_n = zero;
+        /* A contact's lost rolling resistance (Model 2) lasts while it does. */
+        unsigned fl = FL2(BAL_PAIR_TOUCHING);
+        if (roll)
+            fl |= (pflags[ca] | (unsigned)pflags[cb] << 8) & FL2(BAL_PAIR_BROKEN);
+        if (damp) {
+            mu_n = bal_law_dashpot_coef_x2(P, L, k.delta);
+            dn = mu_n * k.ndot;
+            ftn = fn + dn;
+        }
+        if (shear) {
+            const bal_v2 tx = ey, ty = -ex;
+            k.sdot = rvx * tx + rvy * ty -
+                     ((bal_v2){w[ia], w[ib]} * ri + (bal_v2){w[ja], w[jb]} * rj);
+            bal_v2 loss;
+            bal_v2m slid;
+            const bal_v2 fs =
+                bal_law_shear_x2(P, L, &k, fn, (bal_v2){pfs[ca], pfs[cb]}, &loss, &slid);
+            const int slide = bal_v2_bits(slid);
+            if (slide) {
+                /* the slip's losses, contact by contact in the list's order */
+                if (slide & 1)
+                    *lost_fric += loss[0];
+                if (slide & 2)
+                    *lost_fric += loss[1];
+                fl |= fl2_lanes(slide, BAL_PAIR_SLIDING);
+            }
+            pfs[ca] = fs[0];
+            pfs[cb] = fs[1];
+            fts = fs;
+            if (damp) {
+                /* D_s where the contact does not slide: F_s + D_s there, F_s
+                 * alone elsewhere (not F_s + 0, which would turn −0 into +0) */
+                ds = bal_law_shear_dashpot_of_x2(L, &k, slid);
+                fts = bal_v2_select(slid, fs, fs + ds);
+            }
+        }
+        /* The couple on y, +(M + M_d); on x the opposite (JYH eq. 52). */
+        bal_v2 mr = zero, md = zero;
+        if (rolling) {
+            const struct bal_roll_x2 R = bal_law_roll_of_x2(L, bal_law_common_radius_x2(ri, rj));
+            const bal_v2 wrel = (bal_v2){w[ia], w[ib]} - (bal_v2){w[ja], w[jb]};
+            const bal_v2 dtheta = wrel * P->dt;
+            ptr[ca] += dtheta[0];
+            ptr[cb] += dtheta[1];
+            bal_v2 loss;
+            bal_v2m capped;
+            bal_v2m live = live_x2(fl);
+            mr = bal_law_roll_moment_x2(P, R, fn, dtheta, (bal_v2){pmr[ca], pmr[cb]}, live, &loss,
+                                        &capped);
+            const int cap = bal_v2_bits(capped);
+            if (cap) {
+                /* the losses, contact by contact in the list's order */
+                const unsigned flag = P->rolling_model == BAL_ROLLING_MODEL2 ? BAL_PAIR_BROKEN
+                                                                              : BAL_PAIR_ROLLING;
+                if (cap & 1)
+                    *lost_roll += loss[0];
+                if (cap & 2)
+                    *lost_roll += loss[1];
+                fl |= fl2_lanes(cap, flag);
+                if (P->rolling_model == BAL_ROLLING_MODEL2)
+                    live &= ~capped; /* broken now */
+            }
+            pmr[ca] = mr[0];
+            pmr[cb] = mr[1];
+            if (damp) {
+                md = bal_law_roll_dashpot_x2(mu_n, R, wrel, live);
+                mr = mr + md;
+            }
+        }
+        pflags[ca] = (uint8_t)fl;
+        pflags[cb] = (uint8_t)(fl >> 8);
+        /* The force +(F_n e + F_s t) on j, the opposite on i (Fig. 3); the
+         * moments: the shear force's, and the couple. */
+        const bal_v2 fcx = ftn * ex + fts * ey;
+        const bal_v2 fcy = ftn * ey - fts * ex;
+        const bal_v2 tqi = roll ? fts * ri - mr : fts * ri;
+        const bal_v2 tqj = roll ? fts * rj + mr : fts * rj;
+        bal_v2 dfx = zero, dfy = zero, dtqi = zero, dtqj = zero;
+        if (damp) {
+            /* the dashpots' share, for their work at t_N (energy.c) */
+            dfx = dn * ex + ds * ey;
+            dfy = dn * ey - ds * ex;
+            dtqi = roll ? ds * ri - md : ds * ri;
+            dtqj = roll ? ds * rj + md : ds * rj;
+        }
+        /* contact a's sums, then contact b's; the dashpots' shares in
+         * float, (F_x, F_y) of a and of b, and the moments of i and j of a
+         * and of b, each as a pair of adjacent floats */
+        const __m128d fxya = _mm_unpacklo_pd(fcx, fcy), fxyb = _mm_unpackhi_pd(fcx, fcy);
+        __m128 dxya = _mm_setzero_ps(), dxyb = dxya, dtqa = dxya, dtqb = dxya;
+        if (damp) {
+            dxya = _mm_unpacklo_ps(_mm_cvtpd_ps(dfx), _mm_cvtpd_ps(dfy));
+            dxyb = _mm_movehl_ps(dxya, dxya);
+            dtqa = _mm_unpacklo_ps(_mm_cvtpd_ps(dtqi), _mm_cvtpd_ps(dtqj));
+            dtqb = _mm_movehl_ps(dtqa, dtqa);
+        }
+        add_contact_x2(f, dsh, ia, ja, fxya, tqi[0], tqj[0], dxya, dtqa, mods);
+        add_contact_x2(f, dsh, ib, jb, fxyb, tqi[1], tqj[1], dxyb, dtqb, mods);
     }
     *over |= ov != 0;
     return n2;
@@ -430,8 +558,7 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
     /* Two at a time: the commonest law, in the chunks that do not log,
      * unless a test asks for one contact at a time (par.one_lane). */
 #if defined(BAL_X2)
-    const int pairs = mods == (MOD_POWER | MOD_SHEAR) && linear && one && !logged &&
-                      one_law->shear && !s->par.one_lane;
+    const int pairs = (mods & MOD_POWER) && linear && one && !logged && !s->par.one_lane;
 #else
     const int pairs = 0;
 #endif
@@ -488,7 +615,8 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
         /* Pass 3: the law at each touching contact, in the list's order. */
 #if defined(BAL_X2)
         if (pairs) {
-            q0 = two_at_a_time(s, &P, c0, tc, tq, tdx, tdy, nt, budget, &over, &lost_fric);
+            q0 = two_at_a_time(s, &P, mods, c0, tc, tq, tdx, tdy, nt, budget, &over, &lost_fric,
+                               &lost_roll);
             wide += q0;
         }
 #endif

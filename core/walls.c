@@ -134,21 +134,6 @@
 #include "scene_keys.h"
 #include "walls.h"
 
-double bal_walls_closest(const struct bal_wall *w, double x, double y,
-                         double *cx, double *cy)
-{
-    const double rx = x - w->p[0], ry = y - w->p[1];
-    double h = rx * w->e[0] + ry * w->e[1];
-    if (h < w->h1)
-        h = w->h1;
-    else if (h > w->h2)
-        h = w->h2;
-    *cx = w->p[0] + h * w->e[0];
-    *cy = w->p[1] + h * w->e[1];
-    const double dx = x - *cx, dy = y - *cy;
-    return dx * dx + dy * dy;
-}
-
 int bal_walls_find(const struct bal_sim *s, const char *name)
 {
     for (int k = 0; k < s->n_walls; k++)

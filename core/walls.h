@@ -9,8 +9,22 @@
 
 #include "state.h"
 
-/* Closest point of wall w to (x, y); returns squared distance. */
-double bal_walls_closest(const struct bal_wall *w, double x, double y, double *cx, double *cy);
+/* Closest point of wall w to (x, y); returns squared distance.  Inline: the
+ * disc–wall loop calls it at every candidate of every cycle (wall_loop.c). */
+static inline double bal_walls_closest(const struct bal_wall *w, double x, double y, double *cx,
+                                       double *cy)
+{
+    const double rx = x - w->p[0], ry = y - w->p[1];
+    double h = rx * w->e[0] + ry * w->e[1];
+    if (h < w->h1)
+        h = w->h1;
+    else if (h > w->h2)
+        h = w->h2;
+    *cx = w->p[0] + h * w->e[0];
+    *cy = w->p[1] + h * w->e[1];
+    const double dx = x - *cx, dy = y - *cy;
+    return dx * dx + dy * dy;
+}
 /* The overlap of a disc of radius r at (x, y) with wall w: r less the
  * distance to the wall's closest point (negative: a gap). */
 double bal_walls_overlap(const struct bal_wall *w, double x, double y, double r);

@@ -1,7 +1,7 @@
 /*
  * bench.c — the dense-packing benchmark behind `make bench`.
  *
- * Kept whole (about 1000 lines): one benchmark program, whose modes share
+ * Kept whole (about 1400 lines): one benchmark program, whose modes share
  * the packing, the settling, the timing and the reporting.
  *
  * For each N it loads the benchmark scene through the ordinary scene
@@ -40,6 +40,13 @@
  *        bench --cost SCENE PERIOD WINDOW  (any scene file on one thread, the
  *                                         last WINDOW cycles of every PERIOD
  *                                         bracketed for callgrind: make bench-cost)
+ *        bench --workload DENSE BIAXIAL PILE_POLY [ROUNDS]  (the catalogue's
+ *                                         biaxial test and polydisperse pile
+ *                                         against the race's dense scene,
+ *                                         alternating: make bench)
+ *        bench --biaxial BIAXIAL DELTA [SHEAR_CYCLES]  (one biaxial test of
+ *                                         --workload, its shearing counted
+ *                                         under callgrind)
  */
 #include <math.h>
 #include <stdio.h>
@@ -482,6 +489,7 @@ struct module_config {
  * step 1e-4 of the scene's: the packing stays put (no rebuilds), and every
  * configuration does its per-cycle work on the same contacts — the cost of
  * a cycle does not depend on Δt. */
+#define MODULES_DT_FACTOR 1e-4
 static const struct module_config module_configs[] = {
     {"base (frictionless, undamped, linear)", {"material.grain.friction=0", "material.box.friction=0",
                                                "settings.beta=0", "settings.alpha=0"}},
@@ -517,18 +525,24 @@ static int load_config(const char *path, long n, const struct module_config *c, 
     return load_scene(path, n, sets, k, sc, sim, err);
 }
 
-/* The reference packing: frictionless and without dashpots, settled by
- * global damping alone, so that the bare build (which has only that pair
- * loop) settles exactly the same packing.  Returned in scene order: x, y
- * and θ of disc id k at xyt[3k], xyt[3k + 1], xyt[3k + 2] (malloc'd). */
-static int settle_packing(const char *path, long n, double **xyt, int *n_out)
+/* The reference packing of the module costs: frictionless and without
+ * dashpots, settled by global damping alone, so that the bare build (which
+ * has only that pair loop) settles exactly the same packing. */
+static const struct module_config modules_settled = {
+    "frictionless, global damping",
+    {"material.grain.friction=0", "material.box.friction=0", "settings.beta=0", NULL}};
+
+/* The N-disc packing of configuration `how`, settled: every stage but the
+ * last, then blocks of the first stage's length until E_k < 1e-3 E_el, at
+ * most `blocks` of them.  Returned in scene order: x, y and θ of disc id k
+ * at xyt[3k], xyt[3k + 1], xyt[3k + 2] (malloc'd). */
+static int settle_packing(const char *path, long n, const char *what,
+                          const struct module_config *how, long blocks, double **xyt, int *n_out)
 {
     struct bal_scene sc;
     struct bal_sim *ref = NULL;
     struct bal_error err = {0};
-    static const struct module_config settled = {
-        "settled", {"material.grain.friction=0", "material.box.friction=0", "settings.beta=0", NULL}};
-    int rc = load_config(path, n, &settled, 0, &sc, &ref, &err);
+    int rc = load_config(path, n, how, 0, &sc, &ref, &err);
     long settle = 0;
     for (int g = 0; rc == 0 && g + 1 < sc.n_stages; g++) {
         bal_sim_set_stage(ref, g);
@@ -536,7 +550,7 @@ static int settle_packing(const char *path, long n, double **xyt, int *n_out)
             rc = bal_sim_step(ref, &err) != BAL_OK;
     }
     while (rc == 0 && bal_measure_kinetic(ref) > SETTLED_EK_OVER_EE * bal_measure_elastic(ref) &&
-           settle < (MAX_SETTLE_BLOCKS + 1) * sc.stages[0].cycles)
+           settle < blocks * sc.stages[0].cycles)
         for (long c = 0; rc == 0 && c < sc.stages[0].cycles; c++, settle++)
             rc = bal_sim_step(ref, &err) != BAL_OK;
     *xyt = rc ? NULL : malloc(3 * sizeof **xyt * (size_t)ref->n);
@@ -547,9 +561,9 @@ static int settle_packing(const char *path, long n, double **xyt, int *n_out)
     if (rc) {
         fprintf(stderr, "bench: settling: %s\n", err.msg);
     } else {
-        printf("# module costs: N=%d packing settled for %ld cycles (frictionless, global damping) "
-               "(E_k/E_el = %.2g); each configuration starts from it at rest\n",
-               ref->n, settle, bal_measure_kinetic(ref) / bal_measure_elastic(ref));
+        printf("# %s: N=%d packing settled for %ld cycles (%s) (E_k/E_el = %.2g); each "
+               "configuration starts from it at rest\n",
+               what, ref->n, settle, how->name, bal_measure_kinetic(ref) / bal_measure_elastic(ref));
         for (int i = 0; i < ref->n; i++) {
             double *p = *xyt + 3 * (size_t)ref->id[i];
             p[0] = ref->x[i], p[1] = ref->y[i], p[2] = ref->th[i];
@@ -596,10 +610,10 @@ static int read_packing(const char *file, double **xyt, int *n)
 }
 
 /* Configuration c of the N-disc scene, started from the packing at rest
- * with a time step 1e-4 of the scene's, in its last stage. */
+ * with a time step dt_factor times the scene's, in its last stage. */
 static int start_config(const char *path, long n, const struct module_config *c, int nonlinear,
-                        const double *xyt, int nn, struct bal_scene *sc, struct bal_sim **sim,
-                        struct bal_error *err)
+                        const double *xyt, int nn, double dt_factor, struct bal_scene *sc,
+                        struct bal_sim **sim, struct bal_error *err)
 {
     if (load_config(path, n, c, nonlinear, sc, sim, err))
         return 1;
@@ -617,7 +631,7 @@ static int start_config(const char *path, long n, const struct module_config *c,
         s->vx[to] = s->vy[to] = s->w[to] = 0;
     }
     s->need_rebuild = 1;
-    s->dt *= 1e-4;
+    s->dt *= dt_factor;
     bal_sim_set_stage(s, sc->n_stages - 1);
     return 0;
 }
@@ -632,7 +646,7 @@ static int modules_bench(const char *path, long n, int base_only)
 {
     double *xyt = NULL;
     int nn = 0;
-    if (settle_packing(path, n, &xyt, &nn))
+    if (settle_packing(path, n, "module costs", &modules_settled, MAX_SETTLE_BLOCKS + 1, &xyt, &nn))
         return 1;
     struct bal_error err = {0};
     const size_t n_cfg = base_only ? 1 : sizeof module_configs / sizeof module_configs[0];
@@ -642,7 +656,7 @@ static int modules_bench(const char *path, long n, int base_only)
         const struct module_config *c = &module_configs[k];
         struct bal_scene sc;
         struct bal_sim *sim = NULL;
-        if (start_config(path, n, c, k == 4, xyt, nn, &sc, &sim, &err)) {
+        if (start_config(path, n, c, k == 4, xyt, nn, MODULES_DT_FACTOR, &sc, &sim, &err)) {
             fprintf(stderr, "bench: %s\n", err.msg);
             bal_sim_free(sim);
             bal_scene_free(&sc);
@@ -742,7 +756,8 @@ static int modules_step(const char *path, const char *pack, long steps, int repe
     struct bal_error err = {0};
     double t[MAX_STEP_REPEATS];
     long rebuilds0 = 0;
-    int rc = start_config(path, nn, &module_configs[0], 0, xyt, nn, &sc, &sim, &err);
+    int rc = start_config(path, nn, &module_configs[0], 0, xyt, nn, MODULES_DT_FACTOR, &sc, &sim,
+                          &err);
     if (rc == 0) {
         CALLGRIND_START_INSTRUMENTATION;
         rc = timed_steps(sim, WARMUP_STEPS, &err) < 0;
@@ -1069,6 +1084,264 @@ static int modules_summary(char **arg)
     return !same || !ok;
 }
 
+/* ------------------------------------------------------------------ */
+/* The catalogue's own workload against the race (issue 33)             */
+/* ------------------------------------------------------------------ */
+
+/* The dense race scene of `make bench-peer` (harness/peer/race.py,
+ * settle_dense), made in this process: the N-disc packing of dense.scene
+ * settled with the race's normal law and without friction (its damping
+ * kept) until E_k < 1e-3 E_el (the race allows 40 000 cycles: RACE_SETTLE
+ * blocks of the settle stage's 6 000), then raced from rest with the
+ * scene's friction, the power law with ν = 1, no damping, the skin chosen
+ * from the motion (the race's ballast settings). */
+#define RACE_N 20000
+#define RACE_SETTLE 7
+static const struct module_config race_settled = {
+    "frictionless, the scene's damping", {"material.grain.friction=0", "material.box.friction=0",
+                                          NULL, NULL}};
+static const struct module_config race_config = {
+    "race", {"settings.beta=0", "settings.alpha=0", "settings.skin_rule=motion", NULL}};
+
+/* The biaxial test of cases/biaxial/case.txt, variants m0_s200_e020 (no
+ * rolling resistance) and m1_d1.6_s200_e020 (Model 1, δ = 1.6): specimen
+ * e020, σ_h = 200 kPa, consolidated to its stop rule (the fixed preparation,
+ * untimed), then BIAXIAL_SHEAR_CYCLES cycles of shearing, of which all but
+ * the first BIAXIAL_UNTIMED are timed.  The sets are case.txt's (make_case.py
+ * writes them); the catalogue runs 250 000 (default tier) or 500 000 (full)
+ * cycles of shearing, this a slice of its start. */
+#define BIAXIAL_SHEAR_CYCLES 41984 /* 41 x 1024: the timed window is whole reports */
+#define BIAXIAL_SHEAR_TEXT "41984"  /* the same, for the scene's set */
+#define BIAXIAL_UNTIMED 1024       /* bal_sim_run's clock is read every 1024 cycles */
+static const char *const biaxial_sets[] = {
+    "stage.consolidate.servo=spec_top 200000 0.5 0.05 spec_left spec_right",
+    "stage.consolidate.servo=spec_bottom 200000 0.5 0.05 spec_left spec_right",
+    "stage.consolidate.servo=spec_left 200000 0.5 0.05 spec_bottom spec_top",
+    "stage.consolidate.servo=spec_right 200000 0.5 0.05 spec_bottom spec_top",
+    "stage.shear.servo=spec_left 200000 0.5 1 spec_bottom spec_top",
+    "stage.shear.servo=spec_right 200000 0.5 1 spec_bottom spec_top",
+    "import.spec.discs=specimens/e020_r1/discs.tsv",
+    "import.spec.walls=specimens/e020_r1/walls.tsv",
+};
+
+/* The sets of one biaxial test: biaxial_sets, the rolling resistance, the
+ * shearing's length; returns how many. */
+#define BIAXIAL_SETS 16
+static int biaxial_variant(const char *sets[BIAXIAL_SETS], const char *rolling, const char *shear)
+{
+    const int n = (int)(sizeof biaxial_sets / sizeof biaxial_sets[0]);
+    for (int k = 0; k < n; k++)
+        sets[k] = biaxial_sets[k];
+    sets[n] = rolling;
+    sets[n + 1] = shear ? shear : "stage.shear.cycles=" BIAXIAL_SHEAR_TEXT;
+    return n + 2;
+}
+
+enum { W_RACE, W_BIAX_M0, W_BIAX_M1, W_POLY, W_KINDS };
+static const char *const workload_name[W_KINDS] = {"race_dense", "biaxial_m0_s200_e020",
+                                                   "biaxial_m1_d1.6_s200_e020", "pile_poly_L100"};
+
+/* Where the shear stage's timed window starts: bal_sim_run's first progress
+ * report in that stage (after its first 1024 cycles).  Under callgrind
+ * (--instr-atstart=no --collect-atstart=no), the window is what it counts. */
+struct stage_clock {
+    int stage;
+    long step;
+    double cpu;
+};
+
+/* The CPU time of the calling thread: the workload's runs are timed by it,
+ * not by the wall clock, which on a shared machine also counts the time
+ * another process has the core (on an idle machine the two agree). */
+static double cpu_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void stage_clock_report(const struct bal_progress *p, void *ctx)
+{
+    struct stage_clock *c = ctx;
+    if (p->stage == c->stage && c->step < 0) {
+        c->step = p->step;
+        c->cpu = cpu_now();
+        CALLGRIND_START_INSTRUMENTATION;
+        CALLGRIND_TOGGLE_COLLECT;
+    }
+}
+
+/* What one whole run measured. */
+struct run_figures {
+    double rate;       /* particle-steps/s of the timed cycles */
+    long timed, steps; /* cycles timed, cycles run */
+    long first_stage;  /* cycles of the first stage (its stop rule) */
+    int n;
+    long rebuilds;
+    double contacts;   /* disc–disc contacts per disc at the end */
+};
+
+/* One whole run of a catalogue scene through bal_sim_run, as `ballast run`
+ * runs it (series rows written, to /dev/null), on one thread.  With
+ * timed_stage >= 0 the rate is that of that stage's cycles after its first
+ * 1024, else of the whole run; in CPU seconds (cpu_now). */
+static int workload_run(const char *path, const char *const *sets, int n_sets, const char *extra,
+                        int timed_stage, struct run_figures *out)
+{
+    struct bal_scene sc;
+    struct bal_sim *sim = NULL;
+    struct bal_error err = {0};
+    struct stage_clock clock = {timed_stage, -1, 0};
+    double cpu0 = 0, cpu1 = 0;
+    FILE *series = fopen("/dev/null", "w");
+    bal_scene_default(&sc);
+    int rc = !series || bal_scene_load(&sc, path, &err) != BAL_OK;
+    for (int k = 0; rc == 0 && k < n_sets; k++)
+        rc = bal_scene_set(&sc, sets[k], &err) != BAL_OK;
+    rc = rc || (extra && bal_scene_set(&sc, extra, &err) != BAL_OK) ||
+         bal_sim_create(&sim, &sc, &err) != BAL_OK;
+    if (rc == 0) {
+        if (timed_stage >= 0)
+            bal_sim_set_progress(sim, stage_clock_report, &clock, 0);
+        bal_output_series_header(sim, series);
+        cpu0 = cpu_now();
+        rc = bal_sim_run(sim, series, NULL, &err) != BAL_OK;
+        cpu1 = cpu_now();
+        if (clock.step >= 0) {
+            CALLGRIND_TOGGLE_COLLECT;
+            CALLGRIND_STOP_INSTRUMENTATION;
+        }
+    }
+    if (rc == 0 && timed_stage >= 0 && clock.step < 0) {
+        snprintf(err.msg, sizeof err.msg, "%s: stage %d has fewer than %d cycles", path,
+                 timed_stage, BIAXIAL_UNTIMED);
+        rc = 1;
+    }
+    if (rc) {
+        fprintf(stderr, "bench: %s\n", series ? err.msg : "/dev/null: cannot open");
+    } else {
+        out->steps = sim->step;
+        out->timed = timed_stage >= 0 ? sim->step - clock.step : sim->step;
+        const double seconds = cpu1 - (timed_stage >= 0 ? clock.cpu : cpu0);
+        out->n = sim->n;
+        out->rate = (double)out->timed * sim->n / seconds;
+        out->first_stage = sc.n_stages > 0 ? sim->log[0].cycles : 0;
+        out->rebuilds = sim->rebuilds;
+        out->contacts = (double)count_contacts(sim) / sim->n;
+    }
+    if (series)
+        fclose(series);
+    bal_sim_free(sim);
+    bal_scene_free(&sc);
+    return rc;
+}
+
+static void print_spread(const char *key, double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof v[0], cmp_double);
+    printf(" %s=%.4g min=%.4g max=%.4g", key, v[n / 2], v[0], v[n - 1]);
+}
+
+/* One biaxial test of the workload (rolling: the δ of material grain;
+ * shear: its cycles of shearing, or NULL for the workload's), its line; the
+ * timed window is what callgrind counts when run under it with
+ * --instr-atstart=no --collect-atstart=no (the profile of docs/benchmarks.md). */
+static int biaxial_one(const char *biaxial, const char *rolling, const char *shear)
+{
+    char set[64], cycles[64];
+    const char *sets[BIAXIAL_SETS];
+    snprintf(set, sizeof set, "material.grain.rolling=%s", rolling);
+    if (shear)
+        snprintf(cycles, sizeof cycles, "stage.shear.cycles=%s", shear);
+    const int n = biaxial_variant(sets, set, shear ? cycles : NULL);
+    struct run_figures fig;
+    if (workload_run(biaxial, sets, n, NULL, 1, &fig))
+        return 1;
+    printf("bench biaxial rolling=%s N=%d steps=%ld particle_steps_per_s=%.4g consolidation=%ld "
+           "rebuilds=%ld contacts_per_disc=%.3f\n", rolling, fig.n, fig.timed, fig.rate,
+           fig.first_stage, fig.rebuilds, fig.contacts);
+    return 0;
+}
+
+/* `make bench`'s lines for the catalogue's heavy work: the biaxial test at
+ * δ = 0 and Model 1 δ = 1.6 and one polydisperse L0 = 100 pile, each with
+ * its ratio to the dense race scene measured in the same process.  The
+ * four alternate, round by round (race, biaxial m0, biaxial m1, pile), so
+ * that the machine's drift falls on all alike; each ratio is taken within
+ * its round, and the line gives the median, min and max over the rounds. */
+static int workload_bench(const char *dense, const char *biaxial, const char *poly, int rounds)
+{
+    enum { MAX_ROUNDS = 32 };
+    if (rounds < 1 || rounds > MAX_ROUNDS) {
+        fprintf(stderr, "bench: --workload: 1 <= rounds <= %d\n", MAX_ROUNDS);
+        return 2;
+    }
+    double *xyt = NULL;
+    int nn = 0;
+    if (settle_packing(dense, RACE_N, "race_dense", &race_settled, RACE_SETTLE, &xyt, &nn))
+        return 1;
+    struct bal_scene sc;
+    struct bal_sim *race = NULL;
+    struct bal_error err = {0};
+    int rc = start_config(dense, RACE_N, &race_config, 0, xyt, nn, 1.0, &sc, &race, &err);
+    free(xyt);
+    long steps = 50;
+    double t = rc ? -1 : timed_steps(race, steps, &err); /* (wall clock: calibration only) */
+    if (t > 0)
+        steps = (long)fmax(100, TARGET_SECONDS / (t / (double)steps));
+    rc = rc || t < 0;
+    const char *m0[BIAXIAL_SETS], *m1[BIAXIAL_SETS];
+    const int n_biax = biaxial_variant(m0, "material.grain.rolling=0", NULL);
+    biaxial_variant(m1, "material.grain.rolling=1.6", NULL);
+    double rate[W_KINDS][MAX_ROUNDS], ratio[W_KINDS][MAX_ROUNDS];
+    struct run_figures fig[W_KINDS] = {{0}};
+    for (int r = 0; r < rounds && rc == 0; r++) {
+        const double c0 = cpu_now();
+        rc = timed_steps(race, steps, &err) < 0;
+        rate[W_RACE][r] = (double)steps * race->n / (cpu_now() - c0);
+        rc = rc || workload_run(biaxial, m0, n_biax, NULL, 1, &fig[W_BIAX_M0]);
+        rate[W_BIAX_M0][r] = fig[W_BIAX_M0].rate;
+        rc = rc || workload_run(biaxial, m1, n_biax, NULL, 1, &fig[W_BIAX_M1]);
+        rate[W_BIAX_M1][r] = fig[W_BIAX_M1].rate;
+        rc = rc || workload_run(poly, NULL, 0, NULL, -1, &fig[W_POLY]);
+        rate[W_POLY][r] = fig[W_POLY].rate;
+        for (int w = 0; w < W_KINDS; w++)
+            ratio[w][r] = rate[w][r] / rate[W_RACE][r];
+        fprintf(stderr, "bench: workload round %d of %d done\n", r + 1, rounds);
+    }
+    if (rc) {
+        if (err.msg[0])
+            fprintf(stderr, "bench: %s\n", err.msg);
+    } else {
+        printf("# workload: %d rounds, each the race scene for %ld cycles, then one whole run of "
+               "each workload scene, in turn on one thread; rates in particle-steps per CPU second "
+               "of the thread; ratio = rate / the race's rate of the same round\n", rounds, steps);
+        printf("# %s: %s from rest, friction on, power law nu = 1, no damping, skin_rule = motion; "
+               "%ld rebuilds, %.3f contacts per disc at the end\n", workload_name[W_RACE], dense,
+               race->rebuilds, (double)count_contacts(race) / race->n);
+        for (int w = W_BIAX_M0; w <= W_BIAX_M1; w++)
+            printf("# %s: %s consolidated in %ld cycles (its stop rule, untimed), then %d cycles "
+                   "of shearing, the last %ld timed; %ld rebuilds, %.3f contacts per disc at the "
+                   "end\n", workload_name[w], biaxial, fig[w].first_stage, BIAXIAL_SHEAR_CYCLES,
+                   fig[w].timed, fig[w].rebuilds, fig[w].contacts);
+        printf("# %s: %s, one whole realisation (seed 1) to its stop rule, timed whole: %ld cycles "
+               "(ramp %ld), %ld rebuilds\n", workload_name[W_POLY], poly, fig[W_POLY].steps,
+               fig[W_POLY].first_stage, fig[W_POLY].rebuilds);
+        printf("bench %s N=%d steps=%ld", workload_name[W_RACE], race->n, steps);
+        print_spread("particle_steps_per_s", rate[W_RACE], rounds);
+        printf("\n");
+        for (int w = W_BIAX_M0; w < W_KINDS; w++) {
+            printf("bench %s N=%d steps=%ld", workload_name[w], fig[w].n, fig[w].timed);
+            print_spread("particle_steps_per_s", rate[w], rounds);
+            print_spread("ratio_to_race", ratio[w], rounds);
+            printf("\n");
+        }
+    }
+    bal_sim_free(race);
+    bal_scene_free(&sc);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -1086,7 +1359,8 @@ int main(int argc, char **argv)
     if (strcmp(argv[1], "--modules-pack") == 0 && argc == 5) {
         double *xyt = NULL;
         int nn = 0;
-        int rc = settle_packing(argv[2], atol(argv[3]), &xyt, &nn) ||
+        int rc = settle_packing(argv[2], atol(argv[3]), "module costs", &modules_settled,
+                                MAX_SETTLE_BLOCKS + 1, &xyt, &nn) ||
                  write_packing(argv[4], xyt, nn);
         free(xyt);
         return rc;
@@ -1099,6 +1373,10 @@ int main(int argc, char **argv)
         return threads_bench(argv[2], atol(argv[3]), atoi(argv[4]), argc == 6 ? atoi(argv[5]) : 9);
     if (strcmp(argv[1], "--cost") == 0 && argc == 5)
         return cost_run(argv[2], atol(argv[3]), atol(argv[4]));
+    if (strcmp(argv[1], "--biaxial") == 0 && (argc == 4 || argc == 5))
+        return biaxial_one(argv[2], argv[3], argc == 5 ? argv[4] : NULL);
+    if (strcmp(argv[1], "--workload") == 0 && (argc == 5 || argc == 6))
+        return workload_bench(argv[2], argv[3], argv[4], argc == 6 ? atoi(argv[5]) : REPEATS);
     if (strcmp(argv[1], "--modules-summary") == 0 && argc == 7)
         return modules_summary(argv + 2);
     if (strcmp(argv[1], "--settling") == 0 && argc >= 3) {

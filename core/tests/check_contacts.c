@@ -1029,9 +1029,9 @@ static struct tfx *run_width(const char *settings, double friction, double cohes
  * one at a time (par.one_lane), and every array the cycle writes must agree
  * byte for byte: where a variant has a two-lane path its kernels (the _x2
  * twins of laws_lanes.h) and its kinematics must give the one-contact bits.
- * The variants that have one are the ones the table below says: today the
- * linear power law with the tangential spring alone (two_at_a_time) — it
- * must run contacts two at a time (not vacuous), and the others never. */
+ * The variants that have one are the ones the table below says: the linear
+ * power law with any of the sub-models (two_at_a_time) — they must run
+ * contacts two at a time (not vacuous), and the others never. */
 START_TEST(contacts_every_variant_same_at_both_widths)
 {
     static const struct {
@@ -1040,18 +1040,25 @@ START_TEST(contacts_every_variant_same_at_both_widths)
         int two_lanes; /* the variant runs contacts two at a time */
     } variants[] = {
         {"inc", "normal_law = incremental\nbeta = 0", 0, 0, 0, 0},
-        {"pow", "normal_law = power\nnu = 1\nbeta = 0", 0, 0, 0, 0},
+        {"pow", "normal_law = power\nnu = 1\nbeta = 0", 0, 0, 0, 1},
         {"inc_s", "normal_law = incremental\nbeta = 0", 0.4, 3, 0, 0},
         {"pow_s", "normal_law = power\nnu = 1\nbeta = 0", 0.4, 3, 0, 1},
         {"pow_s nu = 1.5", "normal_law = power\nnu = 1.5\ndelta0 = 0.05\nbeta = 0", 0.4, 3, 0, 0},
         {"inc_d", "normal_law = incremental\nbeta = 0.01", 0, 0, 0, 0},
-        {"pow_d", "normal_law = power\nnu = 1\nbeta = 0.01", 0, 0, 0, 0},
+        {"pow_d", "normal_law = power\nnu = 1\nbeta = 0.01", 0, 0, 0, 1},
+        {"pow_d gamma_n psi", "normal_law = power\nnu = 1\nbeta = 0\ngamma_n = 40\npsi = 0.5\n"
+                              "delta0 = 0.05", 0, 0, 0, 1},
         {"inc_sd", "normal_law = incremental\nbeta = 0.01", 0.4, 3, 0, 0},
-        {"pow_sd", "normal_law = power\nnu = 1\nbeta = 0.01", 0.4, 3, 0, 0},
+        {"pow_sd", "normal_law = power\nnu = 1\nbeta = 0.01", 0.4, 3, 0, 1},
         {"inc_sr", "normal_law = incremental\nbeta = 0", 0.4, 3, 0.5, 0},
-        {"pow_sr", "normal_law = power\nnu = 1\nbeta = 0", 0.4, 3, 0.5, 0},
+        {"pow_sr", "normal_law = power\nnu = 1\nbeta = 0", 0.4, 3, 0.5, 1},
+        {"pow_sr model2", "normal_law = power\nnu = 1\nbeta = 0\nrolling_model = model2", 0.4, 3,
+         0.5, 1},
         {"inc_sdr", "normal_law = incremental\nbeta = 0.01", 0.4, 3, 0.5, 0},
-        {"pow_sdr", "normal_law = power\nnu = 1\nbeta = 0.01", 0.4, 3, 0.5, 0},
+        {"pow_sdr", "normal_law = power\nnu = 1\nbeta = 0.01", 0.4, 3, 0.5, 1},
+        {"pow_sdr model2 gamma_n", "normal_law = power\nnu = 1\nbeta = 0.01\ngamma_n = 40\n"
+                                   "rolling_model = model2", 0.4, 3, 0.5, 1},
+        {"pow_sd friction 0", "normal_law = power\nnu = 1\nbeta = 0.01", 0, 0, 0, 1},
     };
     for (size_t v = 0; v < sizeof variants / sizeof variants[0]; v++) {
         struct tfx *wide = run_width(variants[v].settings, variants[v].friction,
@@ -1068,6 +1075,8 @@ START_TEST(contacts_every_variant_same_at_both_widths)
                       variants[v].name, contacts);
         if (variants[v].friction > 0)
             ck_assert_msg(sliding > 0, "%s: no contact slides", variants[v].name);
+        if (variants[v].rolling > 0) /* the rolling cap acted: its loss path ran */
+            ck_assert_msg(a->audit.d_rolling > 0, "%s: no rolling loss", variants[v].name);
         ck_assert_int_eq(two_lane(b), 0);
         if (variants[v].two_lanes)
             ck_assert_msg(two_lane(a) > 100L * WIDTHS_CYCLES,

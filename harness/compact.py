@@ -10,11 +10,10 @@ before), keeps:
   * a case's own runs (its [variant]s) whole, but a series.tsv of GZIP_MIN bytes or more as
     series.tsv.gz, which every reader of the harness reads as it read series.tsv
     (tables.read_text) -- `check`, `report`, `rebaseline` and --resume go on from it unchanged;
-  * of a declared sweep point only what says what ran and how it ended (KEPT: run.json, the
-    runner's harness.json, the core's stderr), the tables removed: its errors are in cost.tsv;
-  * of a realisation of an [ensemble] the same, its small series.tsv, and the tables the
-    ensemble checks read gzipped (REALISATION_GZIPPED), so that `harness check` after a
-    validate evaluates every check as the validate did;
+  * of a realisation of an [ensemble] and of a declared sweep point only what says what ran and
+    how it ended (KEPT: run.json, the runner's harness.json, the core's stderr; a realisation
+    its small series.tsv too), the tables removed: their statistics and errors are in the
+    report, summary.json and cost.tsv;
   * a run that failed whole, whatever it is: a reader needs its outputs to see why.
 
 What was done is recorded in the run's harness.json under "compacted" (its time of writing kept,
@@ -40,12 +39,6 @@ KEPT = ("run.json", "harness.json", "ballast.stderr")   # ballast.stdout: its on
 # still evaluate after validate; the checks over the ensemble need the removed tables.
 REALISATION_KEPT = KEPT + ("series.tsv",)
 GZIPPED = ("series.tsv",)      # of a case's own runs: the one table every check reads, and the largest
-# A realisation's discs.tsv and stress.tsv are what the ensemble checks read (the pile row of
-# each disc, its stress: harness/families/piles.py), so they stay, gzipped whatever their size:
-# at level 1, 70 KB of an L0 = 34 realisation become 33 KB (about 33 MB for the default tier's
-# 1 000, against 136 MB whole), and `harness check` after a validate evaluates every check.
-# Its contacts.tsv (53 KB) is read by no ensemble check and goes.
-REALISATION_GZIPPED = ("discs.tsv", "stress.tsv")
 # A table below this stays plain: it takes whole 4 KiB blocks on disk either way, so gzip would
 # gain at most some 40 KiB a file (the quick cases' two-disc series, the fake project's runs),
 # and a plain file is one a reader opens without zcat.
@@ -65,9 +58,8 @@ class Tally:
     drop_saved: int = 0        # bytes removed
 
     def text(self):
-        return (f"{self.gzipped} series.tsv and the tables of {self.realisations} ensemble realisation(s) "
-                f"gzipped ({self.gzip_saved / 1e6:.0f} MB saved), the other tables of those and of "
-                f"{self.points} sweep point(s) removed "
+        return (f"{self.gzipped} series.tsv gzipped ({self.gzip_saved / 1e6:.0f} MB saved), the tables of "
+                f"{self.realisations} ensemble realisation(s) and {self.points} sweep point(s) removed "
                 f"({self.drop_saved / 1e6:.0f} MB)")
 
 
@@ -87,17 +79,16 @@ def _write_record(folder, record):
     os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns))
 
 
-def gzip_tables(folder, tally, names=GZIPPED, minimum=GZIP_MIN):
-    """A case's own run: each of names (GZIPPED) of minimum (GZIP_MIN) bytes or more as NAME.gz,
-    recorded."""
+def gzip_tables(folder, tally):
+    """A case's own run: each GZIPPED table of GZIP_MIN bytes or more as NAME.gz, recorded."""
     folder = Path(folder)
     record = _record(folder)
     if record is None:
         return
     done = dict(record.get("compacted", {}).get("gzip", {}))
-    for name in names:
+    for name in GZIPPED:
         plain = folder / name
-        if name in done or not plain.is_file() or plain.stat().st_size < minimum:
+        if name in done or not plain.is_file() or plain.stat().st_size < GZIP_MIN:
             continue
         data = plain.read_bytes()
         packed = gzip.compress(data, compresslevel=GZIP_LEVEL, mtime=0)     # mtime 0: the same bytes every time
@@ -106,8 +97,7 @@ def gzip_tables(folder, tally, names=GZIPPED, minimum=GZIP_MIN):
         record.setdefault("compacted", {})["gzip"] = done
         _write_record(folder, record)
         files.remove(plain)
-        if name in GZIPPED:
-            tally.gzipped += 1
+        tally.gzipped += 1
         tally.gzip_saved += len(data) - len(packed)
 
 
@@ -146,9 +136,7 @@ def compact(cases, runs_root, sweeps_root=None):
             if not folder.is_dir():
                 continue
             if v.ensemble:
-                gzip_tables(folder, tally, REALISATION_GZIPPED, minimum=0)
-                tally.realisations += drop_tables(folder, tally, REALISATION_KEPT
-                                                  + tuple(n + ".gz" for n in REALISATION_GZIPPED))
+                tally.realisations += drop_tables(folder, tally, REALISATION_KEPT)
             else:
                 gzip_tables(folder, tally)
         if case.sweeps and sweeps_root is not None:

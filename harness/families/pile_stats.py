@@ -45,6 +45,9 @@ of numbers of realisations n (whole, 2 to the ensemble's size):
                                     last, partial block left out): SE against n from one ensemble
     dip_sd_blocks(name, sizes)      for each n, the standard deviation (n - 1) of D over those
                                     blocks (at least two): the spread the SE should predict
+    dip_mean_blocks(name, sizes)    for each n, the mean of D over those blocks: what an ensemble
+                                    of n shows on average (D of an averaged profile is biased
+                                    at small n: R is a largest window mean, lifted by the noise)
     se_exponent(name, sizes)        the least-squares slope of log dip_se_blocks on log n:
                                     -1/2 for the sqrt(N) law
     n_for_z(name, z, sizes)         the number of realisations at which |D| / SE = z, with D the
@@ -229,7 +232,7 @@ def normalised_forces(final):
 
 NAMES = ("ens_X", "ens_S", "ens_S_se", "dip", "dip_se", "profile_dip", "coordination",
          "ens_forces", "tail_rate", "tail_ks", "ens_fluct", "ens_rho", "log10", "dip_first",
-         "dip_se_first", "dip_se_blocks", "dip_sd_blocks", "se_exponent", "n_for_z")
+         "dip_se_first", "dip_se_blocks", "dip_sd_blocks", "dip_mean_blocks", "se_exponent", "n_for_z")
 KN_KEY = "material.grain.kn="
 
 
@@ -352,6 +355,10 @@ def bind(run, sibling=None):
         P, X, ns = sized(name, sizes, "dip_sd_blocks", blocks=2)
         return np.array([np.std([d for d, _ in block_stats(P, X, n)], ddof=1) for n in ns])
 
+    def dip_mean_blocks(name, sizes):
+        P, X, ns = sized(name, sizes, "dip_mean_blocks")
+        return np.array([np.mean([d for d, _ in block_stats(P, X, n)]) for n in ns])
+
     def law(name, sizes, fname):
         if np.ndim(sizes) == 1 and len(set(np.asarray(sizes, dtype=float).tolist())) < 2:
             raise EvalError(f"{fname}(): needs two or more different sizes")
@@ -372,7 +379,8 @@ def bind(run, sibling=None):
     return {"ens_fluct": ens_fluct, "ens_rho": ens_rho, "log10": log10, "ens_X": ens_X, "ens_S": ens_S, "ens_S_se": ens_S_se, "dip": dip, "dip_se": dip_se,
             "profile_dip": profile_dip, "coordination": coordination, "ens_forces": ens_forces,
             "tail_rate": tail_rate, "tail_ks": tail_ks, "dip_first": dip_first, "dip_se_first": dip_se_first,
-            "dip_se_blocks": dip_se_blocks, "dip_sd_blocks": dip_sd_blocks, "se_exponent": se_exponent,
+            "dip_se_blocks": dip_se_blocks, "dip_sd_blocks": dip_sd_blocks, "dip_mean_blocks": dip_mean_blocks,
+            "se_exponent": se_exponent,
             "n_for_z": n_for_z}
 
 

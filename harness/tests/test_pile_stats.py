@@ -211,6 +211,8 @@ def test_the_functions_over_a_fake_ensemble(tmp_path):
         q("dip_first('e', [1, 2])")
     with pytest.raises(EvalError, match="from 2 to 2 .*at least 2 blocks"):
         q("dip_sd_blocks('e', [3])")
+    with pytest.raises(EvalError, match="sizes must be whole numbers from 2 to 4"):
+        q("dip_mean_blocks('e', [2.5])")
     with pytest.raises(EvalError, match="sizes must be a list"):
         q("dip_se_blocks('e', 3)")
     with pytest.raises(EvalError, match="two or more different sizes"):

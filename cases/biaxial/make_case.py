@@ -312,37 +312,37 @@ stability = no
         ys = [f"y = {q}; {e} - same_seed('{ref[mat]}', '{e}')" for q, e in quantities]
         for q, e in quantities:
             floor = f"sd(over('{ref[mat]}', '{e}'))"
-            ys += [f"y = {q}: + sd of the 3 specimens at 0.125 /s; {floor}", f"y = {q}: - sd; -{floor}"]
+            ys += [f"y = {q}: + sd of 3 specimens at 0.125 /s; {floor}", f"y = {q}: - sd; -{floor}"]
         parts.append("\n".join([
             f"[figure rate_phi_{mat}]", "kind = errorbars",
-            f"title = Rate study, {label}, 200 kPa: peak and residual phi against the cost of the test",
+            f"title = Rate study, {label}, 200 kPa: phi against the test's cost",
             f"variants = {' '.join(rate_name(mat, r) for r in STUDY_RATES)}",
             f"x = {cost}"] + ys + [
-            "xlabel = log10 cost in particle-steps, mean of the 3 specimens (points: 4, 2, 1, 0.5, 0.25, 0.125 /s from the left)",
-            "ylabel = phi - phi at 0.125 /s of the same specimen (degrees); bars: the 3 specimens"]) + "\n")
+            "xlabel = log10 particle-steps (4, 2, 1, 0.5, 0.25, 0.125 /s from the left)",
+            "ylabel = phi - phi(0.125 /s), same specimen (deg)"]) + "\n")
     names = {m: "[" + ", ".join(f"'{rate_name(m, r)}'" for r in STUDY_RATES) + "]" for m in STUDY_MATERIALS}
     dil = ["[figure rate_dilation]", "kind = curves",
-           "title = Rate study, 200 kPa: the dilation (largest volumetric strain less the last) against the cost of the test",
+           "title = Rate study, 200 kPa: dilation against the test's cost",
            f"variants = {ref['m0']}_s1",
            f"x = log10(means({names['m0']}, \"run('steps') * run('n_discs')\"))"]
     for mat in STUDY_MATERIALS:
         floor = f"100 * sd(over('{ref[mat]}', 'dilation()'))"
         dil += [f"y = {mat}; 100 * paired_means({names[mat]}, '{ref[mat]}', 'dilation()')",
-                f"y = {mat}: + sd of the 3 specimens at 0.125 /s; [{floor}] * {len(STUDY_RATES)}",
+                f"y = {mat}: + sd of 3 specimens at 0.125 /s; [{floor}] * {len(STUDY_RATES)}",
                 f"y = {mat}: - sd; [-{floor}] * {len(STUDY_RATES)}"]
-    dil += ["xlabel = log10 cost in particle-steps, mean of the 3 specimens of m0 (points: 4 ... 0.125 /s from the left)",
-            "ylabel = dilation - that at 0.125 /s, same specimen, mean of 3 (% points)"]
+    dil += ["xlabel = log10 particle-steps of m0 (4 ... 0.125 /s from the left)",
+            "ylabel = dilation - dilation(0.125 /s), mean of 3 (% points)"]
     parts.append("\n".join(dil) + "\n")
     damp = ["[figure damping]", "kind = curves",
-            "title = Damping study at the catalogue's 0.5 /s, 200 kPa: peak and residual phi against the contact dashpot",
+            "title = Damping study at 0.5 /s, 200 kPa: phi against the contact dashpot",
             f"variants = {ref['m0']}_s1", f"x = [{', '.join(f'{f:g}' for f in (BETA_FACTORS[0], 1, BETA_FACTORS[1]))}]"]
     for mat in STUDY_MATERIALS:
         group = "[" + ", ".join(f"'{n}'" for n in (beta_name(mat, BETA_FACTORS[0]), rate_name(mat, RATE),
                                                   beta_name(mat, BETA_FACTORS[1]))) + "]"
         for q, e in quantities:
             damp.append(f"y = {mat} {q}; paired_means({group}, '{ref[mat]}', '{e}')")
-    damp += ["xlabel = beta / 2e-6 s (-): 1e-6, 2e-6, 4e-6 s, at the same cost",
-             "ylabel = phi - phi at 0.125 /s of the same specimen, mean of 3 (degrees)"]
+    damp += ["xlabel = beta / 2e-6 s (-), at the same cost",
+             "ylabel = phi - phi(0.125 /s), mean of 3 (deg)"]
     parts.append("\n".join(damp) + "\n")
     return "\n".join(parts)
 

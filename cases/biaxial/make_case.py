@@ -341,7 +341,7 @@ stability = no
                                                   beta_name(mat, BETA_FACTORS[1]))) + "]"
         for q, e in quantities:
             damp.append(f"y = {mat} {q}; paired_means({group}, '{ref[mat]}', '{e}')")
-    damp += ["xlabel = beta / 2e-6 s (-), at the same cost",
+    damp += ["xlabel = beta / 2e-6 s, at the same cost (-)",
              "ylabel = phi - phi(0.125 /s), mean of 3 (deg)"]
     parts.append("\n".join(damp) + "\n")
     return "\n".join(parts)

@@ -241,6 +241,139 @@ stability = no
     return "\n".join(parts)
 
 
+# ---------------------------------------------------------------- the rate study (issue 33)
+# The strain rate, the contact damping and density scaling against their cost, on the dense
+# specimen e020 (the default tier's) at 200 kPa, no rolling resistance and Model 1 delta = 1.6,
+# three specimens (e020_r1, r2, r3: e020's recipe, seeds 1-3) at each point: each point is an
+# [ensemble] over the specimens, its realisation NAME_s<seed> on specimen e020_r<seed>.  The
+# test is the default tier's (to a natural axial strain of 0.15, residual window [0.10, 0.15],
+# peak over 5 rows of 0.0015 strain): what the study measures is the catalogue's own test.
+STUDY_MATERIALS = ("m0", "m1_d1.6")
+STUDY_RATES = (0.125, 0.25, 0.5, 1, 2, 4)   # 1/s; the slowest, 0.125, is the reference
+STUDY_STRAIN = 0.15                           # the standard tier's strain
+STUDY_DT = 1.2e-6                             # biaxial.scene's step
+STUDY_SEEDS = "1-3"                           # specimens e020_r1 ... e020_r3
+ROW_CYCLES = 2500                             # biaxial.scene's output_every: a row per 0.0015 strain at 0.5 /s
+BETA = 2e-6                                   # biaxial.scene's contact dashpot (s)
+BETA_FACTORS = (0.5, 2)                       # the damping study, at the catalogue's rate
+DENSITY_FACTOR = 4                            # density scaling: rho x 4, dt x 2 (a power of 2: exact)
+STUDY_WINDOW = WINDOW["standard"]
+
+
+def study_cycles(rate):
+    """Shear cycles to the study's strain at rate (a whole number for every rate of the study)."""
+    cycles = STUDY_STRAIN / (rate * STUDY_DT)
+    assert abs(cycles - round(cycles)) < 1e-6, rate
+    return round(cycles)
+
+
+def study_rows(rate):
+    """output_every at rate: the same strain per row as 0.5 /s (2500 cycles), so that the peak's
+    5 rows are the same strain, 0.0075, at every rate.  At 4 /s that is 312.5 cycles: 313 (a row
+    0.16 % longer)."""
+    return int(ROW_CYCLES * RATE / rate + 0.5)
+
+
+def study_ensemble(name, mat, rate, beta=BETA, extra=(), comment=None):
+    sets = (material_sets(mat) + stress_sets(200) +
+            ["import.spec.discs=specimens/e020_r{seed}/discs.tsv", "import.spec.walls=specimens/e020_r{seed}/walls.tsv",
+             f"stage.shear.cycles={study_cycles(rate)}", f"stage.shear.strain_rate=spec_top {rate:g} spec_bottom",
+             f"settings.output_every={study_rows(rate)}", f"settings.beta={beta:g}"] + list(extra))
+    out = [f"[ensemble {name}]"] + ([f"# {comment}"] if comment else []) + ["scene = biaxial.scene"]
+    return "\n".join(out + [f"set = {s}" for s in sets] + [f"seeds = {STUDY_SEEDS}"]) + "\n"
+
+
+def rate_name(mat, rate):
+    return f"{mat}_rate{rate:g}"
+
+
+def beta_name(mat, factor):
+    return f"{mat}_beta_x{factor:g}"
+
+
+def density_variant(mat):
+    """Density scaling: rho x 4 with dt x 2 (the same fraction of the critical step), beta x 2 (the
+    same damping ratio) and the servos' vmax / 2 (the same cap per cycle: a servo's step is per
+    cycle, docs/physics.md), at 0.5 /s: per cycle the same motion as 1 /s unscaled."""
+    f = DENSITY_FACTOR
+    root = f ** 0.5
+    sets = (material_sets(mat) +
+            [f"stage.consolidate.servo={w} 200000 0.5 {0.05 / root:g} {a} {b}" for w, a, b in
+             (("spec_top", "spec_left", "spec_right"), ("spec_bottom", "spec_left", "spec_right"),
+              ("spec_left", "spec_bottom", "spec_top"), ("spec_right", "spec_bottom", "spec_top"))] +
+            [f"stage.shear.servo={w} 200000 0.5 {1 / root:g} spec_bottom spec_top" for w in ("spec_left", "spec_right")] +
+            specimen_sets("e020_r1") +
+            [f"material.grain.density={2650 * f:g}", f"settings.dt={STUDY_DT * root:g}",
+             f"stage.shear.cycles={study_cycles(RATE * root)}", f"stage.shear.strain_rate=spec_top {RATE:g} spec_bottom",
+             f"settings.output_every={study_rows(RATE * root)}", f"settings.beta={BETA * root:g}"])
+    return "\n".join([f"[variant {mat}_density_x{f}]",
+                      f"# density x {f} at 0.5 /s, dt x {root:g}, beta x {root:g}, servo vmax / {root:g}, "
+                      f"specimen e020_r1: against {rate_name(mat, RATE * root)}_s1",
+                      "scene = biaxial.scene"] + [f"set = {s}" for s in sets]) + "\n"
+
+
+def rate_study():
+    lo, hi = STUDY_WINDOW
+    ref = {m: rate_name(m, STUDY_RATES[0]) for m in STUDY_MATERIALS}
+    parts = [f"""[case biaxial_rate]
+tier = full
+title = Biaxial compression: the strain rate, the contact damping and density scaling against their cost, three specimens at each point (issue 33)
+checks = the default tier's test (specimen e020, 200 kPa, axial strain 0.15) at strain rates 0.125 ... 4 /s, no rolling resistance and Model 1 delta = 1.6, on three specimens each: peak and residual phi and the dilation against the slowest rate, specimen by specimen, with the spread between specimens; the catalogue's 0.5 /s within 1 degree of 0.125 /s; the contact damping x 0.5 and x 2 at 0.5 /s; density x 4 at 0.5 /s is 1 /s cycle for cycle
+runtime = 900
+stability = no
+"""]
+    # the slowest rates first: the longest runs start first
+    for rate in STUDY_RATES:
+        for mat in STUDY_MATERIALS:
+            parts.append(study_ensemble(rate_name(mat, rate), mat, rate))
+    for factor in BETA_FACTORS:
+        for mat in STUDY_MATERIALS:
+            parts.append(study_ensemble(beta_name(mat, factor), mat, RATE, beta=BETA * factor,
+                                        comment=f"contact damping beta x {factor:g} at the catalogue's 0.5 /s"))
+    for mat in STUDY_MATERIALS:
+        parts.append(density_variant(mat))
+    cost = "log10(mean(over(this_ensemble(), \"run('steps') * run('n_discs')\")))"
+    quantities = (("peak", "phi_peak(rows=5)"), ("residual", f"phi_residual({lo}, {hi})"))
+    for mat in STUDY_MATERIALS:
+        label = "no rolling resistance" if mat == "m0" else "Model 1, delta = 1.6"
+        ys = [f"y = {q}; {e} - same_seed('{ref[mat]}', '{e}')" for q, e in quantities]
+        for q, e in quantities:
+            floor = f"sd(over('{ref[mat]}', '{e}'))"
+            ys += [f"y = {q}: + sd of 3 specimens at 0.125 /s; {floor}", f"y = {q}: - sd; -{floor}"]
+        parts.append("\n".join([
+            f"[figure rate_phi_{mat}]", "kind = errorbars",
+            f"title = Rate study, {label}, 200 kPa: phi against the test's cost",
+            f"variants = {' '.join(rate_name(mat, r) for r in STUDY_RATES)}",
+            f"x = {cost}"] + ys + [
+            "xlabel = log10 particle-steps (4, 2, 1, 0.5, 0.25, 0.125 /s from the left)",
+            "ylabel = phi - phi(0.125 /s), same specimen (deg)"]) + "\n")
+    names = {m: "[" + ", ".join(f"'{rate_name(m, r)}'" for r in STUDY_RATES) + "]" for m in STUDY_MATERIALS}
+    dil = ["[figure rate_dilation]", "kind = curves",
+           "title = Rate study, 200 kPa: dilation against the test's cost",
+           f"variants = {ref['m0']}_s1",
+           f"x = log10(means({names['m0']}, \"run('steps') * run('n_discs')\"))"]
+    for mat in STUDY_MATERIALS:
+        floor = f"100 * sd(over('{ref[mat]}', 'dilation()'))"
+        dil += [f"y = {mat}; 100 * paired_means({names[mat]}, '{ref[mat]}', 'dilation()')",
+                f"y = {mat}: + sd of 3 specimens at 0.125 /s; [{floor}] * {len(STUDY_RATES)}",
+                f"y = {mat}: - sd; [-{floor}] * {len(STUDY_RATES)}"]
+    dil += ["xlabel = log10 particle-steps of m0 (4 ... 0.125 /s from the left)",
+            "ylabel = dilation - dilation(0.125 /s), mean of 3 (% points)"]
+    parts.append("\n".join(dil) + "\n")
+    damp = ["[figure damping]", "kind = curves",
+            "title = Damping study at 0.5 /s, 200 kPa: phi against the contact dashpot",
+            f"variants = {ref['m0']}_s1", f"x = [{', '.join(f'{f:g}' for f in (BETA_FACTORS[0], 1, BETA_FACTORS[1]))}]"]
+    for mat in STUDY_MATERIALS:
+        group = "[" + ", ".join(f"'{n}'" for n in (beta_name(mat, BETA_FACTORS[0]), rate_name(mat, RATE),
+                                                  beta_name(mat, BETA_FACTORS[1]))) + "]"
+        for q, e in quantities:
+            damp.append(f"y = {mat} {q}; paired_means({group}, '{ref[mat]}', '{e}')")
+    damp += ["xlabel = beta / 2e-6 s, at the same cost (-)",
+             "ylabel = phi - phi(0.125 /s), mean of 3 (deg)"]
+    parts.append("\n".join(damp) + "\n")
+    return "\n".join(parts)
+
+
 HEADER = """# Biaxial compression tests of Jiang, Yu & Harris (2005), Sec. 5 (JYH) -- WRITTEN BY
 # make_case.py (run it after changing it; a test compares).  Scene: biaxial.scene (one test:
 # import a prepared specimen, consolidate isotropically, shear).  Specimens: specimens/,
@@ -251,7 +384,7 @@ HEADER = """# Biaxial compression tests of Jiang, Yu & Harris (2005), Sec. 5 (JY
 
 
 def text():
-    return HEADER + standard() + "\n" + full()
+    return HEADER + standard() + "\n" + full() + "\n" + rate_study()
 
 
 if __name__ == "__main__":

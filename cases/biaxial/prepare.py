@@ -42,12 +42,15 @@ BANDS = 6
 # seed; r1, r2, r3: different specimens (seeds).  The density study, seed 1: e020 (mu_prep 0,
 # the densest this method gives), e023 (0.1), e030 (loose: friction alone locks no looser
 # than e ~ 0.26, so mu_prep = 1 with rolling resistance delta_prep = 1.0 during the
-# preparation only; the tests then run with their own delta).
+# preparation only; the tests then run with their own delta).  e020_r2, e020_r3: e020's recipe
+# with seeds 2 and 3, the three specimens of the rate study (case biaxial_rate, issue 33).
 SPECIMENS = {
     "e025_r1": (1, 0.4, 0.0),
     "e025_r2": (2, 0.4, 0.0),
     "e025_r3": (3, 0.4, 0.0),
     "e020_r1": (1, 0.0, 0.0),
+    "e020_r2": (2, 0.0, 0.0),
+    "e020_r3": (3, 0.0, 0.0),
     "e023_r1": (1, 0.1, 0.0),
     "e030_r1": (1, 1.0, 1.0),
 }

@@ -62,6 +62,17 @@ The expression functions (every one takes start=None as above; the arrays are th
     phi_envelope(kind, v1, v2, ..., lo=None, hi=None, rows=1)
     cohesion_envelope(kind, v1, v2, ..., lo=None, hi=None, rows=1)
     setting(key)                           the number a --set KEY=VALUE of this run gave key
+    strain_rate(stage='shear')             the rate of the stage's `strain_rate` line, as a --set
+                                           of this run gave it (1/s)
+    fastest_within(tol, expr, reference, names)
+                                           the rate study (issue 33): of the ensembles `names`
+                                           (the same test at several strain rates, one
+                                           realisation per specimen), the fastest rate r such
+                                           that at r and at every slower rate of the list the
+                                           mean over the specimens of expr less expr in the same
+                                           specimen of ensemble `reference` is within tol in
+                                           magnitude: the cheapest rate that keeps expr within
+                                           tol of the reference
 
 The specimen's density, from the final state (discs.tsv) inside the walls of the last row of
 series.tsv: the planar void ratio e = (W H - A_s) / A_s with A_s = pi sum r^2 (the overlaps of
@@ -84,8 +95,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..compare import evaluate
 from ..errors import EvalError
-from ..expressions import register, sibling_run
+from ..expressions import ensemble_members, register, sibling_run
 from ..final_state import state
 
 COLUMNS = ("fy_top", "fy_bottom", "fx_left", "fx_right", "y_top", "y_bottom", "x_left", "x_right")
@@ -318,6 +330,31 @@ def setting_of(info, key):
         raise EvalError(f"setting(): --set {key}={given[-1]} is not a number") from None
 
 
+def rate_of(info, stage="shear"):
+    """The rate of the last --set stage.STAGE.strain_rate=WALL RATE WALL_TO of run.json "sets"."""
+    key = f"stage.{stage}.strain_rate"
+    sets = [s for s in info.get("sets") or [] if isinstance(s, str)]
+    given = [s.split("=", 1)[1] for s in sets if s.split("=", 1)[0] == key and "=" in s]
+    if not given:
+        raise EvalError(f"strain_rate(): the run has no --set {key}=WALL RATE WALL_TO")
+    words = given[-1].split()
+    try:
+        return float(words[1])
+    except (IndexError, ValueError):
+        raise EvalError(f"strain_rate(): --set {key}={given[-1]} gives no rate (WALL RATE WALL_TO)") from None
+
+
+def fastest_within_of(rates, errors, tol):
+    """The largest rate r such that every rate <= r has |error| <= tol; None when the slowest
+    rate's error is already beyond tol."""
+    best = None
+    for rate, error in sorted(zip(rates, errors)):
+        if not abs(error) <= tol:
+            break
+        best = rate
+    return best
+
+
 # ---------------------------------------------------------------- the expression functions
 
 # ---------------------------------------------------------------- the void ratio
@@ -350,7 +387,7 @@ def void_ratios_of(yc, r, box, bands):
 NAMES = ("sigma_v", "sigma_h", "mean_stress", "deviator", "phi", "axial_strain", "lateral_strain",
          "volumetric_strain", "shear_start", "phi_peak", "peak_cycle", "at_peak", "phi_residual",
          "window_mean", "residual_drift", "dilation", "phi_envelope", "cohesion_envelope", "setting",
-         "void_ratio", "void_ratios", "band_heights", "initial_void_ratio")
+         "void_ratio", "void_ratios", "band_heights", "initial_void_ratio", "strain_rate", "fastest_within")
 
 
 def bind(run, sibling=None):
@@ -462,6 +499,43 @@ def bind(run, sibling=None):
         """The number a --set KEY=VALUE of this run gave key (e.g. a material's delta)."""
         return setting_of(run.info, key)
 
+    def strain_rate(stage="shear"):
+        """The strain rate this run's --set gave the stage (1/s)."""
+        return rate_of(run.info, stage)
+
+    def fastest_within(tol, expr, reference, names):
+        """The cheapest rate of the study within tol of the reference (module docstring)."""
+        if isinstance(names, str) or not isinstance(names, (list, tuple)) or not names:
+            raise EvalError("fastest_within(): names must be a list of ensembles, e.g. ['m0_rate0.5', ...]")
+        if not (isinstance(tol, (int, float)) and tol >= 0):
+            raise EvalError(f"fastest_within(): tol must be a number >= 0, not {tol!r}")
+
+        def value(variant):
+            try:
+                return float(evaluate(expr, sibling_run(sibling, variant, "fastest_within"), sibling))
+            except EvalError as exc:
+                raise EvalError(f"fastest_within(): '{variant}': {exc}") from None
+
+        base = {v[len(reference) + 2:]: value(v) for v in ensemble_members(sibling, reference, "fastest_within")}
+        rates, errors = [], []
+        for name in names:
+            members = ensemble_members(sibling, name, "fastest_within")
+            seeds = [v[len(name) + 2:] for v in members]
+            if sorted(seeds) != sorted(base):
+                raise EvalError(f"fastest_within(): ensembles '{name}' and '{reference}' have different seeds")
+            ratesof = {rate_of(sibling_run(sibling, v, "fastest_within").info) for v in members}
+            if len(ratesof) != 1:
+                raise EvalError(f"fastest_within(): the realisations of '{name}' have different strain rates")
+            rates.append(ratesof.pop())
+            errors.append(float(np.mean([value(v) - base[k] for v, k in zip(members, seeds)])))
+        if len(set(rates)) != len(rates):
+            raise EvalError("fastest_within(): two ensembles have the same strain rate")
+        best = fastest_within_of(rates, errors, tol)
+        if best is None:
+            raise EvalError(f"fastest_within(): even the slowest rate, {min(rates):g} /s, is beyond {tol:g} "
+                            "of the reference")
+        return best
+
     def density(bands):
         bands = whole(bands, "void_ratios", "bands")
         if not 1 <= bands <= 100:
@@ -501,7 +575,8 @@ def bind(run, sibling=None):
             "volumetric_strain": volumetric_strain, "shear_start": shear_start, "phi_peak": phi_peak,
             "peak_cycle": peak_cycle, "at_peak": at_peak, "phi_residual": phi_residual,
             "window_mean": window_mean, "residual_drift": residual_drift, "dilation": dilation,
-            "phi_envelope": phi_envelope, "cohesion_envelope": cohesion_envelope, "setting": setting}
+            "phi_envelope": phi_envelope, "cohesion_envelope": cohesion_envelope, "setting": setting,
+            "strain_rate": strain_rate, "fastest_within": fastest_within}
 
 
 register("biaxial", NAMES, bind)

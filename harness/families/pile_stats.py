@@ -33,6 +33,26 @@ The expression functions of the family (NAME an [ensemble] of the case, as in en
                                     (the weight of its free discs over the base width), k_n
                                     from its run.json `sets` (material.grain.kn=..., required)
     log10(x)                        the base-10 logarithm, element by element (a figure's axis)
+
+The ensemble's size (issue 33: how many realisations the dip needs), each over a list `sizes`
+of numbers of realisations n (whole, 2 to the ensemble's size):
+
+    dip_first(name, sizes)          D of the first n realisations (seed order), for each n: the
+                                    dip the ensemble would have shown with n runs
+    dip_se_first(name, sizes)       its jackknife standard error, for each n
+    dip_se_blocks(name, sizes)      for each n, the mean of the jackknife standard error over the
+                                    ensemble's disjoint blocks of n consecutive realisations (the
+                                    last, partial block left out): SE against n from one ensemble
+    dip_sd_blocks(name, sizes)      for each n, the standard deviation (n - 1) of D over those
+                                    blocks (at least two): the spread the SE should predict
+    dip_mean_blocks(name, sizes)    for each n, the mean of D over those blocks: what an ensemble
+                                    of n shows on average (D of an averaged profile is biased
+                                    at small n: R is a largest window mean, lifted by the noise)
+    se_exponent(name, sizes)        the least-squares slope of log dip_se_blocks on log n:
+                                    -1/2 for the sqrt(N) law
+    n_for_z(name, z, sizes)         the number of realisations at which |D| / SE = z, with D the
+                                    whole ensemble's and SE(n) = a n^b the least-squares power
+                                    law of dip_se_blocks over sizes
     tail_ks(f, f0=1)                the Kolmogorov-Smirnov distance between the f > f0 and that
                                     exponential, times sqrt(count) (below 1.63: not rejected
                                     at the 1 % level; rate estimated, so conservative)
@@ -132,6 +152,33 @@ def dip_with_se(profiles, X, flank=FLANK):
     return dip_depth(mean, X, flank), jackknife_se(P, lambda m: dip_depth(m, X, flank))
 
 
+def first_dips(profiles, X, sizes, flank=FLANK):
+    """[(D, SE)] of the first n rows of profiles, for each n of sizes."""
+    return [dip_with_se(profiles[:n], X, flank) for n in sizes]
+
+
+def block_stats(profiles, X, n, flank=FLANK):
+    """(D, SE) of each disjoint block of n consecutive rows of profiles (a partial last block is
+    left out)."""
+    blocks = profiles.shape[0] // n
+    return [dip_with_se(profiles[k * n:(k + 1) * n], X, flank) for k in range(blocks)]
+
+
+def power_law(sizes, se):
+    """(a, b) of the least-squares line log se = log a + b log n."""
+    b, log_a = np.polyfit(np.log(np.asarray(sizes, dtype=float)), np.log(np.asarray(se, dtype=float)), 1)
+    return float(math.exp(log_a)), float(b)
+
+
+def n_for(z, depth, a, b):
+    """The n at which |depth| / (a n^b) = z (b < 0)."""
+    if not b < 0:
+        raise EvalError(f"n_for_z(): the standard error does not fall with n (exponent {b:.3g})")
+    if depth == 0:
+        raise EvalError("n_for_z(): D is 0: no number of realisations makes it stand out")
+    return float((z * a / abs(depth)) ** (1.0 / -b))
+
+
 def tail(f, f0):
     f = np.asarray(f, dtype=float).reshape(-1)
     t = f[f > f0] - f0
@@ -184,7 +231,8 @@ def normalised_forces(final):
 # ---------------------------------------------------------------- the expression functions
 
 NAMES = ("ens_X", "ens_S", "ens_S_se", "dip", "dip_se", "profile_dip", "coordination",
-         "ens_forces", "tail_rate", "tail_ks", "ens_fluct", "ens_rho", "log10")
+         "ens_forces", "tail_rate", "tail_ks", "ens_fluct", "ens_rho", "log10", "dip_first",
+         "dip_se_first", "dip_se_blocks", "dip_sd_blocks", "dip_mean_blocks", "se_exponent", "n_for_z")
 KN_KEY = "material.grain.kn="
 
 
@@ -274,6 +322,54 @@ def bind(run, sibling=None):
         first = sibling_run(sibling, variant, "ens_rho")
         return rho(state(first), first.info.get("sets"))
 
+    def sized(name, sizes, fname, blocks=1):
+        """(profiles, X, [n, ...]) of ensemble name, each n whole, >= 2 and with `blocks` blocks."""
+        P = profiles(name, "zz", 1, fname)
+        if isinstance(sizes, str) or np.ndim(sizes) != 1 or len(sizes) == 0:
+            raise EvalError(f"{fname}(): sizes must be a list of numbers of realisations, e.g. [10, 20, 50]")
+        out = []
+        for n in sizes:
+            if isinstance(n, bool) or not float(n).is_integer() or not 2 <= n <= P.shape[0] // blocks:
+                raise EvalError(f"{fname}(): {n!r} realisations: sizes must be whole numbers from 2 to "
+                                f"{P.shape[0] // blocks} ({P.shape[0]} realisations"
+                                + (f", at least {blocks} blocks)" if blocks > 1 else ")"))
+            out.append(int(n))
+        return P, ens_X(name), out
+
+    def dip_first(name, sizes):
+        P, X, ns = sized(name, sizes, "dip_first")
+        return np.array([d for d, _ in first_dips(P, X, ns)])
+
+    def dip_se_first(name, sizes):
+        P, X, ns = sized(name, sizes, "dip_se_first")
+        return np.array([se for _, se in first_dips(P, X, ns)])
+
+    def se_blocks(name, sizes, fname="dip_se_blocks"):
+        P, X, ns = sized(name, sizes, fname)
+        return ns, np.array([np.mean([se for _, se in block_stats(P, X, n)]) for n in ns])
+
+    def dip_se_blocks(name, sizes):
+        return se_blocks(name, sizes)[1]
+
+    def dip_sd_blocks(name, sizes):
+        P, X, ns = sized(name, sizes, "dip_sd_blocks", blocks=2)
+        return np.array([np.std([d for d, _ in block_stats(P, X, n)], ddof=1) for n in ns])
+
+    def dip_mean_blocks(name, sizes):
+        P, X, ns = sized(name, sizes, "dip_mean_blocks")
+        return np.array([np.mean([d for d, _ in block_stats(P, X, n)]) for n in ns])
+
+    def law(name, sizes, fname):
+        if np.ndim(sizes) == 1 and len(set(np.asarray(sizes, dtype=float).tolist())) < 2:
+            raise EvalError(f"{fname}(): needs two or more different sizes")
+        return power_law(*se_blocks(name, sizes, fname))
+
+    def se_exponent(name, sizes):
+        return law(name, sizes, "se_exponent")[1]
+
+    def n_for_z(name, z, sizes):
+        return n_for(z, dip(name), *law(name, sizes, "n_for_z"))
+
     def log10(x):
         x = np.asarray(x, dtype=float)
         if np.any(~(x > 0)):
@@ -282,7 +378,10 @@ def bind(run, sibling=None):
 
     return {"ens_fluct": ens_fluct, "ens_rho": ens_rho, "log10": log10, "ens_X": ens_X, "ens_S": ens_S, "ens_S_se": ens_S_se, "dip": dip, "dip_se": dip_se,
             "profile_dip": profile_dip, "coordination": coordination, "ens_forces": ens_forces,
-            "tail_rate": tail_rate, "tail_ks": tail_ks}
+            "tail_rate": tail_rate, "tail_ks": tail_ks, "dip_first": dip_first, "dip_se_first": dip_se_first,
+            "dip_se_blocks": dip_se_blocks, "dip_sd_blocks": dip_sd_blocks, "dip_mean_blocks": dip_mean_blocks,
+            "se_exponent": se_exponent,
+            "n_for_z": n_for_z}
 
 
 register("pile_stats", NAMES, bind)

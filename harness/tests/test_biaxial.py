@@ -350,6 +350,26 @@ def test_setting_reads_the_runs_overrides(tmp_path):
     assert json.loads((tmp_path / CASE / "v" / "run.json").read_text())["sets"][0] == "material.grain.delta=0.4"
 
 
+def test_the_strain_rate_of_a_run_and_the_fastest_rate_within_a_tolerance():
+    info = {"sets": ["stage.shear.strain_rate=spec_top 0.5 spec_bottom", "stage.shear.strain_rate=spec_top 0.125 b",
+                     "stage.load.strain_rate=w", "stage.other.strain_rate=w x y"]}
+    assert biaxial.rate_of(info) == 0.125                                     # the last one given
+    with pytest.raises(EvalError, match="gives no rate"):
+        biaxial.rate_of(info, "load")
+    with pytest.raises(EvalError, match="gives no rate"):
+        biaxial.rate_of(info, "other")
+    with pytest.raises(EvalError, match="no --set stage.consolidate.strain_rate"):
+        biaxial.rate_of(info, "consolidate")
+    # rates 0.125 (the reference) ... 4, in any order; 2 /s is within 0.6 but 1 /s is not
+    rates, errors = [4, 0.125, 0.25, 0.5, 1, 2], [3.0, 0.0, 0.2, -0.4, 0.7, 0.1]
+    assert biaxial.fastest_within_of(rates, errors, 0.5) == 0.5
+    assert biaxial.fastest_within_of(rates, errors, 0.7) == 2
+    assert biaxial.fastest_within_of(rates, errors, 3.0) == 4
+    assert biaxial.fastest_within_of(rates, errors, 0.1) == 0.125
+    assert biaxial.fastest_within_of([0.25, 0.5], [0.2, 0.0], 0.1) is None
+    assert biaxial.fastest_within_of(rates, [float("nan")] + errors[1:], 10) == 2   # NaN is never within
+
+
 # ---------------------------------------------------------------- figures: JYH Figs 11-13
 
 needs_gnuplot = pytest.mark.skipif(not shutil.which("gnuplot"), reason="gnuplot not installed")

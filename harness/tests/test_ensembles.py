@@ -1,6 +1,7 @@
 """[ensemble NAME] in case.txt (harness/ensembles.py): one variant per seed, NAME_s<seed>,
 validated with file:line; the expression functions over an ensemble (families/ensembles.py);
 `list` shows it in a few words; the stability finder takes its first realisation only."""
+import numpy as np
 import pytest
 
 from harness import catalogue, stability
@@ -152,3 +153,82 @@ def test_list_shows_an_ensemble_in_a_few_words(project, capsys):
     assert main(["list"]) == 0
     out = capsys.readouterr().out
     assert "soft stiff stiffer k_s[1-300]" in out and "k_s17" not in out
+
+
+# ---------------------------------------------------------------- pairs of ensembles (issue 33)
+
+PAIRS = """
+[ensemble k]
+scene = spring.scene
+set = k={seed}
+set = stage.shear.strain_rate=top 1 bottom
+seeds = 1-3
+
+[ensemble j]
+scene = spring.scene
+set = k={seed}.05
+set = stage.shear.strain_rate=top 2 bottom
+seeds = 1-3
+
+[ensemble i]
+scene = spring.scene
+set = k={seed}.2
+set = stage.shear.strain_rate=top 4 bottom
+seeds = 1-3
+
+[ensemble h]
+scene = spring.scene
+set = k={seed}
+set = stage.shear.strain_rate=top 8 bottom
+seeds = 1-3
+
+[ensemble odd]
+scene = spring.scene
+set = k={seed}
+set = stage.shear.strain_rate=top 16 bottom
+seeds = 1 2 5
+"""
+
+
+def test_paired_ensembles_specimen_by_specimen(project, runs, capsys):
+    """F = 10 k at the last row: k = seed in ensemble k, seed + 0.05 in j, seed + 0.2 in i, so
+    each realisation of j is 0.5 above its counterpart of the same seed in k, of i 2."""
+    add_ensemble(project, PAIRS)
+    assert main(["run", "spring"]) == 0
+    capsys.readouterr()
+    store = RunStore(folder_locator(runs), catalogue.ensembles_of(catalogue.load()))
+    q = lambda expr, variant="soft": quantity_in(store, "spring", variant, expr)
+    assert q("same_seed('k', 'last(F)')", "j_s2") == pytest.approx(20.0)
+    assert q("last(F) - same_seed('k', 'last(F)')", "i_s3") == pytest.approx(2.0)
+    assert list(quantity_array(store, "paired('j', 'k', 'last(F)')")) == pytest.approx([0.5] * 3)
+    assert list(quantity_array(store, "means(['k', 'j'], 'last(F)')")) == pytest.approx([20.0, 20.5])
+    assert list(quantity_array(store, "paired_means(['k', 'j', 'i'], 'k', 'last(F)')")) == pytest.approx([0, 0.5, 2])
+    assert q("sd(over('k', 'last(F)'))") == pytest.approx(10.0)             # 10, 20, 30
+    assert q("sd([1, 2, 3, 4])") == pytest.approx(np.std([1, 2, 3, 4], ddof=1))
+    assert q("log10(mean(over(this_ensemble(), \"run('steps')\")))", "j_s1") == pytest.approx(1.0)
+    assert q("strain_rate()", "i_s1") == 4.0
+    # the cheapest (fastest) rate within tol of k, at that rate and every slower one: h (8 /s) is
+    # back at 0 but i (4 /s) between is 2 off, so within 1 the answer is j's 2 /s
+    names = "['k', 'j', 'i', 'h']"
+    assert q(f"fastest_within(1, 'last(F)', 'k', {names})") == 2.0
+    assert q(f"fastest_within(0.1, 'last(F)', 'k', {names})") == 1.0
+    assert q(f"fastest_within(2.5, 'last(F)', 'k', {names})") == 8.0
+    with pytest.raises(EvalError, match="no realisation of an ensemble"):
+        q("this_ensemble()")
+    with pytest.raises(EvalError, match="ensemble 'odd' has no realisation of seed 3"):
+        q("same_seed('odd', 'last(F)')", "k_s3")
+    with pytest.raises(EvalError, match="'odd' and 'k' have different seeds"):
+        q("mean(paired('odd', 'k', 'last(F)'))")
+    with pytest.raises(EvalError, match="different seeds"):
+        q("fastest_within(1, 'last(F)', 'k', ['k', 'odd'])")
+    with pytest.raises(EvalError, match="needs at least two values"):
+        q("sd([1])")
+    with pytest.raises(EvalError, match="a list of ensemble names"):
+        q("mean(means('k', 'last(F)'))")
+    with pytest.raises(EvalError, match="the slowest rate, 2 /s, is beyond 0.1"):
+        q("fastest_within(0.1, 'last(F)', 'k', ['j', 'i'])")
+
+
+def quantity_array(store, expr):
+    from harness.compare import evaluate_array
+    return evaluate_array(expr, store.get("spring", "soft"), store.siblings("spring"))

@@ -34,7 +34,10 @@ PILE_STATS = {"ens_X", "ens_S", "ens_S_se", "dip", "dip_se", "profile_dip", "coo
               "tail_rate", "tail_ks", "ens_fluct", "ens_rho", "log10"}
 # issue 30: the Coulomb cap at the sliding contacts of a final state (families/coulomb.py)
 COULOMB = {"coulomb_error", "sliding_contacts"}
-NAMES = NAMES_BEFORE | NAMES_ADDED | BIAXIAL | ENSEMBLES | VOID_RATIO | PILE_STATS | COULOMB
+# issue 33: the rate study (biaxial, over ensembles of specimens) and the ensemble's size (pile_stats)
+STUDIES = {"strain_rate", "fastest_within", "sd", "this_ensemble", "same_seed", "paired", "means", "paired_means",
+           "dip_first", "dip_se_first", "dip_se_blocks", "dip_sd_blocks", "dip_mean_blocks", "se_exponent", "n_for_z"}
+NAMES = NAMES_BEFORE | NAMES_ADDED | BIAXIAL | ENSEMBLES | VOID_RATIO | PILE_STATS | COULOMB | STUDIES
 
 
 def _run(**columns):

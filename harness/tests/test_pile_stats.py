@@ -87,6 +87,29 @@ def test_dip_and_its_standard_error_on_synthetic_ensembles(depth):
     assert np.mean(np.abs(z) < 3) > 0.97
 
 
+def test_the_standard_error_against_the_number_of_realisations():
+    """One synthetic ensemble of 400 runs: the first-n D and SE are those of the first n rows; the
+    blocks are disjoint; the jackknife SE of the blocks falls as n^(-1/2) (i.i.d. runs: the
+    exponent's own scatter here is about 0.02); the n for a z follows from the power law exactly."""
+    rng = np.random.default_rng(5)
+    X, _, P = synthetic_ensemble(rng, 400, 0.2, 0.3)
+    (d10, se10), (d400, se400) = ps.first_dips(P, X, [10, 400])
+    assert (d10, se10) == ps.dip_with_se(P[:10], X) and (d400, se400) == ps.dip_with_se(P, X)
+    blocks = ps.block_stats(P, X, 30)                 # 13 blocks of 30, the last 10 runs left out
+    assert len(blocks) == 13 and blocks[12] == ps.dip_with_se(P[360:390], X)
+    sizes = [10, 20, 25, 40, 50, 80, 100, 200]
+    se = [np.mean([s for _, s in ps.block_stats(P, X, n)]) for n in sizes]
+    a, b = ps.power_law(sizes, se)
+    assert b == pytest.approx(-0.5, abs=0.08)
+    assert ps.power_law([1, 4, 16], [2.0, 1.0, 0.5]) == pytest.approx((2.0, -0.5))
+    assert ps.n_for(5, 0.5, 1.0, -0.5) == pytest.approx(100.0)     # 0.5 / (1 / sqrt(100)) = 5
+    assert ps.n_for(5, -0.5, 1.0, -0.5) == pytest.approx(100.0)    # a hump: |D|
+    with pytest.raises(EvalError, match="does not fall with n"):
+        ps.n_for(5, 0.5, 1.0, 0.1)
+    with pytest.raises(EvalError, match="D is 0"):
+        ps.n_for(5, 0.0, 1.0, -0.5)
+
+
 def test_exponential_tail_rate_and_its_distance():
     rng = np.random.default_rng(3)
     beta = 1.7
@@ -184,6 +207,18 @@ def test_the_functions_over_a_fake_ensemble(tmp_path):
         q("dip('e')")          # a three-disc row has no flanks to compare with
     with pytest.raises(EvalError, match="no ensemble 'q'"):
         q("ens_S('q')")
+    with pytest.raises(EvalError, match="sizes must be whole numbers from 2 to 4"):
+        q("dip_first('e', [1, 2])")
+    with pytest.raises(EvalError, match="from 2 to 2 .*at least 2 blocks"):
+        q("dip_sd_blocks('e', [3])")
+    with pytest.raises(EvalError, match="sizes must be whole numbers from 2 to 4"):
+        q("dip_mean_blocks('e', [2.5])")
+    with pytest.raises(EvalError, match="sizes must be a list"):
+        q("dip_se_blocks('e', 3)")
+    with pytest.raises(EvalError, match="two or more different sizes"):
+        q("se_exponent('e', [2, 2])")
+    with pytest.raises(EvalError, match="no three neighbouring discs"):
+        q("dip_first('e', [2, 4])")
     (runs / "pile" / "e_s3" / "stress.tsv").unlink()
     fresh = RunStore(folder_locator(runs), {"pile": {"e": [f"e_s{s}" for s in shifts]}})
     with pytest.raises(EvalError, match="realisation 'e_s3'"):

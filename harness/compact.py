@@ -2,7 +2,8 @@
 
 A default validate wrote 322 MB: 136 MB the tables of the 1 000 realisations of piles_poly's
 ensembles, 92 MB the tables of the 99 error-against-cost sweep points, 40 MB the series.tsv of
-the cases' own runs, 33 MB the figures; it keeps 52 MB.  Once the report is written nothing reads most of it again: the verdicts are
+the cases' own runs, 33 MB the figures; it kept 52 MB (65 MB once the biaxial snapshots and the
+shear-band figures came, 2026-11-28).  Once the report is written nothing reads most of it again: the verdicts are
 in summary.json and junit.xml, the figures in figures/, each sweep's results in its cost.tsv.  So
 validate, at its very end (an interrupted validate keeps every file, and --resume works as
 before), keeps:

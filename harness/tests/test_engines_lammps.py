@@ -91,3 +91,33 @@ def test_the_matrix_sets_both_engines_side_by_side_with_their_costs(runs, tmp_pa
     text = (tmp_path / "peers" / "index.md").read_text()
     assert "| [collisions](#collisions) |" in text and "NOT EXPRESSIBLE" in text
     assert json.loads((tmp_path / "peers" / "matrix.json").read_text())["totals"] == totals
+
+
+# ---- servo and strain-rate walls (harness/tests/data/servo_box.scene) -----------------------
+
+SERVO_BOX = ROOT / "harness" / "tests" / "data" / "servo_box.scene"
+# Measured: the walls' positions agree to 2e-15 of their largest value, their forces (sums of
+# contact springs k_n delta, k_n = 1e5) to 3e-13, over 500 cycles.
+SERVO_ROUNDOFF = 1e-11
+
+
+def test_servo_and_strain_rate_walls_move_in_lammps_as_in_ballast_to_round_off(tmp_path):
+    import subprocess
+    out = tmp_path / "lammps"
+    assert make_run(Lammps(), SERVO_BOX, [], "run", out, BALLAST) == 0
+    subprocess.run([str(BALLAST), "run", str(SERVO_BOX), "--out", str(tmp_path / "ballast")],
+                   check=True, capture_output=True)
+    info = json.loads((out / "run.json").read_text())
+    assert info["status"] == "ok", info.get("message")
+    core = json.loads((tmp_path / "ballast" / "run.json").read_text())
+    # the consolidation's stop_servo is met at the same check in both (cycle 200 of 400)
+    assert [(g["cycles"], g["stopped"]) for g in info["stages"]] == \
+           [(g["cycles"], g["stopped"]) for g in core["stages"]] == [(200, True), (300, False)]
+    a, b = read_series(out / "series.tsv"), read_series(tmp_path / "ballast" / "series.tsv")
+    assert a["cycle"].tolist() == b["cycle"].tolist() and len(b["cycle"]) == 500
+    for column in ("y_top", "x_right", "fy_top", "fx_right", "fy_bottom", "ek"):
+        scale = float(np.max(np.abs(b[column])))
+        assert np.max(np.abs(a[column] - b[column])) <= SERVO_ROUNDOFF * scale, column
+    # the servo moved the top wall down and the strain rate moved it on: not a wall at rest
+    assert b["y_top"][-1] < b["y_top"][199] < 6.1 - 0.05
+    assert "stress_top" in info["unexpressible"]

@@ -121,3 +121,27 @@ def test_servo_and_strain_rate_walls_move_in_lammps_as_in_ballast_to_round_off(t
     # the servo moved the top wall down and the strain rate moved it on: not a wall at rest
     assert b["y_top"][-1] < b["y_top"][199] < 6.1 - 0.05
     assert "stress_top" in info["unexpressible"]
+
+
+def test_exported_lammps_jobs_run_where_they_are_sent_and_gather_into_the_peers_runs(tmp_path, monkeypatch,
+                                                                                     capsys):
+    """`export collisions --engine lammps`, one job run as GNU parallel or Slurm would run it,
+    then `gather`: the run lands in reports/peers/runs/lammps/collisions/<variant> (where `make
+    validate-peers --resume` keeps it) with the job's bytes, the jobs not run are listed."""
+    from harness.__main__ import main
+    reports = tmp_path / "reports"
+    monkeypatch.setenv("BALLAST_REPORTS", str(reports))
+    folder = tmp_path / "shared"
+    assert main(["export", "collisions", "--to", str(folder), "--engine", "lammps"]) == 0
+    manifest = json.loads((folder / "manifest.json").read_text())
+    index = [j["variant"] for j in manifest["jobs"]].index("linear_10")
+    assert main(["job", str(folder), str(index)]) == 0
+    job = folder / "runs" / "collisions" / "linear_10"
+    assert json.loads((job / "run.json").read_text())["engine"] == "lammps"
+    assert main(["gather", str(folder)]) == 1                      # the other 11 were not run
+    out = capsys.readouterr().out
+    assert f"1 run(s) gathered, 0 already here, {len(manifest['jobs']) - 1} not gathered" in out
+    home = reports / "peers" / "runs" / "lammps" / "collisions" / "linear_10"
+    assert (home / "series.tsv").read_bytes() == (job / "series.tsv").read_bytes()
+    assert json.loads((home / "harness.json").read_text())["gathered_from"] == str(job)
+    assert not (reports / "runs" / "collisions").exists()         # not taken for ballast's run

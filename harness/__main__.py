@@ -275,7 +275,7 @@ def cmd_export(args):
     cases = selected(args, load_cases())
     if not cases:
         raise CatalogueError("no cases selected")
-    export.export(cases, args.bin, args.to, sys.stdout)
+    export.export(cases, args.bin, args.to, sys.stdout, args.engine)
     return 0
 
 
@@ -286,7 +286,8 @@ def cmd_job(args):
 
 def cmd_gather(args):
     """The finished runs of an export folder into reports/runs; 1 if some are not there."""
-    gathered, kept, refused = export.gather(args.dir, load_cases(), args.bin, runs_root(), sys.stdout)
+    gathered, kept, refused = export.gather(args.dir, load_cases(), args.bin, runs_root(), sys.stdout,
+                                            reports_root())
     return 1 if refused else 0
 
 
@@ -496,6 +497,9 @@ def parser():
     exp.add_argument("--to", required=True, type=Path, metavar="DIR",
                      help="the export folder, seen at the same path by every machine that runs jobs")
     exp.add_argument("--bin", type=Path, default=None, help="the core executable (default $BALLAST_BIN or bin/ballast)")
+    exp.add_argument("--engine", default="", metavar="ENGINE",
+                     help="export another engine's runs of the cases (docs/engines.md: lammps), as `make "
+                          "validate-peers` makes them; gather puts them in reports/peers/runs/ENGINE")
     job = _command(sub, "job", cmd_job, "run job INDEX of an export folder (what jobs.txt and slurm.sh call)",
                    writes=False)
     job.add_argument("dir", type=Path, metavar="DIR")

@@ -56,8 +56,10 @@ from . import REPO_ROOT, files
 from .catalogue import COMMANDS
 from .errors import CatalogueError
 from .ini import NAME
-from .runner import (PEER_COMMANDS, Inputs, Job, binary_identity, identity, inputs_change, jobs_for,
-                     output_digests, run_one, sha256_of, stale)
+from .engines.driver import engines
+from .engines.matrix import engine_jobs, peers_root
+from .runner import (PEER_COMMANDS, Inputs, Job, binary_identity, engine_identity, identity, inputs_change,
+                     jobs_for, output_digests, run_one, sha256_of, stale)
 
 FORMAT = "ballast-export 2"   # 2: each job lists the files its run reads, with their SHA-256
 JOB_KEYS = {"case", "variant", "scene", "sets", "command", "expected", "ensemble", "seed", "inputs"}
@@ -68,15 +70,21 @@ MAX_ARRAY = 1000          # array tasks at most (Slurm's default MaxArraySize is
 HARNESS = REPO_ROOT / "harness" / "ballast-harness"
 
 
-def export(cases, binary, folder, out):
+def export(cases, binary, folder, out, engine=""):
     """Write the manifest, job list and array script of every variant of cases into folder;
-    returns the jobs.  The runs already in folder/runs are left (a job keeps a finished one)."""
+    returns the jobs.  The runs already in folder/runs are left (a job keeps a finished one).
+    engine: another engine's runs instead of the core's (harness/engines; `make
+    validate-peers`'s runs): jobs of command ENGINE:COMMAND, and the manifest records that
+    engine's identity (its executable, the adapter's files), which `job` and `gather` hold the
+    runs to."""
     folder = Path(folder).resolve()
     binary = Path(os.path.abspath(binary))
     digest = sha256_of(binary)
     if digest is None:
         raise CatalogueError(f"export: cannot read the executable {binary} (build it: make)")
-    jobs = jobs_for(cases, folder / "runs")
+    if engine and engine not in engines():
+        raise CatalogueError(f"export: no engine {engine!r} (engines: {', '.join(sorted(engines()))})")
+    jobs = engine_jobs(engine, cases, folder / "runs") if engine else jobs_for(cases, folder / "runs")
     if not jobs:
         raise CatalogueError("export: no runs selected")
     relative = next((j for j in jobs if not Path(j.scene).is_absolute()), None)
@@ -87,6 +95,7 @@ def export(cases, binary, folder, out):
     read = [job_inputs(j, binary, inputs) for j in jobs]
     manifest = {"format": FORMAT, "repository": str(REPO_ROOT),
                 "binary": {"path": str(binary), "sha256": digest},
+                "engines": {engine: engine_identity(engine)} if engine else {},
                 "jobs": [{"case": j.case, "variant": j.variant, "scene": str(j.scene),
                           "sets": list(j.sets), "command": j.command, "expected": j.expected,
                           "ensemble": j.ensemble, "seed": j.seed, "inputs": r} for j, r in zip(jobs, read)]}
@@ -97,7 +106,8 @@ def export(cases, binary, folder, out):
     files.write_text(folder / SLURM, slurm_script(folder, cases, len(jobs)))
     os.chmod(folder / SLURM, 0o755)
     tasks = min(len(jobs), MAX_ARRAY)
-    print(f"exported {len(jobs)} run(s) of {', '.join(c.name for c in cases)} to {folder}\n"
+    print(f"exported {len(jobs)} {engines()[engine].title + ' ' if engine else ''}run(s) of "
+          f"{', '.join(c.name for c in cases)} to {folder}\n"
           f"  GNU parallel:  parallel -j N < {folder / JOBS}    (other machines: --sshlogin; docs/ensembles.md)\n"
           f"  Slurm:         sbatch {folder / SLURM}    ({tasks} array task(s))\n"
           f"  then:          {HARNESS} gather {folder}", file=out)
@@ -162,8 +172,13 @@ def load_manifest(folder):
     if not isinstance(manifest, dict) or manifest.get("format") != FORMAT or \
             not isinstance(manifest.get("jobs"), list) or \
             not all(isinstance(j, dict) and set(j) == JOB_KEYS for j in manifest["jobs"]) or \
-            not isinstance(manifest.get("binary"), dict):
+            not isinstance(manifest.get("binary"), dict) or \
+            not isinstance(manifest.setdefault("engines", {}), dict):
         raise CatalogueError(f"{path}: not a manifest of format '{FORMAT}' (export again)")
+    for name, ident in manifest["engines"].items():
+        if name not in engines() or not isinstance(ident, dict):
+            raise CatalogueError(f"{path}: its engines must be {{name: identity}} of {', '.join(sorted(engines()))}; "
+                                 f"got {name!r}; refused, nothing run")
     binary = manifest["binary"]
     if not isinstance(binary.get("path"), str) or not os.path.isabs(binary["path"]) or "\0" in binary["path"] \
             or not isinstance(binary.get("sha256"), str) or not SHA256.fullmatch(binary["sha256"]):
@@ -171,6 +186,8 @@ def load_manifest(folder):
     first = {}
     for index, job in enumerate(manifest["jobs"]):
         why = job_problem(job)
+        if not why and ":" in job["command"] and job["command"].split(":", 1)[0] not in manifest["engines"]:
+            why = f"its engine {job['command'].split(':', 1)[0]!r} has no identity in the manifest's engines"
         if why:
             raise CatalogueError(f"{path}: job {index}: {why}; refused, nothing run or written")
         label = (job["case"], job["variant"])
@@ -196,8 +213,11 @@ def job_problem(job):
         return f"its ensemble {job['ensemble']!r} is not a name a case.txt can give"
     if job["seed"] is not None and (type(job["seed"]) is not int or job["seed"] < 0):
         return f"its seed {job['seed']!r} is not a whole number >= 0"
-    if job["command"] not in COMMANDS:
-        return f"its command {job['command']!r} is none of {', '.join(COMMANDS)}"
+    command = job["command"]
+    engine, _, what = command.rpartition(":") if isinstance(command, str) else ("", "", command)
+    if what not in COMMANDS or (":" in command and engine not in engines()):
+        return (f"its command {command!r} is none of {', '.join(COMMANDS)}, nor ENGINE:COMMAND of one of them "
+                f"(engines: {', '.join(sorted(engines()))})")
     scene = job["scene"]
     if not isinstance(scene, str) or not os.path.isabs(scene) or "\0" in scene:
         return f"its scene {scene!r} is not an absolute path"
@@ -263,6 +283,12 @@ def run_job(folder, index, out):
         raise CatalogueError(f"{folder / MANIFEST}: the executable {binary} "
                              f"{'is missing' if found is None else 'changed'} since the export "
                              "(export again, or rebuild what was exported)")
+    if ":" in job.command:
+        engine = job.command.split(":", 1)[0]
+        changed = engine_change(manifest["engines"][engine], engine_identity(engine))
+        if changed:
+            raise CatalogueError(f"{where}: {changed} since the export (export again); refused, nothing "
+                                 "run or written")
     inputs = Inputs()
     if job.command not in PEER_COMMANDS:
         changed = inputs_change(manifest["jobs"][index]["inputs"], inputs.digests(binary, job.scene, job.sets))
@@ -279,24 +305,42 @@ def run_job(folder, index, out):
     return outcome
 
 
+def engine_change(recorded, now):
+    """What differs between an engine's identity at the export and here ('' when nothing):
+    its executable or an adapter file (harness/engines)."""
+    for key in sorted(set(recorded) | set(now)):
+        if recorded.get(key) != now.get(key):
+            what = {"lmp": "executable's path", "lmp_sha256": "executable"}.get(key, f"adapter file {key}")
+            return f"the engine's {what} changed"
+    return ""
+
+
 # ---------------------------------------------------------------- gathering
 
-def gather(folder, cases, binary, runs_root, out):
-    """Bring every finished run of the export folder into runs_root/<case>/<variant>.
-    Returns (gathered, kept, refused): refused is [(label, why)], the runs not taken."""
+def gather(folder, cases, binary, runs_root, out, reports=None):
+    """Bring every finished run of the export folder into runs_root/<case>/<variant> (an
+    engine's run: into reports/peers/runs/ENGINE/<case>/<variant>, where `make validate-peers`
+    keeps them; reports: the reports folder, default runs_root's parent).  Returns (gathered,
+    kept, refused): refused is [(label, why)], the runs not taken."""
     folder = Path(folder).resolve()
     manifest = load_manifest(folder)
     remotes = manifest_jobs(manifest, folder / "runs")
     linked = next((why for why in (unlinked(folder / "runs", r) for r in remotes) if why), "")
     if linked:
         raise CatalogueError(f"{folder}: {linked}; refused, nothing gathered")
-    local = {j.label: j for j in jobs_for(cases, runs_root)}
+    local = {(j.command, j.label): j for j in jobs_for(cases, runs_root)}
+    peers = peers_root(reports or Path(runs_root).parent) / "runs"
+    for engine in manifest["engines"]:
+        local.update({(j.command, j.label): j for j in engine_jobs(engine, cases, peers / engine)})
     binary = Path(os.path.abspath(binary))
     binary_id = binary_identity(binary)
     inputs = Inputs()
     gathered, kept, refused = [], [], []
     for remote, entry in zip(remotes, manifest["jobs"]):
-        mine = local.get(remote.label)
+        mine = local.get((remote.command, remote.label))
+        if mine is None and any(label == remote.label for _, label in local):
+            refused.append((remote.label, "its case.txt variant changed since the export (export again)"))
+            continue
         if mine is None:
             refused.append((remote.label, "no such variant in the catalogue now"))
             continue

@@ -27,7 +27,10 @@ in short (plan() says per scene which apply, and refuses the rest):
                over s, and the drags -alpha m v, -alpha I omega at the half step (fix langevin
                at T = 0 with omega, whose translational drag fix addforce trims)
   walls        region plane + fix wall/gran/region per wall and disc material, moved and
-               turned by equal-style variables of the step (ballast's `move`)
+               turned by equal-style variables of the step (ballast's `move`); a servo or
+               strain-rate wall (and a moving wall such a controller measures) follows a
+               carrier atom that fix move variable moves by x += dt v, v the core's controller
+               law evaluated first in each step from the state of the step before
   stop rules   checked every check_every steps by the same Python that writes the outputs,
                inside LAMMPS (its PYTHON package), on LAMMPS's state
 
@@ -54,8 +57,8 @@ from pathlib import Path
 from .. import files
 from . import scene as scenes
 from .interface import APPROXIMATE, EXACT, REFUSED, Engine, Plan
-from .lammps_input import (_stop_rule, data_text, fmt, gfac_expr, pair_law, rolling_sds,  # noqa: F401
-                           translate, wall_side)
+from .lammps_input import (_stop_rule, controlled_walls, data_text, fmt, gfac_expr,  # noqa: F401
+                           pair_law, rolling_sds, translate, wall_side)
 from .lammps_output import (last_frame, parse_dump, parse_frames, parse_log, run_lmp,  # noqa: F401
                             trajectory_of, walls_at)
 
@@ -326,15 +329,21 @@ class Lammps(Engine):
                          "fix wall/gran's rolling displacement takes the particle's spin only, not the "
                          "wall's: ballast's theta_r = int (omega - omega_wall) dt has no counterpart")
         controls = {c.kind for s in scene.stages for c in s.controls}
+        carried = {scene.walls[k].name for k in controlled_walls(scene)}
+        for name in sorted(carried & turning):
+            plan.add(f"turning wall {name} under a controller", REFUSED,
+                     "a carried wall (servo, strain rate, or a wall they measure) moves along its "
+                     "carrier atom only: it does not turn")
         if "servo" in controls:
-            plan.add("servo-controlled walls (stress target)", REFUSED,
-                     "a region wall moves by an equal-style variable of the step; a servo needs the "
-                     "wall's position to integrate a velocity computed from its own contact forces each "
-                     "step, which LAMMPS's variables cannot hold (no state between steps) -- it would "
-                     "take a fix of its own or a driver through the library interface")
+            plan.add("servo-controlled walls (stress target)", EXACT,
+                     "the core's law v = clip(alpha (sigma_t - S/L) L/(K dt), vmax) towards the discs, "
+                     "S and K the springs' normal force k_n delta and stiffness k_n summed over the wall's "
+                     "contacts of the step before, L the span gap; the wall's region follows a carrier "
+                     "atom that fix move variable moves by x += dt v, v evaluated first in each step")
         if "strain_rate" in controls:
-            plan.add("strain-rate walls (logarithmic strain)", REFUSED,
-                     "the rate x the current gap is a feedback of the state like a servo's")
+            plan.add("strain-rate walls (logarithmic strain)", EXACT,
+                     "v = rate (M_TO - P_W).n n of the step before, through the wall's carrier atom as "
+                     "for a servo")
         if scene.walls:
             moving = any(c.kind == "move" for s in scene.stages for c in s.controls)
             plan.add("walls" + (" moved and turned by stages" if moving else ""), EXACT,
@@ -346,8 +355,10 @@ class Lammps(Engine):
     def _stages(self, scene, plan):
         for s in scene.stages:
             if s.number("stop_servo") > 0:
-                plan.add(f"stage {s.name}: stop_servo", REFUSED, "no servo walls (above)")
-            if s.number("stop_ke") > 0 or s.number("stop_stress") > 0 or s.number("stop_unbalanced") > 0:
+                plan.add(f"stage {s.name}: stop_servo", EXACT,
+                         "every servo wall's |S/L - sigma_t|/sigma_t at the check, from LAMMPS's state, "
+                         "as the core's stop rule")
+            if _stop_rule(s):
                 plan.add(f"stage {s.name}: stop rule", EXACT,
                          "checked every check_every steps inside LAMMPS (its PYTHON package) by "
                          "harness/engines on LAMMPS's state, with the core's definitions")

@@ -90,16 +90,23 @@ def data_text(scene, opts):
     ys = list(y - r) + list(y + r) + [c for w in scene.walls for c in (w.ay, w.by)]
     margin = float(r.max())
     n = len(x)
+    carriers = controlled_walls(scene)
     out = [f"LAMMPS data file written by harness/engines/lammps.py from {scene.path}", "",
-           f"{n} atoms", f"{len(opts.types)} atom types", "",
+           f"{n + len(carriers)} atoms", f"{len(opts.types) + (1 if carriers else 0)} atom types", "",
            f"{fmt(min(xs) - margin)} {fmt(max(xs) + margin)} xlo xhi",
            f"{fmt(min(ys) - margin)} {fmt(max(ys) + margin)} ylo yhi", "-0.5 0.5 zlo zhi", "",
            "Atoms # sphere", ""]
     for k in range(n):
         rho = scene.materials[scene.disc_material[k]].density * opts.scale
         out.append(f"{k + 1} {opts.type_of[k]} {fmt(2 * r[k])} {fmt(rho)} {fmt(x[k])} {fmt(y[k])} 0")
+    # a carrier atom per controlled wall, at the wall's midpoint (carrier_lines())
+    rho = scene.materials[opts.types[0][0]].density
+    for j, k in enumerate(carriers):
+        mx, my = midpoint(scene.walls[k])
+        out.append(f"{n + j + 1} {len(opts.types) + 1} {fmt(2 * float(r.min()))} {fmt(rho)} {fmt(mx)} {fmt(my)} 0")
     out += ["", "Velocities", ""]
     out += [f"{k + 1} {fmt(d['vx'][k])} {fmt(d['vy'][k])} 0 0 0 {fmt(d['omega'][k])}" for k in range(n)]
+    out += [f"{n + j + 1} 0.0 0.0 0 0 0 0.0" for j in range(len(carriers))]
     return "\n".join(out) + "\n"
 
 
@@ -125,17 +132,25 @@ def translate(scene, opts, work=None, extra=()):
     for t, (mat, _) in enumerate(opts.types):
         L.append(f"set             type {t + 1} density/disc "
                  f"{fmt(scene.materials[mat].density * opts.scale)}")
+    carriers = controlled_walls(scene)
     L.append("group           held id " + _ids(fixed) if fixed else "group           held empty")
-    L.append("group           free subtract all held")
+    if carriers:
+        L.append(f"group           carriers type {len(opts.types) + 1}")
+        L.append("group           free subtract all held carriers")
+    else:
+        L.append("group           free subtract all held")
     for t, (mat, _) in enumerate(opts.types):
         L.append(f"group           t{t + 1} type {t + 1}")
     style = "nsq" if opts.nsq else "bin"
     L.append(f"neighbor        {fmt(opts.skin)} {style}")
     L.append("neigh_modify    delay 0 every 1 check yes"
              + (f" binsize {fmt(opts.binsize)}" if opts.binsize and not opts.nsq else "")
-             + (" exclude group held held" if fixed else ""))
+             + (" exclude group held held" if fixed else "")
+             + (" exclude group carriers all" if carriers else ""))
     L += pair_lines(scene, opts)
     L.append(f"timestep        {fmt(dt)}")
+    # the carriers move first in a step, from the state of the step before (carrier_lines())
+    L += carrier_fix(scene)
     L.append("fix             integrate free nve/sphere disc")
     L += gravity_lines(scene, opts)
     if opts.alpha > 0:
@@ -146,6 +161,7 @@ def translate(scene, opts, work=None, extra=()):
               f"variable        trimy atom {fmt(excess)}*mass/{fmt(opts.scale)}*vy",
               "fix             trim free addforce v_trimx v_trimy 0.0"]
     L += wall_lines(scene, opts)
+    L += carrier_lines(scene, opts)
     for axis in ("x", "y"):
         part = [k for k in range(n) if axis in held[k] and held[k] != {"x", "y", "rotation"}]
         if part:
@@ -175,6 +191,13 @@ def pair_lines(scene, opts):
             kn, ks, mu, delta = pair_law(scene, ma, mb)
             r_eff = ra * rb / (ra + rb) if opts.hertz else None
             out.append(f"pair_coeff      {i + 1} {j + 1} {granular_coeff(scene, kn, ks, mu, delta, r_eff)}")
+    if controlled_walls(scene):
+        # the carriers' pairs are excluded from the neighbour lists; pair granular still wants a
+        # coefficient set for their type
+        kn, ks, mu, delta = pair_law(scene, opts.types[0][0], opts.types[0][0])
+        law = granular_coeff(scene, kn, ks, mu, delta, None)
+        carrier = len(opts.types) + 1
+        out += [f"pair_coeff      {t} {carrier} {law}" for t in range(1, carrier + 1)]
     return out
 
 
@@ -227,12 +250,20 @@ def wall_lines(scene, opts):
         if mat not in mats:
             mats.append(mat)
     moves = moving_walls(scene)
+    carriers = controlled_walls(scene)
     for k, w in enumerate(scene.walls):
         side = wall_side(scene, w)
         (qx, qy), (ex, ey) = wall_line(scene, w)
         nx, ny = -ey * side, ex * side
         motion = ""
-        if w.name in moves:
+        if k in carriers:
+            # where its carrier atom has gone since the start (carrier_lines())
+            j = carriers.index(k)
+            mx, my = midpoint(w)
+            out += [f"variable        W{k}_dx equal x[{len(scene.discs['x']) + j + 1}]-{fmt(mx)}",
+                    f"variable        W{k}_dy equal y[{len(scene.discs['x']) + j + 1}]-{fmt(my)}"]
+            motion = f" move v_W{k}_dx v_W{k}_dy NULL"
+        elif w.name in moves:
             out += [f"variable        W{k}_dx equal 0.0", f"variable        W{k}_dy equal 0.0",
                     f"variable        W{k}_th equal 0.0"]
             px, py = pivot(scene, w)
@@ -284,8 +315,237 @@ def turning_walls(scene):
 
 
 def moving_walls(scene):
+    """The walls a `move` moves (and no carrier carries: controlled_walls())."""
+    carried = {scene.walls[k].name for k in controlled_walls(scene)}
     return {c.wall for s in scene.stages for c in s.controls if c.kind == "move"
-            and any(v != 0 for v in c.numbers(3))}
+            and any(v != 0 for v in c.numbers(3)) and c.wall not in carried}
+
+
+# ---------------------------------------------------------------------------------- controlled walls
+#
+# A servo or strain-rate wall moves in cycle N + 1 with a velocity its controller computed from
+# the state of cycle N (core/walls.c): state that LAMMPS's equal-style variables of the step do
+# not keep.  Each such wall is carried by an atom of its own (a "carrier": no pair, no force,
+# excluded from the neighbour lists) that `fix move variable NULL NULL NULL v_vx v_vy NULL` moves
+# by x += dt v, v the controller's velocity evaluated first thing in the step (the fix is defined
+# before the discs' integrator), i.e. from the discs, walls and wall contacts of the step before;
+# the wall's region moves with its carrier (W<k>_dx = x[carrier] - x0).  docs/engines.md derives
+# the laws.
+
+CONTROLLERS = ("servo", "strain_rate")
+# The speed at which a servo with vmax = 0 moves: this share of the smallest radius per step
+# (core/walls.c, BAL_SERVO_CAP_SHARE).
+SERVO_CAP_SHARE = 1e-3
+
+
+def control_walls(control):
+    """The other walls a controller line names: a servo's span walls, a strain rate's target."""
+    if control.kind == "servo":
+        return control.words[3:5]
+    if control.kind == "strain_rate":
+        return control.words[1:2]
+    return []
+
+
+def controlled_walls(scene):
+    """Indices (wall order) of the walls a carrier atom carries: every wall a servo or strain
+    rate drives in some stage, and every wall such a controller measures (a span, a target) that
+    some stage moves."""
+    driven, measured, moved = set(), set(), set()
+    for st in scene.stages:
+        for c in st.controls:
+            moved.add(c.wall)
+            if c.kind in CONTROLLERS:
+                driven.add(c.wall)
+                measured.update(control_walls(c))
+    names = driven | (measured & moved)
+    return [k for k, w in enumerate(scene.walls) if w.name in names]
+
+
+def midpoint(wall):
+    return 0.5 * (wall.ax + wall.bx), 0.5 * (wall.ay + wall.by)
+
+
+def wall_normal(wall):
+    """The core's normal (-e2, e1) of a wall, e = (B - A)/|B - A|."""
+    ex, ey = wall.bx - wall.ax, wall.by - wall.ay
+    length = math.hypot(ex, ey)
+    return -ey / length, ex / length
+
+
+def toward_discs(scene, wall):
+    """A servo wall's direction of motion: its normal on the side of the discs' centroid (the
+    core's servo_start; taken from the discs as the run starts)."""
+    nx, ny = wall_normal(wall)
+    cx, cy = float(np.mean(scene.discs["x"])), float(np.mean(scene.discs["y"]))
+    side = (cx - wall.ax) * nx + (cy - wall.ay) * ny
+    return (-nx, -ny) if side < 0 else (nx, ny)
+
+
+def _shift(scene, k, axis):
+    """Wall k's displacement since the start along axis ('x' or 'y') as a formula: its carrier's,
+    or 0 for a wall no stage moves (controlled_walls() carries every moving wall a controller
+    reads)."""
+    return f"v_W{k}_d{axis}" if k in controlled_walls(scene) else "0.0"
+
+
+def gap_formula(scene, a, b):
+    """gap(A, B) = (M_B - P_A) . n_A (signed; core/walls.c bal_walls_gap) at the current step,
+    P_A a point of A's line, M_B the midpoint of B, both moved by their displacements."""
+    wa, wb = scene.walls[a], scene.walls[b]
+    nx, ny = wall_normal(wa)
+    mx, my = midpoint(wb)
+    c0 = (mx - wa.ax) * nx + (my - wa.ay) * ny
+    return (f"({fmt(c0)}+({_shift(scene, b, 'x')}-{_shift(scene, a, 'x')})*{fmt(nx)}"
+            f"+({_shift(scene, b, 'y')}-{_shift(scene, a, 'y')})*{fmt(ny)})")
+
+
+def wall_index(scene, name):
+    return next(k for k, w in enumerate(scene.walls) if w.name == name)
+
+
+def carrier_lines(scene, opts):
+    """What moves the carriers: per controlled wall k, the sums its servo reads from the wall's
+    contacts of the step before (compute W<k>s: the springs' normal force sum k_n delta, the
+    contacts per disc material, and where needed the whole force along the normal), its
+    stiffness K and its velocity W<k>_vx, W<k>_vy (stage_lines() defines them per stage); the
+    fix is carrier_fix()'s."""
+    carriers = controlled_walls(scene)
+    if not carriers:
+        return []
+    n = len(scene.discs["x"])
+    mats = []
+    for mat, _ in opts.types:
+        if mat not in mats:
+            mats.append(mat)
+    out = []
+    whole = whole_force_walls(scene)
+    for k in carriers:
+        w = scene.walls[k]
+        side = wall_side(scene, w)
+        (qx, qy), (ex, ey) = wall_line(scene, w)
+        nx, ny = -ey * side, ex * side                 # the region's normal, towards the discs
+        # k_n delta of each disc touching the wall: column 1 of the wall fix's contacts is 1 for a
+        # contact, column 8 the disc's radius; delta = r - the centre's distance to the plane
+        spring = "+".join(f"f_W{k}m{m}[1]*{fmt(pair_law(scene, mat, w.material)[0])}*(f_W{k}m{m}[8]"
+                          f"-((x-v_W{k}_qx)*{fmt(nx)}+(y-v_W{k}_qy)*{fmt(ny)}))"
+                          for m, mat in enumerate(mats))
+        counts = " ".join(f"f_W{k}m{m}[1]" for m in range(len(mats)))
+        out += [f"variable        W{k}_qx equal {fmt(qx)}+v_W{k}_dx",
+                f"variable        W{k}_qy equal {fmt(qy)}+v_W{k}_dy",
+                f"variable        W{k}_kd atom {spring}"]
+        sums = f"v_W{k}_kd {counts}"
+        if k in whole:
+            along = "+".join(f"f_W{k}m{m}[2]*{fmt(nx)}+f_W{k}m{m}[3]*{fmt(ny)}" for m in range(len(mats)))
+            out.append(f"variable        W{k}_ft atom {along}")
+            sums += f" v_W{k}_ft"
+        # [1] the springs' normal force, [2 ...] the contacts with each disc material, [then] the
+        # whole force along the normal (only for a wall whose servo may need it: whole_force_walls())
+        stiff = "+".join(f"c_W{k}s[{m + 2}]*{fmt(pair_law(scene, mat, w.material)[0])}"
+                         for m, mat in enumerate(mats))
+        out += [f"compute         W{k}s all reduce sum {sums}",
+                f"variable        W{k}_K equal \"{stiff}\"",
+                f"variable        W{k}_vx equal 0.0", f"variable        W{k}_vy equal 0.0"]
+    return out
+
+
+def carrier_fix(scene):
+    """The fix that moves every carrier (defined before the discs' integrator, so that it moves
+    first in a step; its variables are carrier_lines()', defined after the wall fixes they read)."""
+    carriers = controlled_walls(scene)
+    if not carriers:
+        return []
+    n = len(scene.discs["x"])
+    vx = "+".join(f"(id=={n + j + 1})*v_W{k}_vx" for j, k in enumerate(carriers))
+    vy = "+".join(f"(id=={n + j + 1})*v_W{k}_vy" for j, k in enumerate(carriers))
+    return [f"variable        carry_vx atom {vx}", f"variable        carry_vy atom {vy}",
+            "fix             carry carriers move variable NULL NULL NULL v_carry_vx v_carry_vy NULL"]
+
+
+def whole_force_walls(scene):
+    """The carried walls whose servo starts a stage after a stage with no controller: the core
+    then reads the whole force of its contacts at that first step (control_lines())."""
+    out = set()
+    for g, stage in enumerate(scene.stages):
+        before = [s for s in scene.stages[:g] if s.cycles > 0]
+        if before and not stage_tracks(before[-1]):
+            out |= {wall_index(scene, c.wall) for c in stage.controls if c.kind == "servo"}
+    return out
+
+
+def stage_tracks(stage):
+    """Does a stage drive a wall by a controller that acts every cycle (the core's
+    walls_controlled: then its wall loop keeps the dashpots' share apart)?"""
+    return any(c.kind in CONTROLLERS for c in stage.controls)
+
+
+def control_lines(scene, g, first_step):
+    """Each carried wall's velocity in stage g (the core's controllers, core/walls.c):
+    servo        v = clip(alpha (sigma_t - S/L) L / (K dt), vcap) towards the discs, S the springs'
+                 normal force sum (c_W<k>s[1]), K their stiffness (c_W<k>s[2]), L the span gap;
+                 vcap when K = 0 (no contact; and at the first step of a run, before any wall
+                 loop); at a stage's first step after a stage with no controller the whole force
+                 (c_W<k>s[3]: the core kept no dashpot share then)
+    strain_rate  v = rate gap(W, TO) along W's normal towards TO: rate (M_TO - P_W).n_W n_W
+    move         (v1, v2) (a carried wall does not turn: plan())
+    none         at rest.
+    first_step: the formula that is 1 at the stage's first step."""
+    out = []
+    carriers = controlled_walls(scene)
+    stage = scene.stages[g]
+    before = [s for s in scene.stages[:g] if s.cycles > 0]
+    r_min = float(np.min(scene.discs["r"]))
+    for k in carriers:
+        w = scene.walls[k]
+        line = next((c for c in stage.controls if c.wall == w.name), None)
+        if line is None:
+            vx = vy = "0.0"
+        elif line.kind == "move":
+            v1, v2, _ = line.numbers(3)
+            vx, vy = fmt(v1), fmt(v2)
+        elif line.kind == "strain_rate":
+            rate = line.numbers(1)[0]
+            target = wall_index(scene, line.words[1])
+            nx, ny = wall_normal(w)
+            d = gap_formula(scene, k, target)
+            vx, vy = f"{fmt(rate)}*{d}*{fmt(nx)}", f"{fmt(rate)}*{d}*{fmt(ny)}"
+        else:
+            sigma, gain, vmax = line.numbers(3)
+            span = f"abs({gap_formula(scene, wall_index(scene, line.words[3]), wall_index(scene, line.words[4]))})"
+            vcap = vmax if vmax > 0 else SERVO_CAP_SHARE * r_min / scene.dt
+            stiff = f"v_W{k}_K"
+            if not before:
+                force = f"c_W{k}s[1]"
+            elif not stage_tracks(before[-1]):
+                whole = len(mats_of(scene)) + 2
+                force = f"({first_step}*c_W{k}s[{whole}]+(1-{first_step})*c_W{k}s[1])"
+            else:
+                force = f"c_W{k}s[1]"
+            # the uncapped speed (the denominator 1 instead of 0 where K = 0, which is then unused)
+            out.append(f'variable        W{k}_raw equal "{fmt(gain)}*({fmt(sigma)}-{force}/{span})*{span}'
+                       f'/(({stiff}+({stiff}<=0))*{fmt(scene.dt)})"')
+            # clipped to [-vcap, vcap] by 0/1 factors (exact: no min/max of two numbers in LAMMPS)
+            raw, cap = f"v_W{k}_raw", fmt(vcap)
+            speed = (f"({stiff}>0)*(({raw}>{cap})*{cap}-({raw}<-{cap})*{cap}+({raw}>=-{cap})*({raw}<={cap})*{raw})"
+                     f"+({stiff}<=0)*{cap}")
+            if not before:
+                speed = f"{first_step}*{fmt(vcap)}+(1-{first_step})*({speed})"
+            tx, ty = toward_discs(scene, w)
+            out.append(f'variable        W{k}_sp equal "{speed}"')
+            # a component along which the wall does not move is 0 (not 0 times the speed: the
+            # same, and LAMMPS evaluates the speed once less)
+            vx, vy = (f"v_W{k}_sp*{fmt(t)}" if t != 0 else "0.0" for t in (tx, ty))
+        out += [f'variable        W{k}_vx equal "{vx}"', f'variable        W{k}_vy equal "{vy}"']
+    return out
+
+
+def mats_of(scene):
+    """The disc materials in the order of the wall fixes (one fix per wall and disc material)."""
+    mats = []
+    for mat in scene.disc_material:
+        if mat not in mats:
+            mats.append(mat)
+    return mats
 
 
 def wall_fixes(scene, opts):
@@ -336,7 +596,8 @@ def start_lines(scene, opts):
 
 
 def _stop_rule(stage):
-    return stage.number("stop_ke") > 0 or stage.number("stop_stress") > 0 or stage.number("stop_unbalanced") > 0
+    return (stage.number("stop_ke") > 0 or stage.number("stop_stress") > 0 or stage.number("stop_unbalanced") > 0
+            or stage.number("stop_servo") > 0)
 
 
 def stage_lines(scene, opts, work):
@@ -369,9 +630,13 @@ def stage_lines(scene, opts, work):
         first[0] = False
         return ["variable        chunkend equal $(step+%d)" % steps, f"run             {steps}{pre}"]
 
+    carried = bool(controlled_walls(scene))
     for g, stage in enumerate(scene.stages):
         out.append(f"# stage {stage.name}: {stage.cycles} cycles")
         out += motion_lines(scene, stage, moves)
+        if carried and stage.cycles > 0:
+            out.append("variable        gstart equal $(step)")
+            out += control_lines(scene, g, "(step==v_gstart+1)")
         if stage.cycles <= 0:
             continue
         if not _stop_rule(stage):

@@ -16,8 +16,8 @@ import numpy as np
 
 from .. import files
 from . import scene as scenes
-from .lammps_input import _stop_rule, pair_law, pivot, wall_fixes
-from .outputs import Bodies, Laws, Measure
+from .lammps_input import _stop_rule, controlled_walls, midpoint, pair_law, pivot, wall_fixes
+from .outputs import Bodies, Laws, Measure, wall_gap
 from .trajectory import Frame, Trajectory, concatenate, contacts_of, empty_contacts
 
 # A contact at the Coulomb (or rolling) cap: |F_s| >= mu |F_n| to this relative round-off.
@@ -167,9 +167,11 @@ class Reader:
 
     def frame(self, atoms, pairs, walls, gfac):
         """A Frame from one atoms frame and one pairs frame (dicts of columns), the walls'
-        segments at that step and the ramp factor."""
+        segments at that step (carried walls: where their carriers are, carriers()) and the
+        ramp factor."""
         order = np.argsort(atoms["id"])
-        A = {k: v[order] for k, v in atoms.items() if k != "_step"}
+        A = {k: v[order][:self.n] for k, v in atoms.items() if k != "_step"}
+        self.carried_v = {k: (vx, vy) for k, (_, _, vx, vy) in carriers(self.scene, atoms).items()}
         if not np.array_equal(A["id"], np.arange(1, self.n + 1)):
             raise RuntimeError("LAMMPS lost or renumbered atoms")
         step = int(atoms["_step"])
@@ -291,7 +293,10 @@ class Reader:
         return rows
 
     def wall_velocity(self, wk, cx, cy, step):
-        """The velocity of wall wk's point (cx, cy) in the stage that holds step: V + omega x (c - P)."""
+        """The velocity of wall wk's point (cx, cy) in the stage that holds step: V + omega x (c - P)
+        (a carried wall: its carrier's velocity, the one it moved with into this step)."""
+        if wk in getattr(self, "carried_v", {}):
+            return self.carried_v[wk]
         name = self.scene.walls[wk].name
         n0 = 0
         for stage in self.stage_cycles:
@@ -315,13 +320,38 @@ class Reader:
         return int(s < -tol or s > length + tol)
 
 
-def walls_at(scene, schedule, step):
+def carriers(scene, atoms):
+    """{wall index: (dx, dy, vx, vy)} of the carried walls (lammps_input.controlled_walls()) in
+    one atoms frame: the carrier's displacement from the wall's midpoint and its velocity."""
+    carried = controlled_walls(scene)
+    if not carried:
+        return {}
+    n = len(scene.discs["x"])
+    ids = atoms["id"].astype(int)
+    out = {}
+    for j, k in enumerate(carried):
+        row = np.flatnonzero(ids == n + j + 1)
+        if not len(row):
+            raise RuntimeError(f"LAMMPS lost the carrier atom of wall {scene.walls[k].name}")
+        r = row[0]
+        mx, my = midpoint(scene.walls[k])
+        out[k] = (atoms["x"][r] - mx, atoms["y"][r] - my, atoms["vx"][r], atoms["vy"][r])
+    return out
+
+
+def walls_at(scene, schedule, step, atoms=None):
     """Every wall's segment (ax, ay, bx, by) after `step` cycles: moved by each stage's velocity
-    for its cycles and turned about its (moving) pivot (ballast's `move`). schedule: (stage,
+    for its cycles and turned about its (moving) pivot (ballast's `move`); a carried wall
+    translated by its carrier's displacement in the atoms frame of that step. schedule: (stage,
     its actual cycles) in order."""
     dt = scene.dt
     out = []
-    for w in scene.walls:
+    carried = carriers(scene, atoms) if atoms is not None else {}
+    for k, w in enumerate(scene.walls):
+        if k in carried:
+            dx, dy = carried[k][:2]
+            out.append((w.ax + dx, w.ay + dy, w.bx + dx, w.by + dy))
+            continue
         px, py = pivot(scene, w)
         dx = dy = th = 0.0
         n0 = 0
@@ -402,7 +432,7 @@ def stop_check(work, stage):
     reader.stage_cycles = schedule
     reader.pivots = [pivot(scene, w) for w in scene.walls]
     step = int(atoms["_step"])
-    frame = reader.frame(atoms, pairs, walls_at(scene, schedule, step), gfac_at(scene, schedule, step))
+    frame = reader.frame(atoms, pairs, walls_at(scene, schedule, step, atoms), gfac_at(scene, schedule, step))
     m = Measure(scene, frame, Laws(scene), Bodies(scene))
     st = scene.stages[stage]
     ee = m.elastic()
@@ -418,12 +448,33 @@ def stop_check(work, stage):
             size = float(np.max(np.abs(mom)))
             change = float(np.max(np.abs(mom - prev))) / size if size > 0 else math.inf
             met = met and change <= st.number("stop_stress")
+    if st.number("stop_servo") > 0:
+        errors = [abs(sigma - target) / target if sigma != 0 else math.inf
+                  for sigma, target in servo_stresses(scene, frame, st)]
+        met = met and max(errors, default=0.0) <= st.number("stop_servo")
     if st.number("stop_unbalanced") > 0:
         met = met and m.unbalanced() <= st.number("stop_unbalanced")
     if met:
         stops[str(stage)] = step
         files.write_text(stops_path(work), json.dumps(stops))
     return 1 if met else 0
+
+
+def servo_stresses(scene, frame, stage):
+    """(sigma, sigma_t) of each servo wall of a stage in a frame, as the core's servo measures it
+    (core/walls.c): the springs' normal forces of the wall's contacts over its span gap(A, B)."""
+    out = []
+    names = {w.name: k for k, w in enumerate(scene.walls)}
+    c = frame.contacts
+    for line in stage.controls:
+        if line.kind != "servo":
+            continue
+        k = names[line.wall]
+        rows = (c["wall"] == 1) & (c["b"] == k)
+        force = float(np.sum(c["fn"][rows]))
+        span = wall_gap(frame.walls[names[line.words[3]]], frame.walls[names[line.words[4]]])
+        out.append((force / span if span > 0 else 0.0, line.numbers(1)[0]))
+    return out
 
 
 def schedule_of(scene, stops):
@@ -457,11 +508,11 @@ def trajectory_of(scene, opts, work, log):
     if missing:
         raise RuntimeError(f"LAMMPS wrote no state at cycle(s) {missing[:5]} of the series rows")
     for step in wanted:
-        f = reader.frame(atoms[step], pairs.get(step, {}), walls_at(scene, schedule, step),
+        f = reader.frame(atoms[step], pairs.get(step, {}), walls_at(scene, schedule, step, atoms[step]),
                          gfac_at(scene, schedule, step))
         frames.append(f)
     final = frames[-1] if frames and frames[-1].step == total else reader.frame(
-        atoms[max(atoms)], pairs.get(max(atoms), {}), walls_at(scene, schedule, max(atoms)), 1.0)
+        atoms[max(atoms)], pairs.get(max(atoms), {}), walls_at(scene, schedule, max(atoms), atoms[max(atoms)]), 1.0)
     beyond = reader.beyond
     stages = [{"name": s.name, "cycles": c, "max_cycles": s.cycles, "stop_rule": _stop_rule(s),
                "stopped": str(g) in stops} for g, (s, c) in enumerate(schedule)]

@@ -33,7 +33,8 @@ LEDGER = ("work_walls", "work_gravity", "dissipated_dashpot", "dissipated_fricti
 LEDGER_WHY = ("the energy ledger (work of walls and gravity, dissipation; core/energy.c) is "
               "ballast's own, accumulated every cycle: the engine reports no such terms")
 THETA_WHY = "the engine keeps no angle for a disc (a sphere's orientation is not integrated)"
-SERVO_WHY = "no wall is under a servo in an engine run (servo walls are not expressible)"
+SERVO_WHY = ("the adapter does not report the stress a servo measured (its wall's force over its span "
+             "is there: wall_f1, wall_f2 and the walls' positions)")
 
 
 def unexpressible_probes(scene):

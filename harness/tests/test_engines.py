@@ -194,6 +194,58 @@ def test_walls_move_from_where_each_stage_found_them(tmp_path):
     assert lammps.walls_at(s, [(s.stages[0], 40), (s.stages[1], 600)], 100)[0][0] == pytest.approx(0.048)
 
 
+SERVO_BOX = ROOT / "harness" / "tests" / "data" / "servo_box.scene"
+BIAXIAL = ROOT / "cases" / "biaxial" / "biaxial.scene"
+
+
+@needs_ballast
+def test_servo_and_strain_rate_walls_ride_carrier_atoms_moved_first_in_each_step(tmp_path):
+    s = resolved(tmp_path, SERVO_BOX, [])
+    plan = lammps.Lammps().plan(s, "run")
+    assert plan.refused() == []
+    status = {f.name: f.status for f in plan.features}
+    assert status["servo-controlled walls (stress target)"] == EXACT
+    assert status["strain-rate walls (logarithmic strain)"] == EXACT
+    assert status["stage consolidate: stop_servo"] == EXACT
+    # top and right are driven; bottom is the strain rate's target and left a span wall, but no
+    # stage moves them: they stay plain static walls
+    assert [s.walls[k].name for k in lammps.controlled_walls(s)] == ["top", "right"]
+    opts = plan.options["lammps"]
+    data = lammps.data_text(s, opts)
+    assert "8 atoms" in data and "2 atom types" in data            # 6 discs and 2 carriers
+    assert "7 2 1.9 1.0 2.0 6.1 0" in data                         # top's carrier at its midpoint
+    text = lammps.translate(s, opts)
+    lines = [l for l in text.splitlines() if l.startswith(("fix ", "variable        W", "region", "neigh"))]
+    order = [l.split()[1] for l in lines if l.startswith("fix ")]
+    assert order.index("carry") < order.index("integrate")           # the carriers move first
+    assert "fix             carry carriers move variable NULL NULL NULL v_carry_vx v_carry_vy NULL" in text
+    assert "exclude group carriers all" in text
+    assert "variable        W1_dy equal y[7]-6.1" in text
+    assert "move v_W1_dx v_W1_dy NULL" in next(l for l in lines if l.startswith("region          W1 "))
+    stage = text[text.index("# stage consolidate"):text.index("# stage shear")]
+    # the core's servo law: gain (sigma - S/L) L / (K dt), capped at vmax (here 1e-3 r_min / dt,
+    # vmax = 0), the cap at the first step of the run (no wall loop has run yet)
+    cap = repr(1e-3 * 0.95 / 0.001)
+    assert 'variable        W1_raw equal "0.5*(4000.0-c_W1s[1]/abs(' in stage
+    assert f'variable        W1_sp equal "(step==v_gstart+1)*{cap}+(1-(step==v_gstart+1))*(' in stage
+    assert 'variable        W1_vx equal "0.0"' in stage and 'W1_vy equal "v_W1_sp*-1.0"' in stage
+    shear = text[text.index("# stage shear"):]
+    # the strain rate: rate (M_bottom - P_top).n n, n = (-0, 1): towards the bottom wall
+    assert 'variable        W1_vy equal "0.5*(-6.1+(0.0-v_W1_dx)*-0.0+(0.0-v_W1_dy)*1.0)*1.0"' in shear
+    # right's servo goes on from the consolidation's wall loop: no first-step case
+    assert "W1_sp" not in shear and "W3_sp" in shear and "(step==v_gstart+1)" not in shear
+
+
+@needs_ballast
+def test_the_biaxial_tests_are_expressible_but_model_2(tmp_path):
+    sets = ["stage.consolidate.cycles=1", "stage.shear.cycles=0"]
+    refused = lambda extra: [f.name for f in lammps.Lammps().plan(resolved(tmp_path, BIAXIAL, sets + extra),
+                                                                    "run").refused()]
+    assert refused(["material.grain.rolling=0.4"]) == []
+    assert refused(["material.grain.rolling=0.4", "settings.rolling_model=model2"]) == [
+        "rolling resistance: JYH Model 2 (elasto-brittle)"]
+
+
 def test_the_gravity_ramp_is_the_cores_c_plus_one_over_c():
     class S:
         def __init__(self, cycles, ramp):

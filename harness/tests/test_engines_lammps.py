@@ -91,3 +91,57 @@ def test_the_matrix_sets_both_engines_side_by_side_with_their_costs(runs, tmp_pa
     text = (tmp_path / "peers" / "index.md").read_text()
     assert "| [collisions](#collisions) |" in text and "NOT EXPRESSIBLE" in text
     assert json.loads((tmp_path / "peers" / "matrix.json").read_text())["totals"] == totals
+
+
+# ---- servo and strain-rate walls (harness/tests/data/servo_box.scene) -----------------------
+
+SERVO_BOX = ROOT / "harness" / "tests" / "data" / "servo_box.scene"
+# Measured: the walls' positions agree to 2e-15 of their largest value, their forces (sums of
+# contact springs k_n delta, k_n = 1e5) to 3e-13, over 500 cycles.
+SERVO_ROUNDOFF = 1e-11
+
+
+def test_servo_and_strain_rate_walls_move_in_lammps_as_in_ballast_to_round_off(tmp_path):
+    import subprocess
+    out = tmp_path / "lammps"
+    assert make_run(Lammps(), SERVO_BOX, [], "run", out, BALLAST) == 0
+    subprocess.run([str(BALLAST), "run", str(SERVO_BOX), "--out", str(tmp_path / "ballast")],
+                   check=True, capture_output=True)
+    info = json.loads((out / "run.json").read_text())
+    assert info["status"] == "ok", info.get("message")
+    core = json.loads((tmp_path / "ballast" / "run.json").read_text())
+    # the consolidation's stop_servo is met at the same check in both (cycle 200 of 400)
+    assert [(g["cycles"], g["stopped"]) for g in info["stages"]] == \
+           [(g["cycles"], g["stopped"]) for g in core["stages"]] == [(200, True), (300, False)]
+    a, b = read_series(out / "series.tsv"), read_series(tmp_path / "ballast" / "series.tsv")
+    assert a["cycle"].tolist() == b["cycle"].tolist() and len(b["cycle"]) == 500
+    for column in ("y_top", "x_right", "fy_top", "fx_right", "fy_bottom", "ek"):
+        scale = float(np.max(np.abs(b[column])))
+        assert np.max(np.abs(a[column] - b[column])) <= SERVO_ROUNDOFF * scale, column
+    # the servo moved the top wall down and the strain rate moved it on: not a wall at rest
+    assert b["y_top"][-1] < b["y_top"][199] < 6.1 - 0.05
+    assert "stress_top" in info["unexpressible"]
+
+
+def test_exported_lammps_jobs_run_where_they_are_sent_and_gather_into_the_peers_runs(tmp_path, monkeypatch,
+                                                                                     capsys):
+    """`export collisions --engine lammps`, one job run as GNU parallel or Slurm would run it,
+    then `gather`: the run lands in reports/peers/runs/lammps/collisions/<variant> (where `make
+    validate-peers --resume` keeps it) with the job's bytes, the jobs not run are listed."""
+    from harness.__main__ import main
+    reports = tmp_path / "reports"
+    monkeypatch.setenv("BALLAST_REPORTS", str(reports))
+    folder = tmp_path / "shared"
+    assert main(["export", "collisions", "--to", str(folder), "--engine", "lammps"]) == 0
+    manifest = json.loads((folder / "manifest.json").read_text())
+    index = [j["variant"] for j in manifest["jobs"]].index("linear_10")
+    assert main(["job", str(folder), str(index)]) == 0
+    job = folder / "runs" / "collisions" / "linear_10"
+    assert json.loads((job / "run.json").read_text())["engine"] == "lammps"
+    assert main(["gather", str(folder)]) == 1                      # the other 11 were not run
+    out = capsys.readouterr().out
+    assert f"1 run(s) gathered, 0 already here, {len(manifest['jobs']) - 1} not gathered" in out
+    home = reports / "peers" / "runs" / "lammps" / "collisions" / "linear_10"
+    assert (home / "series.tsv").read_bytes() == (job / "series.tsv").read_bytes()
+    assert json.loads((home / "harness.json").read_text())["gathered_from"] == str(job)
+    assert not (reports / "runs" / "collisions").exists()         # not taken for ballast's run

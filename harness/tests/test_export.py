@@ -195,6 +195,43 @@ def test_bad_export_folders_and_indices_are_refused(springs, tmp_path, capsys):
     assert main(["export", "nosuchcase", "--to", str(folder)]) == 2
 
 
+def test_an_engines_runs_export_with_its_identity_and_run_only_on_that_engine(springs, tmp_path, capsys):
+    """`export --engine lammps`: the jobs of command lammps:run, the manifest holding LAMMPS's
+    identity (its executable, the adapter's files: what the runner records); a job whose engine
+    changed since is refused before anything is written, and so is an unknown engine."""
+    from harness.runner import engine_identity
+    folder = tmp_path / "shared"
+    assert main(["export", "spring", "--to", str(folder), "--engine", "lammps"]) == 0
+    assert f"exported 7 LAMMPS run(s) of spring to {folder}" in capsys.readouterr().out
+    manifest = json.loads((folder / "manifest.json").read_text())
+    assert manifest["format"] == "ballast-export 2"
+    assert {j["command"] for j in manifest["jobs"]} == {"lammps:run"}
+    assert manifest["engines"] == {"lammps": json.loads(json.dumps(engine_identity("lammps")))}
+    assert any(k.endswith("harness/engines/lammps_input.py") for k in manifest["engines"]["lammps"])
+    # the scene's files are the job's inputs, as for the core's runs
+    assert all(j["scene"] in j["inputs"] for j in manifest["jobs"])
+    # LAMMPS (or an adapter file) changed since the export: refused, nothing written
+    recorded = manifest["engines"]["lammps"]
+    recorded["lmp_sha256"] = "0" * 64
+    (folder / "manifest.json").write_text(json.dumps(manifest))
+    assert main(["job", str(folder), "0"]) == 2
+    assert "the engine's executable changed since the export (export again)" in capsys.readouterr().err
+    assert not (folder / "runs" / "spring" / "soft").exists()
+    # a job naming an engine the manifest has no identity for, or no engine at all
+    for command, why in (("other:run", "none of run, exact"), ("lammps:tea", "none of run, exact")):
+        manifest["jobs"][0]["command"] = command
+        (folder / "manifest.json").write_text(json.dumps(manifest))
+        assert main(["job", str(folder), "1"]) == 2
+        assert why in capsys.readouterr().err
+    manifest["jobs"][0]["command"] = "lammps:run"
+    manifest["engines"] = {}
+    (folder / "manifest.json").write_text(json.dumps(manifest))
+    assert main(["job", str(folder), "1"]) == 2
+    assert "its engine 'lammps' has no identity in the manifest's engines" in capsys.readouterr().err
+    assert main(["export", "spring", "--to", str(folder), "--engine", "nosuch"]) == 2
+    assert "no engine 'nosuch'" in capsys.readouterr().err
+
+
 # ---------------------------------------------------------------- GNU parallel, for real
 
 @needs_ballast

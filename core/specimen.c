@@ -1,5 +1,6 @@
 /*
- * specimen.c — the discs a scene generates, in scene order.
+ * specimen.c — the discs a scene generates, in scene order.  Kept whole
+ * (about 800 lines): see "Kept whole" below.
  *
  * A scene places discs one by one ([disc] sections) or by generators, laid
  * out here before the builder (build.c) sorts them into cell order:

@@ -1,6 +1,10 @@
 """Pictures and movies of any run: `harness plot RUN` and `harness movie RUN`, and the report's
 figures of kinds `snapshots` and `movie` (case.txt; drawn through report/plots.py).
 
+Kept whole (about 800 lines): reading a run's frames, laying out panels, scaling the chains and
+colours over every panel drawn together, and writing one gnuplot script are one pipeline that
+shares its scales and refusals; plot, movie and the report's two figure kinds all go through it.
+
 A run folder (what `bin/ballast run SCENE --out DIR` writes) holds its final state --
 discs.tsv, contacts.tsv, walls.tsv, run.json -- and, when the scene asks for them
 (settings.snapshot_every = N cycles or snapshot_dt = T), snapshots/: index.tsv (frame, cycle,

@@ -20,6 +20,7 @@ import functools
 import os
 import shutil
 import sys
+import time
 from contextlib import nullcontext
 from pathlib import Path
 
@@ -35,7 +36,7 @@ from .errors import Busy, CatalogueError, IniError, PictureError
 from .gate import counts_text, gate
 from .lock import reports_lock
 from .rebaseline import rebaseline
-from .report import write_report
+from .report import budget, write_report
 from .runner import STOPPED, jobs_for, run_all, sigterm_as_interrupt, unrecorded
 
 USAGE_ERROR = 2
@@ -131,9 +132,10 @@ def refresh_known(checks, tiers, verdicts):
         print(f"{path}: refreshed {len(done)} KNOWN row(s) ({', '.join(c for _, c in done)}); commit it")
 
 
-def cmd_report(args):
+def cmd_report(args, validate=None, stability_tally=None):
     """The report of the tier; given case names, their figures are drawn anew and the other cases
-    that have runs keep what an earlier report drew, so the report stays whole."""
+    that have runs keep what an earlier report drew, so the report stays whole.  validate,
+    stability_tally: the budget's account of the validate calling (report/budget.py)."""
     all_cases = load_cases()
     checks = load_checks(all_cases)
     cases, render = selected(args, all_cases), None
@@ -144,7 +146,7 @@ def cmd_report(args):
         cases = [c for c in all_cases
                  if c.name in render or (c.name in tier_names and (runs_root() / c.name).is_dir())]
     write_report(cases, references.for_cases(checks, cases), default_store(all_cases), runs_root(), reports_root(),
-                 sys.stdout, render)
+                 sys.stdout, render, validate, stability_tally)
     return 0
 
 
@@ -154,6 +156,9 @@ def cmd_validate(args):
     and every failure, KNOWN row and finding; the detail of the sweeps, the bisections and the
     probes goes to a Transient status line (console.py) and is in the report (issue 32, item 4)."""
     load_checks(load_cases())          # a broken reference file stops us before any run
+    # the budget (report/budget.py): the validate's start, -j and tier; the stability runs' tally
+    validate = {"started": round(time.time(), 3), "jobs": args.jobs, "tier": args.tier}
+    stability_tally = None
     run_status = cmd_run(args)
     verdicts = []
     check_status = cmd_check(args, verdicts)
@@ -168,12 +173,13 @@ def cmd_validate(args):
         stab.no_extremes = subset(args) and not args.extremes
         stab.cap, stab.tolerance = 20000, 0.01
         stab.quiet = not args.verbose
+        stab.budget = stability_tally = {}
         try:
             cmd_stability(stab)
         except (RuntimeError, OSError, ValueError, CatalogueError) as exc:
             # a measurement for the report: its failure is said, not fatal to the gate
             print(f"stability: not measured: {exc}")
-    cmd_report(args)
+    cmd_report(args, validate, stability_tally)
     if not args.keep_outputs:
         # the report is written: what no check, figure, report or resume reads again goes (compact.py)
         tally = compact.compact(selected(args, load_cases()), runs_root(),
@@ -335,6 +341,8 @@ def cmd_stability(args):
         raise
     finally:
         if not interrupted:
+            if getattr(args, "budget", None) is not None:    # validate's budget: the runs about to go
+                args.budget.update(budget.stability_costs(work))
             shutil.rmtree(work, ignore_errors=True)
 
 

@@ -132,10 +132,11 @@ def refresh_known(checks, tiers, verdicts):
         print(f"{path}: refreshed {len(done)} KNOWN row(s) ({', '.join(c for _, c in done)}); commit it")
 
 
-def cmd_report(args, validate=None, stability_tally=None):
+def cmd_report(args):
     """The report of the tier; given case names, their figures are drawn anew and the other cases
-    that have runs keep what an earlier report drew, so the report stays whole.  validate,
-    stability_tally: the budget's account of the validate calling (report/budget.py)."""
+    that have runs keep what an earlier report drew, so the report stays whole.  A validate
+    calling sets args.budget_validate and args.budget_stability: its account for the budget
+    (report/budget.py)."""
     all_cases = load_cases()
     checks = load_checks(all_cases)
     cases, render = selected(args, all_cases), None
@@ -146,7 +147,8 @@ def cmd_report(args, validate=None, stability_tally=None):
         cases = [c for c in all_cases
                  if c.name in render or (c.name in tier_names and (runs_root() / c.name).is_dir())]
     write_report(cases, references.for_cases(checks, cases), default_store(all_cases), runs_root(), reports_root(),
-                 sys.stdout, render, validate, stability_tally)
+                 sys.stdout, render, getattr(args, "budget_validate", None),
+                 getattr(args, "budget_stability", None))
     return 0
 
 
@@ -157,8 +159,8 @@ def cmd_validate(args):
     probes goes to a Transient status line (console.py) and is in the report (issue 32, item 4)."""
     load_checks(load_cases())          # a broken reference file stops us before any run
     # the budget (report/budget.py): the validate's start, -j and tier; the stability runs' tally
-    validate = {"started": round(time.time(), 3), "jobs": args.jobs, "tier": args.tier}
-    stability_tally = None
+    args.budget_validate = {"started": round(time.time(), 3), "jobs": args.jobs, "tier": args.tier}
+    args.budget_stability = None
     run_status = cmd_run(args)
     verdicts = []
     check_status = cmd_check(args, verdicts)
@@ -173,13 +175,13 @@ def cmd_validate(args):
         stab.no_extremes = subset(args) and not args.extremes
         stab.cap, stab.tolerance = 20000, 0.01
         stab.quiet = not args.verbose
-        stab.budget = stability_tally = {}
+        stab.budget = args.budget_stability = {}
         try:
             cmd_stability(stab)
         except (RuntimeError, OSError, ValueError, CatalogueError) as exc:
             # a measurement for the report: its failure is said, not fatal to the gate
             print(f"stability: not measured: {exc}")
-    cmd_report(args, validate, stability_tally)
+    cmd_report(args)
     if not args.keep_outputs:
         # the report is written: what no check, figure, report or resume reads again goes (compact.py)
         tally = compact.compact(selected(args, load_cases()), runs_root(),

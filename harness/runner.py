@@ -477,10 +477,8 @@ def _record(outcome, cmd, ident):
     """harness.json, written last and whole (tmp file + rename): the runner's own account of
     the run, its identity and the digests of its files (what resume compares)."""
     folder = outcome.job.out
-    ended = time.time()     # epoch seconds: the report's budget spans a case's runs with them
     record = {"case": outcome.job.case, "variant": outcome.job.variant, "command": cmd,
               "returncode": outcome.returncode, "wall_seconds": round(outcome.wall, 6),
-              "started": round(ended - outcome.wall, 3), "ended": round(ended, 3),
               "ok": outcome.ok, "cause": outcome.cause, "kind": outcome.job.command,
               "identity": ident, "outputs": output_digests(folder)}
     if outcome.job.ensemble:

@@ -4,14 +4,15 @@ One row per case: how many runs it has, counted by kind -- its own [variant]s, t
 of its [ensemble]s, the points of its declared [sweep]s, and the trial runs of its stability
 bisection (validate bisects the first DEM variant of each case) -- and, summed over them, the
 particle-steps (steps x n_discs of each run.json) and the run seconds (each run.json's
-wall_seconds: seconds of the stepping processes, which overlap at -j N, so their sum is CPU time,
+wall_seconds: the core's time stepping; the runs overlap at -j N, so their sum is CPU time,
 not the time waited).  The extreme probes belong to no case: a row of their own.  A run without
 run.json (it failed before writing one, was never run, or was stopped) is counted in "no
 run.json" and adds nothing: the sums are then lower bounds.  When the validate is known (its
 start, -j, tier: `validate` passes them; `report` alone reuses those of the last validate's
 budget.json), each case's span is the wall-clock time from the start of its first run to the
-end of its last, over the runs this validate made (runner.py records "started" and "ended" in
-harness.json), and the total row has the validate's wall time to the writing of its report.
+end of its last, over the runs this validate made -- a run ended when the runner wrote its
+harness.json (its last write; compact.py keeps its time) and started the runner's wall_seconds
+before -- and the total row has the validate's wall time to the writing of its report.
 
 A run kept by --resume is counted with the seconds it took when it was made, not in the span.
 The stability trials are deleted once measured (__main__.cmd_stability): validate tallies them
@@ -49,8 +50,8 @@ def empty():
 
 def run_cost(folder):
     """(particle-steps, seconds, started, ended) of a run folder; particle-steps and seconds None
-    when it has no readable run.json (or it lacks them), started/ended None when harness.json
-    does not record them."""
+    when it has no readable run.json (or it lacks them), started/ended (epoch seconds) None when
+    it has no harness.json with a wall_seconds."""
     folder = Path(folder)
     try:
         info = read_run_json(folder) if folder.is_dir() else None
@@ -62,9 +63,16 @@ def run_cost(folder):
     steps, n, seconds = ((info or {}).get(k) for k in ("steps", "n_discs", "wall_seconds"))
     ps = steps * n if isinstance(steps, int) and isinstance(n, int) else None
     seconds = float(seconds) if isinstance(seconds, (int, float)) and not isinstance(seconds, bool) else None
-    started, ended = record.get("started"), record.get("ended")
-    ok = all(isinstance(t, (int, float)) for t in (started, ended))
-    return ps, seconds, (started if ok else None), (ended if ok else None)
+    # harness.json is the runner's last write (runner._record; compact.py keeps its time): its
+    # modification time is when the run ended, less the runner's wall_seconds when it started
+    wall = record.get("wall_seconds")
+    if not isinstance(wall, (int, float)) or isinstance(wall, bool):
+        return ps, seconds, None, None
+    try:
+        ended = (folder / "harness.json").stat().st_mtime
+    except OSError:
+        return ps, seconds, None, None
+    return ps, seconds, ended - wall, ended
 
 
 def add(row, kind, cost, since=None):

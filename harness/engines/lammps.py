@@ -31,6 +31,9 @@ in short (plan() says per scene which apply, and refuses the rest):
                strain-rate wall (and a moving wall such a controller measures) follows a
                carrier atom that fix move variable moves by x += dt v, v the core's controller
                law evaluated first in each step from the state of the step before
+  turning wall with rolling: the run is made in the wall's frame (the one wall, every disc held):
+               the wall a static plane, the held discs moved rigidly by fix move variable with
+               spin -omega_wall, the state rotated back into the lab by the reader
   stop rules   checked every check_every steps by the same Python that writes the outputs,
                inside LAMMPS (its PYTHON package), on LAMMPS's state
 

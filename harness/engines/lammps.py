@@ -31,6 +31,9 @@ in short (plan() says per scene which apply, and refuses the rest):
                strain-rate wall (and a moving wall such a controller measures) follows a
                carrier atom that fix move variable moves by x += dt v, v the core's controller
                law evaluated first in each step from the state of the step before
+  turning wall with rolling: the run is made in the wall's frame (the one wall, every disc held):
+               the wall a static plane, the held discs moved rigidly by fix move variable with
+               spin -omega_wall, the state rotated back into the lab by the reader
   stop rules   checked every check_every steps by the same Python that writes the outputs,
                inside LAMMPS (its PYTHON package), on LAMMPS's state
 
@@ -57,8 +60,8 @@ from pathlib import Path
 from .. import files
 from . import scene as scenes
 from .interface import APPROXIMATE, EXACT, REFUSED, Engine, Plan
-from .lammps_input import (_stop_rule, controlled_walls, data_text, fmt, gfac_expr,  # noqa: F401
-                           pair_law, rolling_sds, translate, wall_side)
+from .lammps_input import (_stop_rule, controlled_walls, data_text, fmt, frame_wall,  # noqa: F401
+                           gfac_expr, pair_law, rolling_sds, translate, wall_side)
 from .lammps_output import (last_frame, parse_dump, parse_frames, parse_log, run_lmp,  # noqa: F401
                             trajectory_of, walls_at)
 
@@ -131,6 +134,7 @@ class Options:
         self.skin = 0.2 * float(r.max()) if skin is None else skin     # ballast's default skin
         self.binsize, self.nsq, self.dumps = binsize, nsq, dumps
         self.sort_every, self.sort_binsize = sort_every, sort_binsize
+        self.frame = None          # the wall whose frame the run is made in (lammps_input.frame_wall)
         self.alpha = scene.number("alpha")
         self.every = int(float(scene.setting("output_every")))     # the dumps' row spacing (plan())
         self.scale = 1 + self.alpha * scene.dt / 2                       # s = 1 + alpha dt/2
@@ -287,6 +291,7 @@ class Lammps(Engine):
                      "fix wall/gran takes one coefficient set per fix, k_L depends on each radius")
         granular = damped or rolling or hertz
         opts = Options(scene, granular, hertz, nsq=rolling, **options)
+        opts.frame = plan.options.pop("frame", None)              # _rolling_turning()
         if len(opts.types) > MAX_TYPES:
             plan.add(f"{len(opts.types)} atom types", REFUSED,
                      f"more than {MAX_TYPES} (material, radius) classes for per-pair Hertz coefficients")
@@ -325,9 +330,7 @@ class Lammps(Engine):
                 plan.add(f"turning wall {name} (generated)", REFUSED,
                          "its pivot P is the generator's; only [wall] sections give it")
             if rolling:
-                plan.add(f"rolling against turning wall {name}", REFUSED,
-                         "fix wall/gran's rolling displacement takes the particle's spin only, not the "
-                         "wall's: ballast's theta_r = int (omega - omega_wall) dt has no counterpart")
+                self._rolling_turning(scene, plan, name)
         controls = {c.kind for s in scene.stages for c in s.controls}
         carried = {scene.walls[k].name for k in controlled_walls(scene)}
         for name in sorted(carried & turning):
@@ -351,6 +354,36 @@ class Lammps(Engine):
                      "pair law 2 k_a k_b/(k_a + k_b)); move: displacement and angle as equal-style "
                      "variables of the step; the plane is infinite, ballast's wall a segment: each "
                      "contact is checked to lie within the wall's ends")
+
+    def _rolling_turning(self, scene, plan, name):
+        """Rolling against turning wall `name`: in the wall's own frame where that is exact
+        (lammps_input.frame_wall(): the one wall, every disc held; and no friction or dashpots,
+        the only forces the frame change was measured with), else refused."""
+        refused = ("fix wall/gran's rolling displacement takes the particle's spin only, not the "
+                   "wall's: ballast's theta_r = int (omega - omega_wall) dt has no counterpart")
+        k = frame_wall(scene)
+        if k is None:
+            plan.add(f"rolling against turning wall {name}", REFUSED,
+                     refused + "; the run is made in the wall's frame only where that wall is the "
+                     "scene's one wall, moved by `move` alone, every disc is held (fixed = 1) and no "
+                     "stage has a stop rule")
+            return
+        others = [what for what, on in (
+            ("friction", any(m.friction > 0 for m in scene.materials.values())),
+            ("contact dashpots", scene.number("gamma_n") > 0 or scene.number("beta") > 0)) if on]
+        if others:
+            plan.add(f"rolling against turning wall {name}", REFUSED,
+                     refused + "; the run in the wall's frame is taken without " + " and ".join(others)
+                     + " only (the only contact forces it was measured with)")
+            return
+        plan.add(f"rolling against turning wall {name}: run in the wall's frame", EXACT,
+                 "the wall stands still as a plane through P0 and every held disc moves rigidly, "
+                 "X' = P0 + R(-theta)(X - P0 - d), d and theta the wall's displacement and angle as "
+                 "step formulas (fix move variable), spin -omega_wall (set per stage): the contact's "
+                 "overlap, normal, moment and theta_r = int (omega - omega_wall) dt are ballast's to "
+                 "round-off (the turned rather than the lab overlap: 1 ulp of the disc's place); "
+                 "positions, points and forces are rotated back into the lab")
+        plan.options["frame"] = k
 
     def _stages(self, scene, plan):
         for s in scene.stages:

@@ -162,6 +162,7 @@ def translate(scene, opts, work=None, extra=()):
               "fix             trim free addforce v_trimx v_trimy 0.0"]
     L += wall_lines(scene, opts)
     L += carrier_lines(scene, opts)
+    L += frame_lines(scene, opts)
     for axis in ("x", "y"):
         part = [k for k in range(n) if axis in held[k] and held[k] != {"x", "y", "rotation"}]
         if part:
@@ -249,7 +250,7 @@ def wall_lines(scene, opts):
     for mat, _ in opts.types:
         if mat not in mats:
             mats.append(mat)
-    moves = moving_walls(scene)
+    moves = moving_walls(scene, opts)
     carriers = controlled_walls(scene)
     for k, w in enumerate(scene.walls):
         side = wall_side(scene, w)
@@ -314,11 +315,112 @@ def turning_walls(scene):
     return {c.wall for s in scene.stages for c in s.controls if c.kind == "move" and c.numbers(3)[2] != 0}
 
 
-def moving_walls(scene):
-    """The walls a `move` moves (and no carrier carries: controlled_walls())."""
+def moving_walls(scene, opts=None):
+    """The walls a `move` moves (and no carrier carries: controlled_walls(); nor the wall whose
+    frame the run is made in, opts.frame: that one stands still, frame_lines())."""
     carried = {scene.walls[k].name for k in controlled_walls(scene)}
+    frame = getattr(opts, "frame", None)
+    if frame is not None:
+        carried.add(scene.walls[frame].name)
     return {c.wall for s in scene.stages for c in s.controls if c.kind == "move"
             and any(v != 0 for v in c.numbers(3)) and c.wall not in carried}
+
+
+# ---------------------------------------------------------------------------------- the wall's frame
+#
+# Rolling against a turning wall (docs/engines.md, "Rolling against a turning wall"): fix
+# wall/gran's rolling displacement takes the particle's spin only, not the wall's.  Where one
+# wall moves and every disc is held, the run is made in that wall's own frame (moving and turning
+# with it): there the wall stands still and each held disc moves rigidly,
+#     X'(t) = P0 + R(-theta(t)) (X - P0 - d(t)),   spin omega' = omega - omega_wall = -omega_wall,
+# X the disc's (fixed) place in the lab, P0 the wall's pivot at the start, d(t) and theta(t) the
+# wall's displacement and angle (the same step formulas as a moving region's).  The contact's
+# relative kinematics are those of the lab (a rotation of them), so its forces, its moment and
+# theta_r = int (omega - omega_wall) dt are ballast's; lammps_output.Reader takes the state back.
+
+
+def frame_wall(scene):
+    """The index of the wall the run can be made in the frame of, or None: rolling resistance,
+    exactly one wall, a [wall] section (its pivot P), turned by some stage and driven by `move`
+    only, every disc held (fixed = 1), no stop rule.  lammps.plan() decides whether it is taken."""
+    if len(scene.walls) != 1 or not any(m.rolling > 0 for m in scene.materials.values()):
+        return None
+    w = scene.walls[0]
+    if w.name not in turning_walls(scene) or "p" not in scene.wall_sections.get(w.name, {}):
+        return None
+    if controlled_walls(scene) or any(c.kind != "move" for s in scene.stages for c in s.controls):
+        return None
+    if not all(h == {"x", "y", "rotation"} for h in scenes.held(scene)):
+        return None
+    if any(_stop_rule(s) for s in scene.stages):
+        return None            # frame_stage_lines() takes each stage's start from the schedule
+    return 0
+
+
+def frame_lines(scene, opts):
+    """The held discs' rigid motion in the frame of wall opts.frame (frame_wall()): their lab
+    places X stored at the start (fix store/state; the frame is the lab's at t = 0) and fix move
+    variable, whose atom-style formulas frame_stage_lines() writes per stage (here: at rest)."""
+    if getattr(opts, "frame", None) is None:
+        return []
+    return ["fix             lab held store/state 0 x y",
+            "variable        F_x atom 0.0", "variable        F_y atom 0.0",
+            "variable        F_vx atom 0.0", "variable        F_vy atom 0.0",
+            "fix             frame held move variable v_F_x v_F_y NULL v_F_vx v_F_vy NULL"]
+
+
+def frame_stage_lines(scene, opts, g):
+    """Stage g's motion of the held discs in the wall's frame: x = X'(t) and v = dX'/dt =
+    -omega_w J (X' - P0) - R(-theta) V, with X' - P0 = R(-theta)(X - P0 - d), d and theta the
+    wall's displacement and angle at the step, d0 + V dt (step - N0) and theta0 + omega_w dt
+    (step - N0) from where the stage starts (wall_motion(): the stages run their whole cycles,
+    frame_wall() has no stop rules); and the discs' spin -omega_w.  Every number is a literal of
+    the formula: LAMMPS hands an equal-style variable to another formula as a 15-digit string
+    (Variable::retrieve), which would round the angle's cosine by up to 5e-16."""
+    if getattr(opts, "frame", None) is None:
+        return []
+    w = scene.walls[opts.frame]
+    stage = scene.stages[g]
+    v1 = v2 = om = 0.0
+    for c in stage.controls:
+        if c.kind == "move" and c.wall == w.name:
+            v1, v2, om = c.numbers(3)
+    n0 = stage_starts(scene)[g]
+    schedule = [(s, s.cycles) for s in scene.stages]
+    dx0, dy0, th0 = wall_motion(scene, schedule, n0, w)
+    dt = scene.dt
+    px, py = pivot(scene, w)
+    since = f"(step-{n0})"
+    th = f"({fmt(th0)}+({fmt(om * dt)})*{since})"
+    dx = f"({fmt(dx0)}+({fmt(v1 * dt)})*{since})"
+    dy = f"({fmt(dy0)}+({fmt(v2 * dt)})*{since})"
+    c, s = f"cos({th})", f"sin({th})"
+    ox, oy = f"(f_lab[1]-({fmt(px)})-{dx})", f"(f_lab[2]-({fmt(py)})-{dy})"      # X - P0 - d
+    rx, ry = f"({c}*{ox}+{s}*{oy})", f"(-{s}*{ox}+{c}*{oy})"                  # X' - P0
+    return [f"variable        F_x atom \"{fmt(px)}+{rx}-f_lab[1]\"",              # X' - X (fix move adds X)
+            f"variable        F_y atom \"{fmt(py)}+{ry}-f_lab[2]\"",
+            f"variable        F_vx atom \"({fmt(om)})*{ry}-({c}*({fmt(v1)})+{s}*({fmt(v2)}))\"",
+            f"variable        F_vy atom \"-({fmt(om)})*{rx}-(-{s}*({fmt(v1)})+{c}*({fmt(v2)}))\"",
+            f"set             group held omega 0.0 0.0 {fmt(-om)}"]
+
+
+def wall_motion(scene, schedule, step, w):
+    """(dx, dy, theta): wall w's displacement and angle after `step` cycles, each stage's velocity
+    and spin times its cycles (ballast's `move`; dyadic sums in the catalogue, so exact).
+    schedule: (stage, its actual cycles) in order."""
+    dt = scene.dt
+    dx = dy = th = 0.0
+    n0 = 0
+    for stage, cycles in schedule:
+        steps = max(0, min(step - n0, cycles))
+        for c in stage.controls:
+            if c.kind == "move" and c.wall == w.name:
+                v1, v2, om = c.numbers(3)
+                dx += v1 * dt * steps
+                dy += v2 * dt * steps
+                th += om * dt * steps
+        n0 += cycles
+    return dx, dy, th
 
 
 # ---------------------------------------------------------------------------------- controlled walls
@@ -622,7 +724,7 @@ def stage_lines(scene, opts, work):
                 f"python          stoprule input 1 v_stage return v_met format ii here \"\"\"\n"
                 f"def stoprule(stage):\n    {code}\n\"\"\"",
                 "variable        met python stoprule"]
-    moves = moving_walls(scene)
+    moves = moving_walls(scene, opts)
     first = [True]
 
     def run(steps):
@@ -634,6 +736,7 @@ def stage_lines(scene, opts, work):
     for g, stage in enumerate(scene.stages):
         out.append(f"# stage {stage.name}: {stage.cycles} cycles")
         out += motion_lines(scene, stage, moves)
+        out += frame_stage_lines(scene, opts, g)
         if carried and stage.cycles > 0:
             out.append("variable        gstart equal $(step)")
             out += control_lines(scene, g, "(step==v_gstart+1)")

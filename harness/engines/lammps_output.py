@@ -16,7 +16,8 @@ import numpy as np
 
 from .. import files
 from . import scene as scenes
-from .lammps_input import _stop_rule, controlled_walls, midpoint, pair_law, pivot, wall_fixes
+from .lammps_input import (_stop_rule, controlled_walls, midpoint, pair_law, pivot, wall_fixes,
+                           wall_motion)
 from .outputs import Bodies, Laws, Measure, wall_gap
 from .trajectory import Frame, Trajectory, concatenate, contacts_of, empty_contacts
 
@@ -171,6 +172,7 @@ class Reader:
         ramp factor."""
         order = np.argsort(atoms["id"])
         A = {k: v[order][:self.n] for k, v in atoms.items() if k != "_step"}
+        self.walls_now = walls
         self.carried_v = {k: (vx, vy) for k, (_, _, vx, vy) in carriers(self.scene, atoms).items()}
         if not np.array_equal(A["id"], np.arange(1, self.n + 1)):
             raise RuntimeError("LAMMPS lost or renumbered atoms")
@@ -182,6 +184,20 @@ class Reader:
         hx = np.where(self.fixed, 0.0, vx - 0.5 * self.dt * fx / mass)
         hy = np.where(self.fixed, 0.0, vy - 0.5 * self.dt * fy / mass)
         hw = np.where(self.fixed, 0.0, w - 0.5 * self.dt * tq / inertia)
+        frame = getattr(self.opts, "frame", None)
+        if frame is not None:
+            # in the wall's frame (lammps_input.frame_wall(): every disc held): the wall-frame
+            # contacts, then positions, points and forces rotated back into the lab; theta_r
+            # sums the discs' spin in that frame, omega - omega_wall, which fix move held
+            # constant through the step (no integration acts on them)
+            to_lab = WallFrame(self.scene, self.stage_cycles, step, frame)
+            rows = self.frame_contacts(A, x, y, tq, to_lab)
+            x, y = to_lab.point(x, y)
+            zero = np.zeros(self.n)
+            contacts = contacts_of(rows)
+            if self.theta is not None:
+                self.accumulate_theta(contacts, w, step)
+            return Frame(step, step * self.dt, x, y, zero, zero, zero.copy(), contacts, walls, gfac)
         for k, h in enumerate(self.held):
             if "x" in h:
                 hx[k] = 0.0
@@ -292,6 +308,39 @@ class Reader:
                 self.beyond += self.beyond_end(walls[wk], cx, cy)
         return rows
 
+    def frame_contacts(self, A, x, y, tq, to_lab):
+        """The wall contacts of a run in the wall's frame (frictionless and undamped: plan()),
+        rows in the lab.  Each held disc touches that wall only (held pairs are excluded), so its
+        torque less the couple of the contact's force about its centre is the rolling couple
+        (LAMMPS's rolling resistance adds a torque, no force): the disc gets -M, M = mr.  At the
+        cap |M| = mu_roll R |F_n| (LAMMPS's Frcrit times R_eff = R against a plane)."""
+        rows = []
+        for wk, fid in self.fixes:
+            flag = A[f"f_{fid}[1]"]
+            for i in np.flatnonzero(flag > 0):
+                cx, cy = A[f"f_{fid}[5]"][i], A[f"f_{fid}[6]"][i]
+                fx, fy = A[f"f_{fid}[2]"][i], A[f"f_{fid}[3]"][i]      # the force on the disc
+                dx, dy = cx - x[i], cy - y[i]
+                dist = math.hypot(dx, dy)
+                ex, ey = dx / dist, dy / dist
+                delta = self.r[i] - dist
+                wall = self.scene.walls[wk]
+                kn, _, _, droll = self.law(self.mat[i], wall.material)
+                fn = self.elastic_normal(kn, delta)
+                fn_total = -(fx * ex + fy * ey)
+                ft_total = -(fx * ey - fy * ex)
+                mr = -(tq[i] - (dx * fy - dy * fx))
+                m0 = droll / 3 * self.r[i] * abs(fn_total)
+                at_cap = int(droll > 0 and m0 > 0 and abs(mr) >= m0 * (1 - CAP_ROUNDOFF))
+                at = 0.5 * (self.r[i] + dist)
+                nx, ny = to_lab.vector(ex, ey)
+                px, py = to_lab.point(x[i] + at * ex, y[i] + at * ey)
+                rows.append(dict(a=i, b=wk, wall=1, nx=nx, ny=ny, delta=delta, px=px, py=py, fn=fn,
+                                 dn=fn_total - fn, fs=ft_total, ds=0.0, sliding=0, mr=mr, md=0.0,
+                                 rolling=at_cap))
+                self.beyond += self.beyond_end(self.walls_now[wk], *to_lab.point(cx, cy))
+        return rows
+
     def wall_velocity(self, wk, cx, cy, step):
         """The velocity of wall wk's point (cx, cy) in the stage that holds step: V + omega x (c - P)
         (a carried wall: its carrier's velocity, the one it moved with into this step)."""
@@ -344,7 +393,6 @@ def walls_at(scene, schedule, step, atoms=None):
     for its cycles and turned about its (moving) pivot (ballast's `move`); a carried wall
     translated by its carrier's displacement in the atoms frame of that step. schedule: (stage,
     its actual cycles) in order."""
-    dt = scene.dt
     out = []
     carried = carriers(scene, atoms) if atoms is not None else {}
     for k, w in enumerate(scene.walls):
@@ -353,17 +401,7 @@ def walls_at(scene, schedule, step, atoms=None):
             out.append((w.ax + dx, w.ay + dy, w.bx + dx, w.by + dy))
             continue
         px, py = pivot(scene, w)
-        dx = dy = th = 0.0
-        n0 = 0
-        for stage, cycles in schedule:
-            steps = max(0, min(step - n0, cycles))
-            for c in stage.controls:
-                if c.kind == "move" and c.wall == w.name:
-                    v1, v2, om = c.numbers(3)
-                    dx += v1 * dt * steps
-                    dy += v2 * dt * steps
-                    th += om * dt * steps
-            n0 += cycles
+        dx, dy, th = wall_motion(scene, schedule, step, w)
         cs, sn = math.cos(th), math.sin(th)
 
         def move(qx, qy):
@@ -371,6 +409,23 @@ def walls_at(scene, schedule, step, atoms=None):
             return px + dx + cs * rx - sn * ry, py + dy + sn * rx + cs * ry
         out.append(move(w.ax, w.ay) + move(w.bx, w.by))
     return out
+
+
+class WallFrame:
+    """The map from the frame of wall k (lammps_input.frame_wall()) back to the lab at one step:
+    a point q' goes to P0 + d + R(theta)(q' - P0), a vector f' to R(theta) f'."""
+
+    def __init__(self, scene, schedule, step, k):
+        self.px, self.py = pivot(scene, scene.walls[k])
+        self.dx, self.dy, th = wall_motion(scene, schedule, step, scene.walls[k])
+        self.c, self.s = math.cos(th), math.sin(th)
+
+    def vector(self, fx, fy):
+        return self.c * fx - self.s * fy, self.s * fx + self.c * fy
+
+    def point(self, qx, qy):
+        rx, ry = self.vector(qx - self.px, qy - self.py)
+        return self.px + self.dx + rx, self.py + self.dy + ry
 
 
 def gfac_at(scene, schedule, step):

@@ -145,3 +145,58 @@ def test_exported_lammps_jobs_run_where_they_are_sent_and_gather_into_the_peers_
     assert (home / "series.tsv").read_bytes() == (job / "series.tsv").read_bytes()
     assert json.loads((home / "harness.json").read_text())["gathered_from"] == str(job)
     assert not (reports / "runs" / "collisions").exists()         # not taken for ballast's run
+
+
+# ---- the rolling tester: rolling against a turning floor, run in the floor's frame ------------
+
+TESTER = ROOT / "cases" / "rolling" / "rolling_tester.scene"
+# M_0 = F_n B/6 at the first press (rolling_tester.scene): the scale of the moment.
+TESTER_M0 = 40.0
+# Both engines compute the overlap as R - (R - p) cos(angle), a difference of two numbers of size
+# R = 0.75 that leaves d = 2^-12 .. 2^-11: one ulp of R is 3.4e-13 of F_n (reference/derive/
+# rolling.py's FN_ROUNDING), and each engine's rotation adds its own ulps (measured: F_n within
+# 3.9e-13 of the exact overlap in LAMMPS, 6.5e-13 in ballast). So F_n, and M = K_m theta_r until
+# the cap and mu_roll R F_n at it, may differ by about three ulps of R: 1e-12 of F_n (measured
+# 9.1e-13 of M_0 and of F_n at most, over the 4183 cycles).  theta_r is a sum of the same dyadic
+# increments of the spin in both (omega - omega_wall = -omega_wall): equal to the bit.
+TESTER_ROUNDOFF = 2e-12
+
+
+def test_the_rolling_tester_runs_in_the_floors_frame_with_ballasts_moment(tmp_path):
+    """model1_d16 (the floor pressed, turned about the contact point, raised, turned again):
+    LAMMPS's rolling displacement takes the disc's spin only, so the run is made in the floor's
+    frame, where the floor stands still and the held disc moves about P at -omega_wall; its
+    moment, theta_r, cap flags and F_n, written back in the lab, are ballast's to round-off."""
+    import subprocess
+    out = tmp_path / "lammps"
+    assert make_run(Lammps(), TESTER, [], "run", out, BALLAST) == 0
+    info = json.loads((out / "run.json").read_text())
+    assert info["status"] == "ok", info.get("message")
+    assert any(f["name"].endswith("run in the wall's frame") and f["status"] == "exact"
+               for f in info["features"])
+    subprocess.run([str(BALLAST), "run", str(TESTER), "--out", str(tmp_path / "ballast")],
+                   check=True, capture_output=True)
+    a, b = read_series(out / "series.tsv"), read_series(tmp_path / "ballast" / "series.tsv")
+    assert a["cycle"].tolist() == b["cycle"].tolist() and len(b["cycle"]) == 4183
+    assert np.max(np.abs(a["mr"] - b["mr"])) <= TESTER_ROUNDOFF * TESTER_M0
+    assert np.max(np.abs(a["fn"] - b["fn"]) / b["fn"]) <= TESTER_ROUNDOFF
+    assert a["theta_r"].tolist() == b["theta_r"].tolist()
+    assert a["state"].tolist() == b["state"].tolist()
+    # not a contact at rest: the moment went through both plateaus of both normal forces
+    assert max(b["mr"]) > 80 and min(b["mr"]) < -80 and max(b["state"]) == 1
+    # the contact, written back in the lab: its normal turned with the floor as ballast's did
+    ca = (out / "contacts.tsv").read_text().splitlines()[1].split("\t")
+    cb = (tmp_path / "ballast" / "contacts.tsv").read_text().splitlines()[1].split("\t")
+    for column in (3, 4, 5, 6):                             # x, y, nx, ny
+        assert abs(float(ca[column]) - float(cb[column])) <= 1e-15
+
+
+@pytest.mark.parametrize("sets,reason", [
+    (["material.grain.friction=0.5"], "without friction"),
+    (["disc.d.fixed=0"], "every disc is held")])
+def test_the_floors_frame_is_taken_only_where_it_is_exact(tmp_path, sets, reason):
+    """The frame change is refused, and says why, with friction (not measured) and with a free
+    disc (in the floor's frame it would need the frame's inertial forces)."""
+    assert make_run(Lammps(), TESTER, sets, "run", tmp_path, BALLAST) == 0
+    info = json.loads((tmp_path / "run.json").read_text())
+    assert info["status"] == "not_expressible" and reason in info["message"], info["message"]

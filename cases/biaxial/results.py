@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """Print the biaxial results tables from the runs of a full tier (reports/runs/biaxial_full, or
 $BALLAST_REPORTS/runs): the delta-phi table (envelope peak and residual, paper beside ballast,
-the spread over the three specimens at delta = 0 and 1.6), the per-test angles, the density
-study and the halved rate.  Run from the repository root:
+the spread over the three specimens at delta = 0 and 1.6), the per-test angles and the density
+study.  Run from the repository root:
 
     /usr/bin/python3 cases/biaxial/results.py
 """
@@ -77,15 +77,6 @@ def main():
             cells.append(f"{f(ev(v, 'phi_peak(rows=5)'))} / {f(ev(v, f'phi_residual({LO}, {HI})'))}")
         print(f"| {sfx or '_e025'} | {f(e0, '{:.4f}')} | {cells[0]} | {cells[1]} | {f(ev(f'm0_s200{sfx}', 'dilation()'), '{:.3f}')} | "
               f"{f(ev(f'm0_s200{sfx}', 'at_peak(axial_strain(), rows=5)'), '{:.3f}')} |")
-    print()
-    print("| halved rate, 200 kPa | phi peak at 0.5 /s | at 0.25 /s | difference | residual at 0.5 /s | at 0.25 /s |")
-    print("|---|---|---|---|---|---|")
-    for m in ("m0", "m1_d1.6"):
-        a, b = ev(f"{m}_s200", "phi_peak(rows=5)"), ev(f"{m}_s200_half", "phi_peak(rows=5)")
-        ra, rb = ev(f"{m}_s200", f"phi_residual({LO}, {HI})"), ev(f"{m}_s200_half", f"phi_residual({LO}, {HI})")
-        d = f"{b - a:+.2f}" if isinstance(a, float) and isinstance(b, float) else ""
-        print(f"| {m} | {f(a, '{:.2f}')} | {f(b, '{:.2f}')} | {d} | {f(ra, '{:.2f}')} | {f(rb, '{:.2f}')} |")
-
 
 if __name__ == "__main__":
     main()

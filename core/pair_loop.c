@@ -400,10 +400,12 @@ two_at_a_time_of(struct bal_sim *restrict s, const struct bal_law_params *params
             dn = mu_n * k.ndot;
             ftn = fn + dn;
         }
+        /* the spins of i and of j (loaded once for ṡ and θ̇_r) */
+        const bal_v2 wi = (shear || rolling) ? (bal_v2){w[ia], w[ib]} : zero;
+        const bal_v2 wj = (shear || rolling) ? (bal_v2){w[ja], w[jb]} : zero;
         if (shear) {
             const bal_v2 tx = ey, ty = -ex;
-            k.sdot = rvx * tx + rvy * ty -
-                     ((bal_v2){w[ia], w[ib]} * ri + (bal_v2){w[ja], w[jb]} * rj);
+            k.sdot = rvx * tx + rvy * ty - (wi * ri + wj * rj);
             bal_v2 loss;
             bal_v2m slid;
             const bal_v2 fs =
@@ -432,7 +434,7 @@ two_at_a_time_of(struct bal_sim *restrict s, const struct bal_law_params *params
         if (rolling) {
             /* the pair's B and K_m (roll_constants) */
             const struct bal_roll_x2 R = {{prb[ca], prb[cb]}, {prk[ca], prk[cb]}};
-            const bal_v2 wrel = (bal_v2){w[ia], w[ib]} - (bal_v2){w[ja], w[jb]};
+            const bal_v2 wrel = wi - wj;
             const bal_v2 dtheta = wrel * P->dt;
             const bal_v2 tr = (bal_v2){ptr[ca], ptr[cb]} + dtheta;
             ptr[ca] = tr[0];

@@ -113,8 +113,11 @@ unit_vectors(double *restrict q, double *restrict ex, double *restrict ey, int n
  * one bit each: the power law (else the incremental one), the tangential
  * kernel, the damping kernels, the rolling kernel (only with the tangential
  * one: it reads the spins that kernel reads).  A new sub-model is one more
- * bit. */
-enum { MOD_POWER = 1, MOD_SHEAR = 2, MOD_DAMP = 4, MOD_ROLL = 8 };
+ * bit.  MOD_ROLL2, rolling resistance of Model 2, is not a variant of the
+ * table: a rolling variant's ranges are compiled for each model
+ * (pair_range), so that Model 1, whose contacts are never BROKEN, reads no
+ * BROKEN flag and masks no lane. */
+enum { MOD_POWER = 1, MOD_SHEAR = 2, MOD_DAMP = 4, MOD_ROLL = 8, MOD_ROLL2 = 16 };
 
 /* Zero the force sums of discs from..to (inclusive). */
 static inline __attribute__((always_inline)) void
@@ -162,16 +165,17 @@ one_contact(const struct bal_law_params *P, const struct bal_pair_law *L, const 
             struct bal_kin k, long c, int i, int j, double ex, double ey, double rvx, double rvy,
             const double *restrict r, const double *restrict w, double *restrict pfn,
             double *restrict pfs, double *restrict pmr, double *restrict ptr,
-            uint8_t *restrict pflags, double *lost_fric, double *lost_roll)
+            const double *restrict prb, const double *restrict prk, uint8_t *restrict pflags,
+            double *lost_fric, double *lost_roll)
 {
     const int shear = (mods & MOD_SHEAR) != 0, damp = (mods & MOD_DAMP) != 0;
-    const int roll = (mods & MOD_ROLL) != 0;
+    const int roll = (mods & MOD_ROLL) != 0, roll2 = (mods & MOD_ROLL2) != 0;
     const double fn = bal_law_normal(P, L, &k, pfn[c]);
     pfn[c] = fn;
     double ftn = fn, fts = 0, dn = 0, ds = 0;
     /* A contact's lost rolling resistance (Model 2) lasts while it does. */
-    uint8_t flags = roll ? (uint8_t)(BAL_PAIR_TOUCHING | (pflags[c] & BAL_PAIR_BROKEN))
-                         : BAL_PAIR_TOUCHING;
+    uint8_t flags = roll2 ? (uint8_t)(BAL_PAIR_TOUCHING | (pflags[c] & BAL_PAIR_BROKEN))
+                          : BAL_PAIR_TOUCHING;
     double mu_n = 0; /* the normal dashpot's coefficient, which the rolling one also uses */
     if (damp) {
         mu_n = bal_law_dashpot_coef(P, L, k.delta);
@@ -192,7 +196,7 @@ one_contact(const struct bal_law_params *P, const struct bal_pair_law *L, const 
     /* The couple on y, +(M + M_d); on x the opposite (JYH eq. 52). */
     double mr = 0, md = 0;
     if (roll && L->rolling > 0) {
-        const struct bal_roll R = bal_law_roll_of(L, bal_law_common_radius(r[i], r[j]));
+        const struct bal_roll R = {prb[c], prk[c]}; /* the pair's (roll_constants) */
         const double wrel = w[i] - w[j];
         const double dtheta = wrel * P->dt;
         ptr[c] += dtheta;
@@ -331,23 +335,34 @@ add_contact_x2(double *restrict f, float *restrict dsh, int i, int j, __m128d fx
  * added contact by contact in the list's order, and the losses of sliding
  * and rolling contacts too.  Returns the contacts done (nt rounded down to
  * even); the one-contact pass does the last.  The variant's bits (mods)
- * leave out what it does not run, as in one_contact(). */
+ * leave out what it does not run, as in one_contact().  whole: the
+ * material runs every sub-model of the variant (a shear force, rolling
+ * resistance) and no viscous damping (γ_n = 0), as constants
+ * (two_at_a_time chooses; otherwise the loop tested them at each pair of
+ * contacts, and reloaded what they crowded out of the registers). */
 static inline __attribute__((always_inline)) int
-two_at_a_time(struct bal_sim *restrict s, const struct bal_law_params *params, const int mods,
-              long c0, const int32_t *restrict tc, const double *restrict tq,
-              const double *restrict tdx, const double *restrict tdy, int nt, double budget,
-              int *over, double *lost_fric, double *lost_roll)
+two_at_a_time_of(struct bal_sim *restrict s, const struct bal_law_params *params, const int mods,
+                 const int whole, long c0, const int32_t *restrict tc,
+                 const double *restrict tq, const double *restrict tdx,
+                 const double *restrict tdy, int nt, double budget, int *over,
+                 double *lost_fric, double *lost_roll)
 {
     const int damp = (mods & MOD_DAMP) != 0, roll = (mods & MOD_ROLL) != 0;
+    const int roll2 = (mods & MOD_ROLL2) != 0;
     /* The law's parameters in locals: through pointers, the compiler
      * reloaded (and broadcast) each one after every store to the sums. */
-    const struct bal_law_params P_ = *params, *P = &P_;
+    struct bal_law_params P_ = *params;
+    if (whole)
+        P_.gamma_n = 0; /* (it is: a constant for the compiler) */
+    const struct bal_law_params *P = &P_;
     const struct bal_pair_law L_ = *s->disc_law, *L = &L_;
-    const int shear = (mods & MOD_SHEAR) && L->shear, rolling = roll && L->rolling > 0;
+    const int shear = (mods & MOD_SHEAR) && (whole || L->shear);
+    const int rolling = roll && (whole || L->rolling > 0);
     const struct bal_pairs *p = &s->pp;
     const int32_t *restrict pi = p->i, *restrict pj = p->j;
     double *restrict pfn = p->fn, *restrict pfs = p->fs;
     double *restrict pmr = p->mr, *restrict ptr = p->tr;
+    const double *restrict prb = p->rb, *restrict prk = p->rk;
     uint8_t *restrict pflags = p->flags;
     const double *restrict r = s->r, *restrict vx = s->vx, *restrict vy = s->vy;
     const double *restrict w = s->w;
@@ -378,17 +393,19 @@ two_at_a_time(struct bal_sim *restrict s, const struct bal_law_params *params, c
         bal_v2 ftn = fn, fts = zero, dn = zero, ds = zero, mu_n = zero;
         /* A contact's lost rolling resistance (Model 2) lasts while it does. */
         unsigned fl = FL2(BAL_PAIR_TOUCHING);
-        if (roll)
+        if (roll2)
             fl |= (pflags[ca] | (unsigned)pflags[cb] << 8) & FL2(BAL_PAIR_BROKEN);
         if (damp) {
             mu_n = bal_law_dashpot_coef_x2(P, L, k.delta);
             dn = mu_n * k.ndot;
             ftn = fn + dn;
         }
+        /* the spins of i and of j (loaded once for ṡ and θ̇_r) */
+        const bal_v2 wi = (shear || rolling) ? (bal_v2){w[ia], w[ib]} : zero;
+        const bal_v2 wj = (shear || rolling) ? (bal_v2){w[ja], w[jb]} : zero;
         if (shear) {
             const bal_v2 tx = ey, ty = -ex;
-            k.sdot = rvx * tx + rvy * ty -
-                     ((bal_v2){w[ia], w[ib]} * ri + (bal_v2){w[ja], w[jb]} * rj);
+            k.sdot = rvx * tx + rvy * ty - (wi * ri + wj * rj);
             bal_v2 loss;
             bal_v2m slid;
             const bal_v2 fs =
@@ -415,14 +432,17 @@ two_at_a_time(struct bal_sim *restrict s, const struct bal_law_params *params, c
         /* The couple on y, +(M + M_d); on x the opposite (JYH eq. 52). */
         bal_v2 mr = zero, md = zero;
         if (rolling) {
-            const struct bal_roll_x2 R = bal_law_roll_of_x2(L, bal_law_common_radius_x2(ri, rj));
-            const bal_v2 wrel = (bal_v2){w[ia], w[ib]} - (bal_v2){w[ja], w[jb]};
+            /* the pair's B and K_m (roll_constants) */
+            const struct bal_roll_x2 R = {{prb[ca], prb[cb]}, {prk[ca], prk[cb]}};
+            const bal_v2 wrel = wi - wj;
             const bal_v2 dtheta = wrel * P->dt;
-            ptr[ca] += dtheta[0];
-            ptr[cb] += dtheta[1];
+            const bal_v2 tr = (bal_v2){ptr[ca], ptr[cb]} + dtheta;
+            ptr[ca] = tr[0];
+            ptr[cb] = tr[1];
             bal_v2 loss;
             bal_v2m capped;
-            bal_v2m live = live_x2(fl);
+            /* Model 1: every lane (no contact is ever BROKEN) */
+            bal_v2m live = roll2 ? live_x2(fl) : (bal_v2m){-1, -1};
             mr = bal_law_roll_moment_x2(P, R, fn, dtheta, (bal_v2){pmr[ca], pmr[cb]}, live, &loss,
                                         &capped);
             const int cap = bal_v2_bits(capped);
@@ -478,6 +498,25 @@ two_at_a_time(struct bal_sim *restrict s, const struct bal_law_params *params, c
     *over |= ov != 0;
     return n2;
 }
+
+/* Pass 3 two at a time (two_at_a_time_of), compiled apart for a material
+ * that runs the whole of the variant without viscous damping (the biaxial
+ * test, the piles, the race). */
+static inline __attribute__((always_inline)) int
+two_at_a_time(struct bal_sim *restrict s, const struct bal_law_params *params, const int mods,
+              long c0, const int32_t *restrict tc, const double *restrict tq,
+              const double *restrict tdx, const double *restrict tdy, int nt, double budget,
+              int *over, double *lost_fric, double *lost_roll)
+{
+    const struct bal_pair_law *L = s->disc_law;
+    const int whole = (!(mods & MOD_SHEAR) || L->shear) && (!(mods & MOD_ROLL) || L->rolling > 0) &&
+                      (!(mods & MOD_DAMP) || params->gamma_n == 0);
+    if (whole)
+        return two_at_a_time_of(s, params, mods, 1, c0, tc, tq, tdx, tdy, nt, budget, over,
+                                lost_fric, lost_roll);
+    return two_at_a_time_of(s, params, mods, 0, c0, tc, tq, tdx, tdy, nt, budget, over,
+                            lost_fric, lost_roll);
+}
 #endif
 
 /* ------------------------------------------------------------------ */
@@ -522,6 +561,7 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
     const int32_t *restrict pi = p->i, *restrict pj = p->j;
     double *restrict pfn = p->fn, *restrict pfs = p->fs;
     double *restrict pmr = p->mr, *restrict ptr = p->tr;
+    const double *restrict prb = p->rb, *restrict prk = p->rk;
     uint8_t *restrict pflags = p->flags;
     const long pn = p->n;
     const double *restrict x = s->x, *restrict y = s->y;
@@ -540,6 +580,8 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
     P.normal_law = mods & MOD_POWER ? BAL_NORMAL_POWER : BAL_NORMAL_INCREMENTAL;
     if (linear)
         P.nu = 1; /* (it is: a constant for the compiler) */
+    if (roll) /* the same: pair_range chose the ranges of the scene's model */
+        P.rolling_model = mods & MOD_ROLL2 ? BAL_ROLLING_MODEL2 : BAL_ROLLING_MODEL1;
     const int n_mat = s->n_mat;
     const struct bal_pair_law *restrict laws = s->law;
     const struct bal_pair_law *restrict one_law = s->disc_law;
@@ -594,7 +636,10 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
              * F_n = F_s = 0), and is not written, so the near pairs of a
              * wide skin cost the loop no stores.  (The rolling history is
              * reset always: a re-sort negates it, which turns a zero into
-             * −0.) */
+             * −0.  Resetting it only in a list's first cycle and then by
+             * the flags, as the others, ran 1.5 more instructions a
+             * particle-step and 5 % more CPU time on the biaxial test of
+             * Model 1: docs/benchmarks.md.) */
             if (!touch & (roll || pflags[c])) {
                 pfn[c] = 0;
                 pflags[c] = 0;
@@ -634,7 +679,7 @@ range_chunks(struct bal_sim *restrict s, int t, struct range_state st, const int
             over |= k.delta > budget; /* a first sieve; bal_energy_overlap judges each pair */
             const struct contact_sums a =
                 one_contact(&P, L, mods, k, c, i, j, ex, ey, rvx, rvy, r, w, pfn, pfs, pmr, ptr,
-                            pflags, &lost_fric, &lost_roll);
+                            prb, prk, pflags, &lost_fric, &lost_roll);
             add_side(f, dsh, i, 1, &a, a.tqi, a.dtqi, mods, logged, zone, log, &n_log);
             add_side(f, dsh, j, 0, &a, a.tqj, a.dtqj, mods, logged, zone, log, &n_log);
         }
@@ -659,7 +704,7 @@ logged_chunks(struct bal_sim *restrict s, int t, struct range_state st, const in
 }
 
 static inline __attribute__((always_inline)) void
-pair_range(struct bal_sim *restrict s, int t, const int mods)
+pair_range_of(struct bal_sim *restrict s, int t, const int mods)
 {
     struct range_state st = {s->par.start[t], s->par.zone[t], 0, 0};
     s->par.log_n[t] = 0;
@@ -682,6 +727,45 @@ pair_range(struct bal_sim *restrict s, int t, const int mods)
     s->par.two_lane[t] += st.wide;
 }
 
+/* Range t, compiled for the scene's model of rolling resistance in a
+ * rolling variant (MOD_ROLL2 for Model 2). */
+static inline __attribute__((always_inline)) void
+pair_range(struct bal_sim *restrict s, int t, const int mods)
+{
+    if ((mods & MOD_ROLL) && bal_law_params_of(s).rolling_model == BAL_ROLLING_MODEL2)
+        pair_range_of(s, t, mods | MOD_ROLL2);
+    else
+        pair_range_of(s, t, mods);
+}
+
+/* The rolling width B and stiffness K_m of every candidate of the disc–disc
+ * list (pp.rb, pp.rk), set once a list, before its first cycle (pair_loop,
+ * which then sets pp.rolled): they are
+ * constants of the pair (its radii and its pair law, which do not change
+ * during a run), so the loop does not compute the common radius, its
+ * division and K_m at each contact every cycle.  The same kernels
+ * (bal_law_common_radius, bal_law_roll_of in laws_lanes.h) on the same
+ * operands as the loop computed them with, so the same bits.  A pair
+ * without rolling resistance (δ = 0) gets B = K_m = 0, which the loop
+ * does not read. */
+static __attribute__((noinline)) void roll_constants(struct bal_sim *restrict s)
+{
+    struct bal_pairs *p = &s->pp;
+    const int32_t *restrict pi = p->i, *restrict pj = p->j;
+    double *restrict prb = p->rb, *restrict prk = p->rk;
+    const double *restrict r = s->r;
+    const int32_t *restrict mat = s->mat;
+    const int n_mat = s->n_mat;
+    for (long c = 0; c < p->n; c++) {
+        const int i = pi[c], j = pj[c];
+        const struct bal_pair_law *L =
+            s->disc_law ? s->disc_law : &s->law[mat[i] * n_mat + mat[j]];
+        const struct bal_roll R = bal_law_roll_of(L, bal_law_common_radius(r[i], r[j]));
+        prb[c] = R.b;
+        prk[c] = R.km;
+    }
+}
+
 /* The whole list: its ranges, on as many threads, then the logs replayed in
  * range order (threads.c) and the chunks' losses added in order. */
 static inline __attribute__((always_inline)) void
@@ -690,6 +774,10 @@ pair_loop(struct bal_sim *restrict s, void (*on_threads)(struct bal_sim *), cons
     struct bal_par *par = &s->par;
     if (par->planned != s->rebuilds)
         bal_threads_plan(s);
+    /* The first cycle of a list with rolling resistance: its constants. */
+    const int first = (mods & MOD_ROLL) && s->pp.rolled != s->rebuilds;
+    if (first)
+        roll_constants(s);
     const int ranges = par->ranges;
     if (ranges == 1)
         pair_range(s, 0, mods);
@@ -715,6 +803,8 @@ pair_loop(struct bal_sim *restrict s, void (*on_threads)(struct bal_sim *), cons
         s->audit.d_rolling += lost_roll;
     }
     s->over_budget |= over;
+    if (first)
+        s->pp.rolled = s->rebuilds;
 }
 
 /* ------------------------------------------------------------------ */

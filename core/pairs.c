@@ -48,7 +48,10 @@ enum bal_status bal_pairs_reserve(struct bal_pairs *p, long cap)
     if (ok && p->rolling)
         ok = grow_array((void **)&p->mr, c, sizeof *p->mr) &&
              grow_array((void **)&p->tr, c, sizeof *p->tr) &&
-             (!p->damping || grow_array((void **)&p->dm, c, sizeof *p->dm));
+             (!p->damping || grow_array((void **)&p->dm, c, sizeof *p->dm)) &&
+             grow_array((void **)&p->rb, c, sizeof *p->rb) &&
+             grow_array((void **)&p->rk, c, sizeof *p->rk);
+    p->rolled = -1; /* rb and rk: set them again before the loop reads them */
     if (!ok)
         return BAL_ENOMEM;
     p->cap = cap;
@@ -67,8 +70,11 @@ void bal_pairs_free(struct bal_pairs *p)
     free(p->mr);
     free(p->tr);
     free(p->dm);
+    free(p->rb);
+    free(p->rk);
     free(p->flags);
     memset(p, 0, sizeof *p);
+    p->rolled = -1;
     p->shear = shear;
     p->damping = damping;
     p->rolling = rolling;

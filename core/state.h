@@ -58,6 +58,12 @@ struct bal_pairs {
     double *mr, *tr;       /* rolling: the elastic moment M and the relative rotation
                             * θ_r accumulated since the contact formed (laws.h) */
     double *dm;            /* rolling: the dashpot's moment M_d of the last cycle (walls) */
+    double *rb, *rk;       /* rolling, the disc–disc list: the pair's contact width B and
+                            * rolling stiffness K_m (bal_law_roll_of), constants of the pair
+                            * set by the loop's first cycle after each rebuild
+                            * (pair_loop.c, roll_constants); the wall list leaves them unset */
+    long rolled;           /* s->rebuilds when rb and rk were last set, -1: not since the
+                            * columns were (re)allocated */
     uint8_t *flags;
 };
 

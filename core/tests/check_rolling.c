@@ -12,7 +12,8 @@
  * turns about the contact point (θ_r = −∫ ω_wall dt, r = 2 R: eq. 11b); two
  * discs spinning as one rigid body about their centre (objectivity: no
  * relative rotation, eqs 12–13, so no moment); a pair turned round by a
- * re-sort keeps its moment; a scene whose pairs all have δ = 0 gives the
+ * re-sort keeps its moment; the rolling constants the loop keeps per pair
+ * follow a rebuild and a re-sort; a scene whose pairs all have δ = 0 gives the
  * plain scheme bit for bit even in the loop compiled with rolling.
  *
  * Expected values come from the paper's formulas evaluated here, never from
@@ -314,6 +315,61 @@ START_TEST(rolling_follows_a_resort)
 }
 END_TEST
 
+/* The rolling width B and stiffness K_m the disc–disc loop keeps per pair
+ * (pp.rb, pp.rk, set in the first cycle of each list: pair_loop.c) follow
+ * the list: after a rebuild that follows a change of radius, and after a
+ * re-sort that renumbers the pairs, every candidate holds its own pair's
+ * B = δ r, r = 2 r1 r2/(r1 + r2), and K_m = K_n B²/12 (eqs 9b, 24, 29),
+ * not one left from before.  Discs a, b, c of three radii in a row, a and
+ * b, b and c touching. */
+static int roll_constants_checked(struct tfx *f)
+{
+    const struct bal_sim *s = f->sim;
+    const struct bal_pairs *p = &s->pp;
+    ck_assert_int_eq(p->rolled, s->rebuilds); /* set for this list */
+    for (long c = 0; c < p->n; c++) {
+        const double r1 = s->r[p->i[c]], r2 = s->r[p->j[c]];
+        const double b = 1.6 * (2 * r1 * r2 / (r1 + r2));
+        ASSERT_REL(p->rb[c], b);
+        ASSERT_REL(p->rk[c], 1e5 * b * b / 12);
+    }
+    return (int)p->n;
+}
+
+START_TEST(rolling_pair_constants_follow_the_list)
+{
+    struct tfx *f = tfx_new("[settings]\ndt = 1e-4\ngrid = on\nnormal_law = power\nnu = 1\n"
+                            "delta0 = 1\n"
+                            "[material g]\nkn = 1e5\ndensity = 1\nfriction = 0.5\nrolling = 1.6\n"
+                            "[disc a]\nx = 1 0\nr = 0.5\nomega = 0.3\nmaterial = g\n"
+                            "[disc b]\nx = 1.799 0\nr = 0.3\nmaterial = g\n"
+                            "[disc c]\nx = 2.498 0\nr = 0.4\nmaterial = g\n"
+                            "[disc e]\nx = 40 20\nr = 0.5\nmaterial = g\n"
+                            "[stage s]\ncycles = 10\n",
+                            "pair constants");
+    t_steps(f, 2);
+    ck_assert_int_ge(roll_constants_checked(f), 2); /* (a, b) and (b, c) at least */
+    struct bal_sim *s = f->sim;
+    const struct bal_pairs *p;
+    const long ab = t_contact(f, "a", "b", &p);
+    const double b_before = s->pp.rb[ab];
+    /* b a little larger: the same pairs, new constants */
+    s->r[t_slot(f, "b")] = 0.31;
+    ck_assert_int_eq(bal_grid_rebuild(s, &f->err), BAL_OK);
+    t_steps(f, 1);
+    ck_assert_int_ge(roll_constants_checked(f), 2);
+    ck_assert_double_ne(s->pp.rb[t_contact(f, "a", "b", &p)], b_before);
+    /* a and c trade places and the discs are re-sorted: the pairs renumbered */
+    const int a = t_slot(f, "a"), c = t_slot(f, "c");
+    const double xa = s->x[a];
+    s->x[a] = s->x[c];
+    s->x[c] = xa;
+    ck_assert_int_eq(bal_grid_reorder(s, &f->err), BAL_OK);
+    t_steps(f, 1);
+    ck_assert_int_ge(roll_constants_checked(f), 2);
+}
+END_TEST
+
 /* A scene with rolling resistance on one material only, which no touching
  * pair uses: its loop is the one compiled with the rolling kernel, and it
  * must give the plain scheme bit for bit (the same scene with δ = 0
@@ -527,6 +583,7 @@ Suite *suite_rolling(void)
     tcase_add_test(tc, rolling_wall_plateau_and_loss);
     tcase_add_test(tc, rolling_rigid_rotation_objective);
     tcase_add_test(tc, rolling_follows_a_resort);
+    tcase_add_test(tc, rolling_pair_constants_follow_the_list);
     tcase_add_test(tc, rolling_zero_is_plain_bit_for_bit);
     tcase_add_test(tc, rolling_energy_ledger);
     tcase_add_test(tc, rolling_elastic_returns_energy);

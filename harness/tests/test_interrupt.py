@@ -34,6 +34,10 @@ REPO = Path(__file__).resolve().parents[2]
 BALLAST = REPO / "bin" / "ballast"
 
 
+def default_sigint():
+    """In the child before exec: SIGINT back to its default disposition (see the Popen below)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
 def harness_record(folder):
     return json.loads((Path(folder) / "harness.json").read_text())
 
@@ -251,8 +255,10 @@ def sweep(reports, wrapper, *extra, hold=None):
         env["BALLAST_TEST_HOLD"] = hold
     argv = [sys.executable, "-m", "harness", "sweep", "two_discs", "--variant", "undamped",
             "--set", VALUES, "-j", "1", "--bin", str(wrapper), *extra]
+    # SIGINT at its default in the harness (preexec_fn): a shell's background job (`make test &` in
+    # a script, nohup) inherits SIGINT ignored, and Python then never raises KeyboardInterrupt.
     return subprocess.Popen(argv, env=env, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            text=True, start_new_session=True)
+                            text=True, start_new_session=True, preexec_fn=default_sigint)
 
 
 @pytest.fixture(scope="module")

@@ -34,6 +34,10 @@ stage          skip 0 cycles 0 s (cycles)
 """
 
 
+def default_sigint():
+    """In the child before exec: SIGINT back to its default disposition (see the Popen below)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
 def test_parse_info():
     v = st.parse_info(INFO)
     # the stages as the core resolved them, in cycles at the scene's dt, whether given in
@@ -260,8 +264,10 @@ def stability(reports, wrapper, *args, hold=None, log=None):
     if log:
         env["BALLAST_TEST_LOG"] = str(log)
     argv = [sys.executable, "-m", "harness", "stability", "--no-extremes", "--bin", str(wrapper), *args]
+    # SIGINT at its default in the harness (preexec_fn): a shell's background job (`make test &` in
+    # a script, nohup) inherits SIGINT ignored, and Python then never raises KeyboardInterrupt.
     return subprocess.Popen(argv, env=env, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            text=True, start_new_session=True)
+                            text=True, start_new_session=True, preexec_fn=default_sigint)
 
 
 def finished(proc, timeout=120):

@@ -38,6 +38,7 @@ def default_sigint():
     """In the child before exec: SIGINT back to its default disposition (see the Popen below)."""
     signal.signal(signal.SIGINT, signal.SIG_DFL)
 
+
 def harness_record(folder):
     return json.loads((Path(folder) / "harness.json").read_text())
 

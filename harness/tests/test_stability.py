@@ -38,6 +38,7 @@ def default_sigint():
     """In the child before exec: SIGINT back to its default disposition (see the Popen below)."""
     signal.signal(signal.SIGINT, signal.SIG_DFL)
 
+
 def test_parse_info():
     v = st.parse_info(INFO)
     # the stages as the core resolved them, in cycles at the scene's dt, whether given in

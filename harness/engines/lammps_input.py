@@ -7,6 +7,11 @@ the input: atom style and types, pair style and coefficients (pair_law: ballast'
 2 k_a k_b/(k_a + k_b)), the integrator, gravity with its ramp, C&S's global damping, the walls
 as moving region planes, the holds, the start from v_1/2 (start_lines), and the stages' runs
 with the dumps the reader takes back (stage_lines) and a stop rule's checks.
+
+Kept whole (780 lines): it is one translation, written in the order of the input file it emits,
+and its parts share the scene's resolved walls, types and frames (the carriers of controlled
+walls, the wall's frame of a turning floor); split, each part would need the others' naming of
+atoms, groups and variables, which is the translation itself.
 """
 import math
 

@@ -277,17 +277,22 @@ class Reader:
             out["rolling"] = (roll & at_cap).astype(int)
         return out
 
+    def wall_touch(self, A, fid, i, x, y):
+        """Disc i's contact with the wall of fix fid, from its columns: the contact point (cx, cy),
+        the force on the disc (fx, fy), the centre-to-point vector (dx, dy), its length, the unit
+        normal (ex, ey) towards the wall and the overlap r - dist."""
+        cx, cy = A[f"f_{fid}[5]"][i], A[f"f_{fid}[6]"][i]
+        fx, fy = A[f"f_{fid}[2]"][i], A[f"f_{fid}[3]"][i]      # the force on the disc
+        dx, dy = cx - x[i], cy - y[i]
+        dist = math.hypot(dx, dy)
+        return cx, cy, fx, fy, dx, dy, dist, dx / dist, dy / dist, self.r[i] - dist
+
     def wall_contacts(self, A, x, y, hx, hy, hw, walls, step):
         rows = []
         for wk, fid in self.fixes:
             flag = A[f"f_{fid}[1]"]
             for i in np.flatnonzero(flag > 0):
-                cx, cy = A[f"f_{fid}[5]"][i], A[f"f_{fid}[6]"][i]
-                fx, fy = A[f"f_{fid}[2]"][i], A[f"f_{fid}[3]"][i]      # the force on the disc
-                dx, dy = cx - x[i], cy - y[i]
-                dist = math.hypot(dx, dy)
-                ex, ey = dx / dist, dy / dist
-                delta = self.r[i] - dist
+                cx, cy, fx, fy, dx, dy, dist, ex, ey, delta = self.wall_touch(A, fid, i, x, y)
                 wall = self.scene.walls[wk]
                 kn, ks, mu, droll = self.law(self.mat[i], wall.material)
                 fn = self.elastic_normal(kn, delta)
@@ -318,12 +323,7 @@ class Reader:
         for wk, fid in self.fixes:
             flag = A[f"f_{fid}[1]"]
             for i in np.flatnonzero(flag > 0):
-                cx, cy = A[f"f_{fid}[5]"][i], A[f"f_{fid}[6]"][i]
-                fx, fy = A[f"f_{fid}[2]"][i], A[f"f_{fid}[3]"][i]      # the force on the disc
-                dx, dy = cx - x[i], cy - y[i]
-                dist = math.hypot(dx, dy)
-                ex, ey = dx / dist, dy / dist
-                delta = self.r[i] - dist
+                cx, cy, fx, fy, dx, dy, dist, ex, ey, delta = self.wall_touch(A, fid, i, x, y)
                 wall = self.scene.walls[wk]
                 kn, _, _, droll = self.law(self.mat[i], wall.material)
                 fn = self.elastic_normal(kn, delta)

@@ -11,9 +11,13 @@ another engine, gated by the same references, side by side (`make validate-peers
    the finished ones, as for any batch);
 3. every check of those cases (reference/*.ref) evaluated on each engine's runs
    (compare.evaluate_check): PASS, FAIL, KNOWN, SKIP, or for the engine NOT EXPRESSIBLE;
-4. reports/peers/index.md, index.html and matrix.json: per case its cost in each engine
-   (particle-steps, seconds), then check by check both verdicts and values.  Given case names,
-   only their part of an existing matrix is replaced.
+4. the questions of reference/questions.txt (harness/engines/questions.py): tables of named
+   quantities, each row a test evaluated in both engines beside the paper's value; their runs
+   are made in both engines when the cases above do not hold them (a table is answered whole);
+5. reports/peers/index.md, index.html and matrix.json: the questions' tables, per case its cost
+   in each engine (particle-steps, seconds), then check by check both verdicts and values.
+   Given case names, only their part of an existing matrix is replaced, and only the questions
+   with a row in one of them are answered again.
 
 Ensembles: --realisations N runs the first N seeds of every [ensemble] in both engines and
 evaluates the ensemble checks over those N in both (stated in the report); 0 runs them all.
@@ -37,6 +41,7 @@ from ..errors import Busy, CatalogueError, IniError
 from ..lock import reports_lock
 from ..runner import jobs_for, run_all, sigterm_as_interrupt
 from ..tables import read_run_json
+from . import questions
 from .driver import engines
 
 DEFAULT_REALISATIONS = 10     # per ensemble in the matrix (docs/engines.md: the full ones in the full tier)
@@ -93,11 +98,15 @@ def case_cost(case, root):
     return {"particle_steps": ps, "seconds": sec, "runs": made, "variants": len(case.variants)}
 
 
+def stores(cases, runs, engine_runs):
+    """(ballast's RunStore, the engine's) over the cases' runs, their ensembles as run."""
+    ens = catalogue.ensembles_of(cases)
+    return RunStore(folder_locator(runs), ens), RunStore(folder_locator(engine_runs), ens)
+
+
 def evaluate(checks, cases, runs, engine_runs):
     """[(check, ballast verdict, engine verdict)] for every check of the cases."""
-    ens = catalogue.ensembles_of(cases)
-    ballast = RunStore(folder_locator(runs), ens)
-    other = RunStore(folder_locator(engine_runs), ens)
+    ballast, other = stores(cases, runs, engine_runs)
     return [(c, evaluate_check(c, ballast), evaluate_check(c, other)) for c in checks]
 
 
@@ -150,7 +159,7 @@ def rows_of(cases, triples, runs, engine_runs, engine):
     return out
 
 
-def markdown(rows, engine, title, realisations, totals):
+def markdown(rows, engine, title, realisations, totals, answers=()):
     t = title
     lines = [f"# ballast and {t}: the agreement matrix", "",
              f"Every check of the catalogue's cases (reference/*.ref) evaluated on ballast's runs and on "
@@ -166,7 +175,9 @@ def markdown(rows, engine, title, realisations, totals):
     lines += ["|---|" + "---|" * len(keys)]
     lines += ["| ballast | " + " | ".join(str(totals["ballast"].get(k, 0)) for k in keys) + " |",
               f"| {t} | " + " | ".join(str(totals["engine"].get(k, 0)) for k in keys) + " |", ""]
-    lines += ["| case | checks | ballast | " + t + " | cost ballast (particle-steps, s) | cost " + t + " |",
+    lines += questions.markdown(answers, t)
+    lines += ["", "## The cases", "",
+              "| case | checks | ballast | " + t + " | cost ballast (particle-steps, s) | cost " + t + " |",
               "|---|---|---|---|---|---|"]
     for r in rows:
         bt = tally_text([c["ballast"]["result"] for c in r["checks"]])
@@ -199,7 +210,7 @@ def tally_text(results):
 CLASS = {"PASS": "pass", "FAIL": "fail", "KNOWN": "known", "SKIP": "skip", "NOT EXPRESSIBLE": "nx"}
 
 
-def html_page(rows, engine, title, realisations, totals):
+def html_page(rows, engine, title, realisations, totals, answers=()):
     t = html.escape(title)
     esc = lambda s: html.escape(str(s))
     out = ["<!doctype html><html><head><meta charset=\"utf-8\"><title>ballast and " + t + "</title>",
@@ -217,7 +228,9 @@ def html_page(rows, engine, title, realisations, totals):
     out.append("<table><tr><th></th>" + "".join(f"<th>{esc(k)}</th>" for k in keys) + "</tr>")
     for who, label in (("ballast", "ballast"), ("engine", t)):
         out.append(f"<tr><td>{label}</td>" + "".join(f"<td>{totals[who].get(k, 0)}</td>" for k in keys) + "</tr>")
-    out.append("</table><h2>Cases</h2><table><tr><th>case</th><th>checks</th><th>ballast</th>"
+    out.append("</table>")
+    out += questions.html_part(answers, title)
+    out.append("<h2>Cases</h2><table><tr><th>case</th><th>checks</th><th>ballast</th>"
                f"<th>{t}</th><th>ballast particle-steps</th><th>ballast s</th><th>{t} particle-steps</th>"
                f"<th>{t} s</th></tr>")
     for r in rows:
@@ -257,14 +270,20 @@ def json_safe(x):
     return x
 
 
-def merged(rows, engine, out_dir):
-    """rows with the other cases of the matrix already in out_dir (of the same engine) kept, in
-    the catalogue's order: a run of some cases updates their part of the matrix only."""
+def previous(engine, out_dir):
+    """The matrix already in out_dir when it is of the same engine, else {}."""
     try:
         old = json.loads((Path(out_dir) / "matrix.json").read_text())
     except (OSError, ValueError):
-        return rows
-    if old.get("engine") != engine:
+        return {}
+    return old if isinstance(old, dict) and old.get("engine") == engine else {}
+
+
+def merged(rows, engine, out_dir):
+    """rows with the other cases of the matrix already in out_dir (of the same engine) kept, in
+    the catalogue's order: a run of some cases updates their part of the matrix only."""
+    old = previous(engine, out_dir)
+    if not old:
         return rows
     order = [c.name for c in catalogue.load(cases_root())]
     mine = {r["case"]: r for r in rows}
@@ -273,7 +292,7 @@ def merged(rows, engine, out_dir):
     return sorted(both.values(), key=lambda r: order.index(r["case"]) if r["case"] in order else len(order))
 
 
-def write(rows, engine, title, realisations, out_dir):
+def write(rows, engine, title, realisations, out_dir, answers=()):
     totals = {"ballast": {}, "engine": {}}
     for r in rows:
         for c in r["checks"]:
@@ -281,11 +300,11 @@ def write(rows, engine, title, realisations, out_dir):
                 k = c[who]["result"]
                 totals[who][k] = totals[who].get(k, 0) + 1
     out_dir = files.make_dirs(out_dir)
-    files.write_text(out_dir / "index.md", markdown(rows, engine, title, realisations, totals))
-    files.write_text(out_dir / "index.html", html_page(rows, engine, title, realisations, totals))
+    files.write_text(out_dir / "index.md", markdown(rows, engine, title, realisations, totals, answers))
+    files.write_text(out_dir / "index.html", html_page(rows, engine, title, realisations, totals, answers))
     files.write_text(out_dir / "matrix.json", json.dumps(json_safe(
-        {"engine": engine, "title": title, "realisations": realisations, "totals": totals, "cases": rows}),
-        indent=1) + "\n")
+        {"engine": engine, "title": title, "realisations": realisations, "totals": totals,
+         "questions": list(answers), "cases": rows}), indent=1) + "\n")
     return totals
 
 
@@ -307,24 +326,30 @@ def main(argv=None):
             checks = references.expand(references.load(), all_cases)
             references.validate(checks, all_cases)
             cases = reduce_ensembles(catalogue.select(all_cases, a.cases, a.tier), a.realisations)
+            tables = questions.chosen(questions.check_loaded(all_cases), a.cases)
+            extra = questions.extra_cases(tables, all_cases, cases, a.realisations)
             engine = engines()[a.engine]()
             problem = engine.problem()
             if problem:
                 print(f"validate-peers: {engine.title} cannot run: {problem}", file=sys.stderr)
             runs = runs_root()
-            print(f"validate-peers: ballast's runs of {len(cases)} case(s) (kept when already made)")
-            run_all(jobs_for(cases, runs), binary, a.jobs, sys.stdout, resume=True)
+            print(f"validate-peers: ballast's runs of {len(cases)} case(s)"
+                  + (f" and the questions' {sum(len(c.variants) for c in extra)} other run(s)" if extra else "")
+                  + " (kept when already made)")
+            run_all(jobs_for(cases + extra, runs), binary, a.jobs, sys.stdout, resume=True)
             engine_runs = peers_root() / "runs" / a.engine
             print(f"validate-peers: {engine.title}'s runs")
-            run_all(engine_jobs(a.engine, cases, engine_runs), binary, a.jobs, sys.stdout, resume=a.resume)
+            run_all(engine_jobs(a.engine, cases + extra, engine_runs), binary, a.jobs, sys.stdout, resume=a.resume)
             mine = references.for_cases(checks, cases)
             members = {c.name: {v.name for v in c.variants} for c in cases}
             mine = [c for c in mine if all(v in members[c.case] for v in c.run_variants)]
             triples = evaluate(mine, cases, runs, engine_runs)
             rows = rows_of(cases, triples, runs, engine_runs, a.engine)
+            answers = questions.answer(tables, *stores(cases + extra, runs, engine_runs))
             if a.cases:
                 rows = merged(rows, a.engine, peers_root())
-            totals = write(rows, a.engine, engine.title, a.realisations, peers_root())
+                answers = questions.merged(answers, previous(a.engine, peers_root()).get("questions"))
+            totals = write(rows, a.engine, engine.title, a.realisations, peers_root(), answers)
             print(f"validate-peers: ballast {tally_text_dict(totals['ballast'])}; "
                   f"{engine.title} {tally_text_dict(totals['engine'])}")
             print(f"wrote {peers_root() / 'index.md'} and index.html")

@@ -133,6 +133,7 @@ class Reader:
         laws = [[pair_law(scene, p, q) for q in names] for p in names]
         self.law_table = [np.array([[law[f] for law in row] for row in laws]) for f in range(4)]
         self.beyond = 0            # wall contacts found beyond a wall's end (beyond_end)
+        self.unsplit = 0           # discs touching two walls with rolling at once (wall_rolling)
         # theta_r of each touching pair, summed from the half-step spins of every step (only when
         # the frames are every step: track_theta())
         self.theta, self.theta_step = None, None
@@ -205,7 +206,9 @@ class Reader:
                 hy[k] = 0.0
         vx, vy, w = (np.where(self.fixed, 0.0, v) for v in (vx, vy, w))
         discs = self.disc_contacts(pairs, x, y, (hx, hy, hw), (vx, vy, w))
-        contacts = concatenate(discs, contacts_of(self.wall_contacts(A, x, y, hx, hy, hw, walls, step)))
+        wall_rows = self.wall_contacts(A, x, y, hx, hy, hw, walls, step)
+        self.wall_rolling(wall_rows, discs, tq, hw)
+        contacts = concatenate(discs, contacts_of(wall_rows))
         if self.theta is not None:
             self.accumulate_theta(contacts, hw, step)
         return Frame(step, step * self.dt, x, y, vx, vy, w, contacts, walls, gfac)
@@ -309,9 +312,53 @@ class Reader:
                 at = 0.5 * (self.r[i] + dist)
                 rows.append(dict(a=i, b=wk, wall=1, nx=ex, ny=ey, delta=delta, px=x[i] + at * ex,
                                  py=y[i] + at * ey, fn=fn, dn=fn_total - fn, fs=ft_total - ds, ds=ds,
-                                 sliding=sliding))
+                                 sliding=sliding, droll=droll, kn=kn, fn_total=fn_total,
+                                 couple=self.arm(self.r[i], delta) * (ex * fy - ey * fx)))
                 self.beyond += self.beyond_end(walls[wk], cx, cy)
         return rows
+
+    def arm(self, r, delta):
+        """The lever of a contact's tangential force about the disc's centre: r - delta/2 in pair
+        granular and its wall fixes, r in gran/hooke/history (docs/engines.md, Dashpots)."""
+        return r - 0.5 * delta if self.opts.granular else r
+
+    def wall_rolling(self, rows, discs, tq, hw):
+        """The rolling moments of the wall contacts with rolling resistance (in the lab; walls that
+        do not turn: plan()).  The wall fix reports no torque, so a disc's rolling couple from its
+        wall is its torque less the couples of its other contacts: each disc-disc contact's
+        tangential force about the centre and its rolling couple (applied: with the half-step
+        dashpots, -(mr + md) on a and +(mr + md) on b, as disc_contacts() reads them), and every
+        wall contact's tangential force.  Then as disc_contacts(): mr the spring, md the dashpot
+        mu_m omega below the cap, the cap when |M| reaches M_0 = (delta/3) R |F_n| (R_eff = r).
+        A disc touching two walls with rolling at once cannot be split: counted in self.unsplit
+        (the run fails with that message) and left at 0."""
+        rolling = [row for row in rows if row["droll"] > 0]
+        if not rolling:
+            return
+        other = np.zeros(self.n)
+        if len(discs["a"]):
+            a, b, delta = discs["a"], discs["b"], discs["delta"]
+            ft_a = -(discs["fs"] + discs["ds"])
+            couple = discs["mr"] + discs["md"]
+            np.add.at(other, a, -self.arm(self.r[a], delta) * ft_a - couple)
+            np.add.at(other, b, -self.arm(self.r[b], delta) * ft_a + couple)
+        for row in rows:
+            other[row["a"]] += row["couple"]
+        count = {}
+        for row in rolling:
+            count[row["a"]] = count.get(row["a"], 0) + 1
+        for row in rolling:
+            i = row["a"]
+            if count[i] > 1:
+                self.unsplit += 1
+                continue
+            moment = tq[i] - other[i]                      # the wall's rolling couple on the disc
+            droll, r = row["droll"], self.r[i]
+            m0 = droll / 3 * r * abs(row["fn_total"])
+            mu_m = (self.gamma_n + self.beta * row["kn"]) * droll ** 2 / 3 * r ** 2
+            at_cap = bool(m0 > 0 and abs(moment) >= m0 * (1 - CAP_ROUNDOFF))
+            md = 0.0 if at_cap else mu_m * hw[i]
+            row.update(mr=-moment - md, md=md, rolling=int(at_cap))
 
     def frame_contacts(self, A, x, y, tq, to_lab):
         """The wall contacts of a run in the wall's frame (frictionless and undamped: plan()),
@@ -577,6 +624,10 @@ def trajectory_of(scene, opts, work, log):
     if beyond:
         notes["failure"] = (f"{beyond} wall contact(s) beyond a wall's end: LAMMPS's plane is infinite, "
                             "ballast's wall a segment")
+    if reader.unsplit:
+        notes["failure"] = (f"{reader.unsplit} wall contact(s) with rolling resistance of a disc touching two such "
+                            "walls at once: LAMMPS's wall fixes report no torque, and the disc's torque cannot "
+                            "be split between them")
     if log["dangerous"] > 0:
         notes["failure"] = f"{log['dangerous']} dangerous neighbour-list builds in LAMMPS"
     return Trajectory(frames, final, stages, total, log["total_seconds"], notes)

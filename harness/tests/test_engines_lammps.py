@@ -200,3 +200,33 @@ def test_the_floors_frame_is_taken_only_where_it_is_exact(tmp_path, sets, reason
     assert make_run(Lammps(), TESTER, sets, "run", tmp_path, BALLAST) == 0
     info = json.loads((tmp_path / "run.json").read_text())
     assert info["status"] == "not_expressible" and reason in info["message"], info["message"]
+
+
+# ---- rolling against a static wall in the lab: the wall's couple from the disc's torque ---------
+
+ROLLING_FLOOR = ROOT / "harness" / "tests" / "data" / "rolling_floor.scene"
+# The moments are K_m theta_r (theta_r the same dyadic sums of the spin in both) or the cap
+# mu_roll R F_n, F_n = k_n delta with delta a difference of coordinates of size 1: a few ulps of
+# the overlap, 1e-13 of M_0 = 106.7 each (measured 1.1e-11 at the floor, the disc's torque less
+# the other contact's couple, and 2.7e-12 between the discs).
+FLOOR_ROUNDOFF = 1e-12
+
+
+def test_a_static_walls_rolling_moment_is_the_discs_torque_less_its_other_couples(tmp_path):
+    """rolling_floor.scene: a spun disc between a floor and a held disc, both contacts with JYH
+    Model 1 and the floor's reaching its cap. LAMMPS's wall fix reports no torque, so the floor's
+    moment is read as the disc's torque less the disc-disc contact's couple; it was 0 before."""
+    import subprocess
+    out = tmp_path / "lammps"
+    assert make_run(Lammps(), ROLLING_FLOOR, [], "run", out, BALLAST) == 0
+    info = json.loads((out / "run.json").read_text())
+    assert info["status"] == "ok", info.get("message")
+    subprocess.run([str(BALLAST), "run", str(ROLLING_FLOOR), "--out", str(tmp_path / "ballast")],
+                   check=True, capture_output=True)
+    a, b = read_series(out / "series.tsv"), read_series(tmp_path / "ballast" / "series.tsv")
+    m0 = 409600 / 1024 * 1.6 / 6                   # F_n B/6 at the floor, B = delta 2 r
+    assert np.max(np.abs(b["m_floor"])) == pytest.approx(m0)         # the floor's contact capped ...
+    assert 0 < np.sum(b["cap_floor"]) < len(b["cap_floor"])          # ... for a while, then elastic
+    for column in ("m_floor", "m_top"):
+        assert np.max(np.abs(a[column] - b[column])) <= FLOOR_ROUNDOFF * m0, column
+    assert a["cap_floor"].tolist() == b["cap_floor"].tolist()

@@ -17,6 +17,7 @@ The tables are data, reference/questions.txt:
     case = biaxial                    # any case of the catalogue, of any tier
     variant = m0_s200_e020            # the run the quantities are evaluated in
     ensembles = hump dip              # optional: ensembles its quantities read (their runs are made)
+    reads = m0_s100 m0_s400           # optional: other variants its quantities read (phi_envelope)
     quantity.peak = phi_peak(rows=5)  # one expression per column (as a check's quantity)
     paper.peak = 24.4                 # optional, per column: the paper's value (a number or words)
     provenance = JYH Sec. 5.2 ...     # where the paper's values come from (required with paper.*)
@@ -39,7 +40,7 @@ from ..ini import parse_file
 
 FILE = "questions.txt"
 TABLE_KEYS = {"title", "question", "columns", "format", "notes"}
-ROW_KEYS = {"table", "label", "case", "variant", "ensembles", "provenance"}
+ROW_KEYS = {"table", "label", "case", "variant", "ensembles", "reads", "provenance"}
 DEFAULT_FORMAT = ".4g"
 
 
@@ -54,6 +55,7 @@ class Row:
     paper: dict                       # column -> the paper's value as written ('' : none)
     provenance: str = ""
     ensembles: tuple = ()
+    reads: tuple = ()                 # other variants of the case the quantities read
     path: str = ""
     line: int = 0
 
@@ -103,11 +105,11 @@ def load(path=None):
                 elif e.key not in ROW_KEYS:
                     known = ", ".join(sorted(ROW_KEYS | {"quantity.COLUMN", "paper.COLUMN"}))
                     raise s.error(f"unknown key '{e.key}' in [row] (known: {known})", e.line)
-            for key in ("table", "label", "case", "variant", "ensembles", "provenance"):
+            for key in ROW_KEYS:
                 s.entry(key)                                   # a repeated key is an error
             row = Row(s.name, s.require("table"), s.require("label"), s.require("case"), s.require("variant"),
                       quantities, paper, s.get("provenance", ""), tuple(s.get("ensembles", "").split()),
-                      str(path), s.line)
+                      tuple(s.get("reads", "").split()), str(path), s.line)
             if paper and not row.provenance:
                 raise s.error("a row with paper values needs 'provenance = ...' (where they come from)")
             rows.append((row, s))
@@ -141,8 +143,9 @@ def validate(tables, cases):
             case = by_name.get(r.case)
             if case is None:
                 raise r.error(f"[row {r.name}]: 'case = {r.case}' is no case of the catalogue")
-            if case.variant(r.variant) is None:
-                raise r.error(f"[row {r.name}]: case {r.case} has no variant '{r.variant}'")
+            for v in (r.variant,) + r.reads:
+                if case.variant(v) is None:
+                    raise r.error(f"[row {r.name}]: case {r.case} has no variant '{v}'")
             for e in r.ensembles:
                 if case.ensemble(e) is None:
                     raise r.error(f"[row {r.name}]: case {r.case} has no [ensemble {e}]")
@@ -158,14 +161,15 @@ def chosen(tables, names=()):
 
 def extra_cases(tables, all_cases, selected, realisations=0):
     """The runs the tables read that the matrix's cases do not hold, as cases cut to those
-    variants (each named ensemble to its first `realisations` seeds; 0: all)."""
+    variants (the rows' variant and reads; each named ensemble to its first `realisations`
+    seeds, 0: all)."""
     have = {c.name for c in selected}
     need = {}
     for t in tables:
         for r in t.rows:
             if r.case not in have:
                 variants, ens = need.setdefault(r.case, (set(), set()))
-                variants.add(r.variant)
+                variants.update((r.variant,) + r.reads)
                 ens.update(r.ensembles)
     out = []
     for case in all_cases:

@@ -52,8 +52,9 @@ def test_a_row_in_a_case_the_matrix_does_not_hold_has_its_runs_made():
     standard = catalogue.select(CASES, (), "standard")
     extra = {c.name: c for c in questions.extra_cases(tables, CASES, standard, 10)}
     assert set(extra) == {"biaxial_full", "piles_poly_full"}          # biaxial and piles_poly are standard
-    assert {v.name for v in extra["biaxial_full"].variants} == {"m0_s200", "m1_d0.4_s200", "m1_d1.6_s200",
-                                                                 "m2_d0.4_s200"}
+    # the e025 tests at 200 kPa, and at 100 and 400 kPa for the envelopes (a row's `reads`)
+    assert {v.name for v in extra["biaxial_full"].variants} == {
+        f"{m}_s{p}" for m in ("m0", "m1_d0.4", "m1_d1.6") for p in (100, 200, 400)} | {"m2_d0.4_s200"}
     full = extra["piles_poly_full"]
     assert [e.name for e in full.ensembles] == ["hump", "dip"] or [e.name for e in full.ensembles] == ["dip", "hump"]
     assert all(len(e.members) == 10 for e in full.ensembles)
@@ -68,6 +69,7 @@ def test_a_row_in_a_case_the_matrix_does_not_hold_has_its_runs_made():
 def test_named_cases_answer_only_the_tables_with_a_row_in_them():
     tables = questions.check_loaded(CASES)
     assert [t.name for t in questions.chosen(tables, ["biaxial"])] == ["biaxial_phi"]
+    assert [t.name for t in questions.chosen(tables, ["biaxial_full"])] == ["biaxial_phi", "biaxial_envelope"]
     assert [t.name for t in questions.chosen(tables, ["collisions"])] == []
     assert len(questions.chosen(tables)) == len(tables)
 
@@ -96,6 +98,10 @@ def test_a_row_naming_a_variant_the_case_lacks_is_an_error_at_the_row(tmp_path):
         questions.validate(tables, CASES)
     assert "questions.txt:7:" in str(err.value) and "no variant 'no_such_variant'" in str(err.value)
     two = catalogue.select(CASES, ["two_discs"])[0].variants[0].name
+    reads = TEXT.format(variant=two).replace("label = first", "label = first\nreads = not_there")
+    with pytest.raises(IniError) as err:
+        questions.validate(questions.load(write(tmp_path, reads)), CASES)
+    assert "questions.txt:7:" in str(err.value) and "no variant 'not_there'" in str(err.value)
     questions.validate(questions.load(write(tmp_path, TEXT.format(variant=two))), CASES)
 
 

@@ -406,6 +406,8 @@ class Lammps(Engine):
     def simulate(self, scene, plan, work):
         work = files.make_dirs(work)
         opts = plan.options["lammps"]
+        for name in ("stops.json", "checks.json"):       # the stop rules' records are this run's
+            (work / name).unlink(missing_ok=True)
         files.write_text(work / "data.lmp", data_text(scene, opts))
         with open(work / "context.pickle", "wb") as f:
             pickle.dump({"scene": scene, "options": opts}, f)

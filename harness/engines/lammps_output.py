@@ -509,6 +509,33 @@ def read_stops(work):
     return json.loads(p.read_text()) if p.exists() else {}
 
 
+def checks_path(work):
+    return Path(work) / "checks.json"
+
+
+def read_checks(work):
+    """{stage: the values its rule's last check measured} (stop_check())."""
+    p = checks_path(work)
+    return json.loads(p.read_text()) if p.exists() else {}
+
+
+def finite_or_none(x):
+    """A check's value for JSON: the core writes a non-finite one as null (output.c json_number)."""
+    return float(x) if math.isfinite(x) else None
+
+
+def stage_log(stage, record):
+    """A stage's record in run.json as the core writes it (core/output.c): the values its rule's
+    last check measured, -1 where it never checked, null where a value was not finite; the
+    servo and unbalanced rules' entries only where the stage has them."""
+    out = {"ke_over_ee": record.get("ke_over_ee", -1), "stress_change": record.get("stress_change", -1)}
+    if stage.number("stop_servo") > 0:
+        out.update(stop_servo=stage.number("stop_servo"), servo_error=record.get("servo_error", -1))
+    if stage.number("stop_unbalanced") > 0:
+        out.update(stop_unbalanced=stage.number("stop_unbalanced"), unbalanced=record.get("unbalanced", -1))
+    return out
+
+
 _STOP_STATE = {}
 
 
@@ -540,22 +567,31 @@ def stop_check(work, stage):
     ee = m.elastic()
     ratio = m.kinetic() / ee if ee > 0 else math.inf
     met = st.number("stop_ke") <= 0 or ratio <= st.number("stop_ke")
+    record = {"ke_over_ee": finite_or_none(ratio)}
     if st.number("stop_stress") > 0:
         mom = m.moments()
         prev = state["prev"].get(stage)
         state["prev"][stage] = mom
         if prev is None:
             met = False
+            record["stress_change"] = None                 # the core's INFINITY at the first check
         else:
             size = float(np.max(np.abs(mom)))
             change = float(np.max(np.abs(mom - prev))) / size if size > 0 else math.inf
             met = met and change <= st.number("stop_stress")
+            record["stress_change"] = finite_or_none(change)
     if st.number("stop_servo") > 0:
         errors = [abs(sigma - target) / target if sigma != 0 else math.inf
                   for sigma, target in servo_stresses(scene, frame, st)]
         met = met and max(errors, default=0.0) <= st.number("stop_servo")
+        record["servo_error"] = finite_or_none(max(errors, default=0.0))
     if st.number("stop_unbalanced") > 0:
-        met = met and m.unbalanced() <= st.number("stop_unbalanced")
+        unbalanced = m.unbalanced()
+        met = met and unbalanced <= st.number("stop_unbalanced")
+        record["unbalanced"] = finite_or_none(unbalanced)
+    checks = read_checks(work)
+    checks[str(stage)] = record
+    files.write_text(checks_path(work), json.dumps(checks))
     if met:
         stops[str(stage)] = step
         files.write_text(stops_path(work), json.dumps(stops))
@@ -616,8 +652,10 @@ def trajectory_of(scene, opts, work, log):
     final = frames[-1] if frames and frames[-1].step == total else reader.frame(
         atoms[max(atoms)], pairs.get(max(atoms), {}), walls_at(scene, schedule, max(atoms), atoms[max(atoms)]), 1.0)
     beyond = reader.beyond
+    checks = read_checks(work)
     stages = [{"name": s.name, "cycles": c, "max_cycles": s.cycles, "stop_rule": _stop_rule(s),
-               "stopped": str(g) in stops} for g, (s, c) in enumerate(schedule)]
+               "stopped": str(g) in stops, **stage_log(s, checks.get(str(g), {}))}
+              for g, (s, c) in enumerate(schedule)]
     notes = {"lammps_log": {k: log[k] for k in ("version", "builds", "dangerous")},
              "pair_style": "granular" if opts.granular else "gran/hooke/history",
              "atom_types": len(opts.types)}

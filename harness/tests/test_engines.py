@@ -321,3 +321,27 @@ def test_a_matrix_of_some_cases_replaces_only_their_rows(tmp_path):
     totals = matrix.write(rows, "lammps", "LAMMPS", 0, out)
     assert totals["engine"] == {"PASS": 1, "NOT EXPRESSIBLE": 1} and totals["ballast"] == {"PASS": 2}
     assert matrix.merged([row("two_discs", "PASS")], "other", out) == [row("two_discs", "PASS")]
+
+
+class Stage:
+    def __init__(self, **rules):
+        self.rules = rules
+
+    def number(self, key):
+        return self.rules.get(key, 0.0)
+
+
+def test_a_lammps_stage_record_is_the_cores_with_its_last_checks_values():
+    """run.json's stages from LAMMPS carry what the core's carry (core/output.c): E_k/E_el and the
+    stress change of the rule's last check (-1 never checked; null not finite: the first check of
+    a stress rule), the servo and unbalanced entries only where the stage has those rules; a
+    check of the catalogue reads them (piles_poly_full's full_at_rest: stress_change < 1e-5)."""
+    from harness.engines.lammps_output import finite_or_none, stage_log
+    assert stage_log(Stage(), {}) == {"ke_over_ee": -1, "stress_change": -1}
+    rest = Stage(stop_ke=1e-8, stop_stress=1e-5)
+    assert stage_log(rest, {"ke_over_ee": 3e-11, "stress_change": 9e-6}) == \
+        {"ke_over_ee": 3e-11, "stress_change": 9e-6}
+    assert stage_log(Stage(stop_servo=0.01, stop_unbalanced=1e-3), {"ke_over_ee": 0.2, "servo_error": 0.5}) == \
+        {"ke_over_ee": 0.2, "stress_change": -1, "stop_servo": 0.01, "servo_error": 0.5,
+         "stop_unbalanced": 1e-3, "unbalanced": -1}
+    assert finite_or_none(math.inf) is None and finite_or_none(2.0) == 2.0

@@ -118,6 +118,15 @@ def test_servo_and_strain_rate_walls_move_in_lammps_as_in_ballast_to_round_off(t
     for column in ("y_top", "x_right", "fy_top", "fx_right", "fy_bottom", "ek"):
         scale = float(np.max(np.abs(b[column])))
         assert np.max(np.abs(a[column] - b[column])) <= SERVO_ROUNDOFF * scale, column
+    # each stage's record of its rule's last check, as the core writes it (core/output.c): the
+    # same entries, E_k/E_el and the servo error at cycle 200 to round-off, -1 where never checked
+    mine, theirs = info["stages"], core["stages"]
+    assert [sorted(g) for g in mine] == [sorted(g) for g in theirs]
+    for g, h in zip(mine, theirs):
+        for key in ("ke_over_ee", "stress_change", "servo_error"):
+            if key in h:
+                assert g[key] == pytest.approx(h[key], rel=SERVO_ROUNDOFF), key
+    assert theirs[1]["ke_over_ee"] == theirs[1]["stress_change"] == -1
     # the servo moved the top wall down and the strain rate moved it on: not a wall at rest
     assert b["y_top"][-1] < b["y_top"][199] < 6.1 - 0.05
     assert "stress_top" in info["unexpressible"]

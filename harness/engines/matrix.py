@@ -348,7 +348,8 @@ def main(argv=None):
             answers = questions.answer(tables, *stores(cases + extra, runs, engine_runs))
             if a.cases:
                 rows = merged(rows, a.engine, peers_root())
-                answers = questions.merged(answers, previous(a.engine, peers_root()).get("questions"))
+                answers = questions.merged(answers, previous(a.engine, peers_root()).get("questions"),
+                                           [t.name for t in questions.check_loaded(all_cases)])
             totals = write(rows, a.engine, engine.title, a.realisations, peers_root(), answers)
             print(f"validate-peers: ballast {tally_text_dict(totals['ballast'])}; "
                   f"{engine.title} {tally_text_dict(totals['engine'])}")

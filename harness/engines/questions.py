@@ -251,11 +251,13 @@ def signed(d, fmt):
     return "" if d is None else format(d, "+" + fmt.lstrip("+"))
 
 
-def merged(new, old):
-    """new answers with the other tables of old (an earlier matrix) kept, old's order first."""
+def merged(new, old, order=()):
+    """new answers with the other tables of old (an earlier matrix) kept, in the order of the
+    table names `order` (reference/questions.txt's), the others after."""
     mine = {a["table"]: a for a in new}
-    kept = [a for a in old or [] if a.get("table") not in mine]
-    return kept + list(new)
+    both = [a for a in old or [] if a.get("table") not in mine] + list(new)
+    rank = {name: k for k, name in enumerate(order)}
+    return sorted(both, key=lambda a: rank.get(a.get("table"), len(rank)))
 
 
 # ---------------------------------------------------------------- pages
@@ -265,7 +267,8 @@ def markdown(answers, title):
     for a in answers:
         fmt = a["format"]
         lines += ["", f"## Question: {a['title']}", "", a["question"], ""]
-        lines += [n for n in a["notes"] for n in (n, "")]
+        for note in a["notes"]:
+            lines += [note, ""]
         papers = with_paper(a)
         head = ["row"]
         for c in a["columns"]:

@@ -163,7 +163,7 @@ def test_the_matrix_writes_its_questions_and_a_matrix_of_some_cases_keeps_the_ot
     md = (out / "index.md").read_text()
     assert "## Question: one" in md and "## Question: two" in md and "| L | 1 | 1 | +0 |" in md
     old = matrix.previous("lammps", out)["questions"]
-    kept = questions.merged([q("two", 3.0)], old)
-    assert [a["table"] for a in kept] == ["one", "two"] and kept[1]["rows"][0]["cells"]["a"]["ballast"]["value"] == 3.0
+    kept = questions.merged([q("one", 3.0)], old, ["one", "two"])
+    assert [a["table"] for a in kept] == ["one", "two"] and kept[0]["rows"][0]["cells"]["a"]["ballast"]["value"] == 3.0
     assert matrix.previous("other", out) == {}
     assert json.loads((out / "matrix.json").read_text())["questions"][0]["table"] == "one"

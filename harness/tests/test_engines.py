@@ -246,6 +246,33 @@ def test_the_biaxial_tests_are_expressible_but_model_2(tmp_path):
         "rolling resistance: JYH Model 2 (elasto-brittle)"]
 
 
+@needs_ballast
+def test_every_full_tier_scene_is_expressible_in_lammps_but_model_2s(tmp_path):
+    """What `make validate-peers TIER=full` would run (docs/engines.md, the full tier): every
+    variant of the full-tier cases, one realisation per ensemble (the others differ by the seed
+    only), through LAMMPS's plan: refused only Model 2's biaxial tests; the cross-checks of
+    harness/peer are ballast against LAMMPS already."""
+    from harness import catalogue, cases_root
+    counts, refused = {}, set()
+    for case in catalogue.load(cases_root()):
+        if case.tier != "full":
+            continue
+        for v in case.variants:
+            if v.ensemble and v.seed != case.ensemble(v.ensemble).seeds[0]:
+                continue
+            if v.command not in ("run", "exact"):
+                counts["cross-check"] = counts.get("cross-check", 0) + 1
+                continue
+            plan = lammps.Lammps().plan(resolved(tmp_path / case.name / v.name, v.scene, v.sets), v.command)
+            names = [f.name for f in plan.refused()]
+            key = "refused" if names else "expressible"
+            counts[key] = counts.get(key, 0) + 1
+            refused.update(names)
+            assert not names or "model2" in " ".join(v.sets), (case.name, v.name, names)
+    assert refused == {"rolling resistance: JYH Model 2 (elasto-brittle)"}
+    assert counts["expressible"] >= 100 and counts["refused"] == 6 and counts["cross-check"] == 2
+
+
 def test_the_gravity_ramp_is_the_cores_c_plus_one_over_c():
     class S:
         def __init__(self, cycles, ramp):

@@ -56,7 +56,7 @@ NAME_s<seed> (ensembles.py); a figure's `variants` may name an ensemble for all 
 import ast
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from . import TIERS, cases_root
@@ -505,6 +505,23 @@ def ensembles_of(cases):
     """{case name: {ensemble name: its realisations' variant names}} of the cases that declare
     ensembles (for compare.RunStore: the expression functions over an ensemble)."""
     return {c.name: c.ensemble_members() for c in cases if c.ensembles}
+
+
+def first_realisations(cases, n):
+    """The cases with each [ensemble] cut to its first n seeds, its other realisations dropped
+    from the variants (0: all of them): the agreement matrix's REALISATIONS."""
+    if not n:
+        return cases
+    out = []
+    for case in cases:
+        if not case.ensembles:
+            out.append(case)
+            continue
+        keep = {name for e in case.ensembles for name in e.members[:n]}
+        cut = [replace(e, seeds=e.seeds[:n], members=e.members[:n]) for e in case.ensembles]
+        out.append(replace(case, variants=[v for v in case.variants if not v.ensemble or v.name in keep],
+                           ensembles=cut))
+    return out
 
 
 def select(cases, names=(), tier="standard"):

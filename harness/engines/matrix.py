@@ -51,23 +51,6 @@ def peers_root(reports=None):
     return Path(reports or reports_root()) / "peers"
 
 
-def reduce_ensembles(cases, realisations):
-    """The cases with each [ensemble] cut to its first `realisations` seeds (0: all)."""
-    if not realisations:
-        return cases
-    out = []
-    for case in cases:
-        if not case.ensembles:
-            out.append(case)
-            continue
-        keep = {name for e in case.ensembles for name in e.members[:realisations]}
-        ensembles = [replace(e, seeds=e.seeds[:realisations], members=e.members[:realisations])
-                     for e in case.ensembles]
-        variants = [v for v in case.variants if not v.ensemble or v.name in keep]
-        out.append(replace(case, variants=variants, ensembles=ensembles))
-    return out
-
-
 def engine_jobs(engine, cases, root):
     """One Job per variant in the engine: command ENGINE:COMMAND, into root/<case>/<variant>."""
     return [replace(j, command=f"{engine}:{j.command}") for j in jobs_for(cases, root)]
@@ -325,8 +308,9 @@ def main(argv=None):
             all_cases = catalogue.load(cases_root())
             checks = references.expand(references.load(), all_cases)
             references.validate(checks, all_cases)
-            cases = reduce_ensembles(catalogue.select(all_cases, a.cases, a.tier), a.realisations)
-            tables = questions.chosen(questions.check_loaded(all_cases), a.cases)
+            cases = catalogue.first_realisations(catalogue.select(all_cases, a.cases, a.tier), a.realisations)
+            every_table = questions.check_loaded(all_cases)
+            tables = questions.chosen(every_table, a.cases)
             extra = questions.extra_cases(tables, all_cases, cases, a.realisations)
             engine = engines()[a.engine]()
             problem = engine.problem()
@@ -349,7 +333,7 @@ def main(argv=None):
             if a.cases:
                 rows = merged(rows, a.engine, peers_root())
                 answers = questions.merged(answers, previous(a.engine, peers_root()).get("questions"),
-                                           [t.name for t in questions.check_loaded(all_cases)])
+                                           [t.name for t in every_table])
             totals = write(rows, a.engine, engine.title, a.realisations, peers_root(), answers)
             print(f"validate-peers: ballast {tally_text_dict(totals['ballast'])}; "
                   f"{engine.title} {tally_text_dict(totals['engine'])}")

@@ -33,7 +33,7 @@ import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from .. import reference_root
+from .. import catalogue, reference_root
 from ..compare import quantity_in
 from ..errors import CatalogueError, EvalError, IniError, RunNotExpressible, RunProblem, RunSkipped
 from ..ini import parse_file
@@ -176,15 +176,11 @@ def extra_cases(tables, all_cases, selected, realisations=0):
         if case.name not in need:
             continue
         variants, ens = need[case.name]
-        kept = []
-        for e in case.ensembles:
-            if e.name in ens:
-                n = realisations or len(e.seeds)
-                kept.append(replace(e, seeds=e.seeds[:n], members=e.members[:n]))
+        kept = [e for e in case.ensembles if e.name in ens]
         members = {m for e in kept for m in e.members}
         out.append(replace(case, variants=[v for v in case.variants if v.name in variants or v.name in members],
                            ensembles=kept))
-    return out
+    return catalogue.first_realisations(out, realisations)
 
 
 # ---------------------------------------------------------------- the answers

@@ -8,6 +8,7 @@ The fake core (FAKE_BIN) reads 'key = value' scenes and --set KEY=VALUE override
 """
 import json
 import os
+import signal
 import stat
 from pathlib import Path
 
@@ -245,3 +246,10 @@ def env_for(root):
     return {"BALLAST_CASES": str(root / "cases"), "BALLAST_REFERENCE": str(root / "reference"),
             "BALLAST_BIN": str(root / "bin" / "ballast"), "BALLAST_REPORTS": str(root / "reports"),
             "PATH": os.environ.get("PATH", "")}
+
+
+def default_sigint():
+    """For a test's Popen(preexec_fn=...): SIGINT back to its default disposition in the child
+    before exec. A shell's background job (`make test &` in a script, nohup) inherits SIGINT
+    ignored, and a Python harness then never raises KeyboardInterrupt."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)

@@ -27,16 +27,11 @@ from harness.__main__ import main
 from harness.errors import RunProblem
 from harness.runner import Job, binary_identity, identity, run_all, stale
 from harness.tables import load_run
-from harness.tests.fakes import tree_snapshot, write_fake_bin
+from harness.tests.fakes import default_sigint, tree_snapshot, write_fake_bin
 from harness.tests.test_runner import add_sets
 
 REPO = Path(__file__).resolve().parents[2]
 BALLAST = REPO / "bin" / "ballast"
-
-
-def default_sigint():
-    """In the child before exec: SIGINT back to its default disposition (see the Popen below)."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def harness_record(folder):

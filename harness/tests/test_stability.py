@@ -15,6 +15,7 @@ from harness import stability as st
 from harness.runner import Batch
 from harness.report.html_page import stability_html
 from harness.report.markdown import stability_markdown
+from harness.tests.fakes import default_sigint
 
 ROOT = Path(__file__).resolve().parents[2]
 BIN = ROOT / "bin" / "ballast"
@@ -32,11 +33,6 @@ stage          load 40 cycles 0.40000000000000002 s (cycles)
 stage          hold 1000 cycles 10 s (time)
 stage          skip 0 cycles 0 s (cycles)
 """
-
-
-def default_sigint():
-    """In the child before exec: SIGINT back to its default disposition (see the Popen below)."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def test_parse_info():

@@ -313,13 +313,14 @@ class Reader:
                 rows.append(dict(a=i, b=wk, wall=1, nx=ex, ny=ey, delta=delta, px=x[i] + at * ex,
                                  py=y[i] + at * ey, fn=fn, dn=fn_total - fn, fs=ft_total - ds, ds=ds,
                                  sliding=sliding, droll=droll, kn=kn, fn_total=fn_total,
-                                 couple=self.arm(self.r[i], delta) * (ex * fy - ey * fx)))
+                                 couple=self.r[i] * (ex * fy - ey * fx)))   # the wall fixes' lever: r
                 self.beyond += self.beyond_end(walls[wk], cx, cy)
         return rows
 
     def arm(self, r, delta):
-        """The lever of a contact's tangential force about the disc's centre: r - delta/2 in pair
-        granular and its wall fixes, r in gran/hooke/history (docs/engines.md, Dashpots)."""
+        """The lever of a disc-disc contact's tangential force about the disc's centre: r - delta/2
+        in pair granular, r in gran/hooke/history (docs/engines.md, Dashpots).  A wall fix's lever
+        is r in both (measured: harness/tests/data/rolling_floor.scene with friction)."""
         return r - 0.5 * delta if self.opts.granular else r
 
     def wall_rolling(self, rows, discs, tq, hw):

@@ -239,3 +239,30 @@ def test_a_static_walls_rolling_moment_is_the_discs_torque_less_its_other_couple
     for column in ("m_floor", "m_top"):
         assert np.max(np.abs(a[column] - b[column])) <= FLOOR_ROUNDOFF * m0, column
     assert a["cap_floor"].tolist() == b["cap_floor"].tolist()
+
+
+def test_a_rolling_walls_moment_with_friction_takes_out_the_wall_fixs_lever_r(tmp_path):
+    """rolling_floor.scene with friction 0.5: the floor's tangential force (sliding at mu F_n at
+    the first row) is in the disc's torque too, and LAMMPS's wall fix applies it at the lever r
+    (not pair granular's r - delta/2).  Read back with r - delta/2, the floor's moment was its
+    cap plus mu F_n delta/2 (9.2e-4 of M_0 here) at the first row, above its own cap M_0 =
+    (delta_roll/3) r |F_n|.  The two engines' trajectories part after the first step (pair
+    granular's lever r - delta/2 between the discs, ballast's r): so the first row against
+    ballast, and every row against the cap of LAMMPS's own normal force."""
+    import subprocess
+    sets = ["material.grain.friction=0.5"]
+    out = tmp_path / "lammps"
+    assert make_run(Lammps(), ROLLING_FLOOR, sets, "run", out, BALLAST) == 0
+    info = json.loads((out / "run.json").read_text())
+    assert info["status"] == "ok", info.get("message")
+    subprocess.run([str(BALLAST), "run", str(ROLLING_FLOOR), "--out", str(tmp_path / "ballast"),
+                    "--set", sets[0]], check=True, capture_output=True)
+    a, b = read_series(out / "series.tsv"), read_series(tmp_path / "ballast" / "series.tsv")
+    m0 = 409600 / 1024 * 1.6 / 6
+    assert abs(b["fs_floor"][0]) == pytest.approx(0.5 * b["fn_floor"][0])     # sliding at the start
+    assert abs(a["m_floor"][0] - b["m_floor"][0]) <= FLOOR_ROUNDOFF * m0
+    cap = 1.6 / 3 * 0.5 * np.abs(a["fn_floor"])
+    capped = a["cap_floor"] > 0
+    assert 0 < np.sum(capped) < len(capped)
+    assert np.max(np.abs(np.abs(a["m_floor"][capped]) - cap[capped])) <= FLOOR_ROUNDOFF * m0
+    assert np.all(np.abs(a["m_floor"][~capped]) < cap[~capped])

@@ -94,6 +94,27 @@ def test_a_feature_the_engine_cannot_express_makes_every_check_reading_it_not_ex
     assert v.result == "NOT EXPRESSIBLE" and "energy ledger" in v.message
 
 
+@needs_ballast
+def test_ballasts_known_discrepancy_within_tolerance_is_a_pass_in_the_other_engines_column(tmp_path):
+    """A check listed as a known discrepancy (reference/known.tsv: why ballast differs from a
+    paper) is FAIL in ballast's column once within its tolerance (the entry is stale), but the
+    entry is ballast's: in another engine's column (matrix.evaluate) a value within the tolerance
+    is a PASS that says so, and a miss is KNOWN as in ballast's.  Seen on biaxial_full's
+    paper_peak_m1_d0.4_e025: LAMMPS's envelope 25.51 against JYH's 29.0 +- 3.5, ballast's 24.11."""
+    from dataclasses import replace
+    root = tmp_path / "runs"
+    assert make_run(Fake(), TWO_DISCS, [], "run", root / "two_discs" / "plain", BALLAST) == 0
+    store = RunStore(folder_locator(root))
+    inside = replace(check("k1", "plain", "last(Fn_B)", hi=1e300), kind="paper", known="a reason")
+    outside = replace(inside, name="k2", lo=1e299)
+    mine, theirs = evaluate_check(inside, store), evaluate_check(inside, store, known_is_ours=False)
+    assert mine.result == "FAIL" and "but within its tolerance now" in mine.message
+    assert theirs.result == "PASS" and not theirs.known and "ballast lists a known discrepancy (a reason)" in theirs.message
+    for own in (True, False):
+        v = evaluate_check(outside, store, known_is_ours=own)
+        assert v.result == "KNOWN" and v.known == "a reason"
+
+
 def test_a_not_expressible_run_is_neither_a_failure_nor_unfinished(tmp_path):
     from harness.tables import run_failure, unfinished_outputs
     info = {"status": "not_expressible", "message": "not expressible in X: y"}

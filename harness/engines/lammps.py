@@ -69,6 +69,9 @@ LMP = "lmp"
 # apt-get's command line for LAMMPS (a test gives another to see the skip path).
 INSTALL = ("apt-get", "install", "-y", "-qq", "--no-install-recommends", "lammps")
 HERE = Path(__file__).resolve().parent
+# harness/engines' modules that only read finished runs (the agreement matrix and its
+# questions): not part of a run's identity
+REPORT_SIDE = frozenset({"matrix.py", "questions.py"})
 STYLES = ("gran/hooke/history", "granular", "wall/gran/region")
 # Hertz needs one atom type per radius (k_L depends on R_eff): more radii than this and the
 # pair table (n^2/2 coefficients) is no longer a translation worth making.
@@ -193,10 +196,14 @@ class Lammps(Engine):
         return m.group(1).strip() if m else ""
 
     def identity(self):
+        """What decides a LAMMPS run's outputs besides its scene: the executable and every file
+        of harness/engines but the report's (REPORT_SIDE: they read finished runs, make none;
+        a change to them must not redo hours of runs)."""
         exe = shutil.which(self.lmp)
         out = {"lmp": exe, "lmp_sha256": _sha256(exe) if exe else None}
         for p in sorted(HERE.glob("*.py")):
-            out[str(p)] = _sha256(p)
+            if p.name not in REPORT_SIDE:
+                out[str(p)] = _sha256(p)
         return out
 
     # ---- what maps -----------------------------------------------------------------------

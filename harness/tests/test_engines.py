@@ -115,6 +115,19 @@ def test_ballasts_known_discrepancy_within_tolerance_is_a_pass_in_the_other_engi
         assert v.result == "KNOWN" and v.known == "a reason"
 
 
+def test_a_lammps_runs_identity_holds_the_adapters_files_not_the_reports():
+    """The runner keeps a finished LAMMPS run while its identity holds (RESUME=1): the executable
+    and the adapter's files decide the outputs, so each is in it; the agreement matrix and its
+    questions only read finished runs, so a change to them keeps hours of runs (a biaxial test
+    is 133-147 s of LAMMPS)."""
+    ident = lammps.Lammps().identity()
+    names = {pathlib.Path(k).name for k in ident if k.endswith(".py")}
+    here = {p.name for p in pathlib.Path(lammps.__file__).parent.glob("*.py")}
+    assert {"lammps.py", "lammps_input.py", "lammps_output.py", "driver.py", "scene.py"} <= names
+    assert names == here - {"matrix.py", "questions.py"}
+    assert "lmp_sha256" in ident
+
+
 def test_a_not_expressible_run_is_neither_a_failure_nor_unfinished(tmp_path):
     from harness.tables import run_failure, unfinished_outputs
     info = {"status": "not_expressible", "message": "not expressible in X: y"}
